@@ -1,0 +1,128 @@
+"""The ``feedoracle`` command line (DESIGN section 7).
+
+Exit codes: 0 all good; 1 a gap above ``--max-gap`` or a limit violation; 2 bad input
+(one message on stderr naming file and line, never a traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path as FsPath
+from typing import Sequence
+
+from reference.core.errors import FeedOracleError
+from reference.machine import Machine, load_machine
+from reference.nc import parse_file
+from reference.nc.program import Program
+from reference.prepare import prepare, unmodelled_features
+
+from .progress import Progress
+
+EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that exits with code 2 and a one-line message on usage errors."""
+
+    def error(self, message: str) -> None:  # noqa: D102 - argparse API
+        self.print_usage(sys.stderr)
+        print(f"feedoracle: error: {message}", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
+def load_inputs(program_file: str, machine_file: str | None, dialect: str | None
+                ) -> tuple[Program, Machine]:
+    """Parse a program and load machine data (the default machine when ``None``).
+
+    Raises
+    ------
+    FeedOracleError
+        Any problem with either input, naming file and line or key.
+    """
+    machine = load_machine(machine_file)
+    program = parse_file(program_file, dialect=dialect)
+    return program, machine
+
+
+def _fmt(x: float, nd: int = 3) -> str:
+    return "inf" if x == float("inf") else f"{x:.{nd}f}"
+
+
+def cmd_inspect(args: argparse.Namespace) -> int:
+    """``feedoracle inspect``: print blocks, their segments and any warnings."""
+    program, machine = load_inputs(args.program, args.machine, args.dialect)
+    path = prepare(program)
+    out = sys.stdout
+    out.write(f"program {program.file} ({program.dialect}, {len(program.blocks)} blocks, "
+              f"{path.n_segments} segments, {path.total_length:.3f} mm); machine "
+              f"{machine.name}\n")
+    out.write(f"{'line':>6} {'label':<8} {'kind':<5} {'segs':>4} {'length_mm':>11} "
+              f"{'feed_mm_min':>11} {'mode':<5} {'stop':<30} source\n")
+    for span in path.blocks:
+        blk = program.blocks[span.block]
+        feed = span.feed_mm_s * 60.0 if span.n_segments else float("nan")
+        feed_s = "rapid" if blk.motion == "G0" else ("-" if feed != feed else _fmt(feed, 1))
+        stop = span.stop_reason or ""
+        src = blk.source.strip()
+        if len(src) > 60:
+            src = src[:57] + "..."
+        out.write(f"{blk.line:>6} {span.label[:8]:<8} {span.kind:<5} {span.n_segments:>4} "
+                  f"{span.length:>11.4f} {feed_s:>11} {blk.continuous_mode:<5} "
+                  f"{stop[:30]:<30} {src}\n")
+    warnings = tuple(program.warnings) + unmodelled_features(program)
+    for w in warnings:
+        print(str(w), file=sys.stderr)
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of all sub-commands."""
+    p = _Parser(prog="feedoracle", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def common(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--machine", metavar="M.toml", default=None,
+                        help="machine data (default: the bundled 3-axis mill; "
+                             "'linuxcnc_xyz' names the bundled LinuxCNC test machine)")
+        sp.add_argument("--dialect", choices=("sinumerik", "ngc"), default=None,
+                        help="NC dialect (default: from the file extension)")
+        sp.add_argument("--quiet", action="store_true", help="no progress output")
+
+    sp = sub.add_parser("inspect", help="blocks -> path segments table")
+    sp.add_argument("program")
+    common(sp)
+    sp.set_defaults(func=cmd_inspect)
+
+    from . import commands  # the planning sub-commands live beside the report code
+    commands.register(sub, common)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    progress = Progress(quiet=getattr(args, "quiet", False))
+    args.progress = progress
+    try:
+        return int(args.func(args))
+    except FeedOracleError as exc:
+        progress.done()
+        print(f"feedoracle: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:
+        progress.done()
+        name = exc.filename if exc.filename is not None else ""
+        print(f"feedoracle: {name}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        progress.done()
+        print("feedoracle: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        progress.done()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

@@ -1,0 +1,376 @@
+"""Time-parameterised motion along a path: the one profile type of every planner.
+
+A :class:`Profile` is piecewise cubic in time: on interval ``k`` (``t_k <= t <= t_{k+1}``)
+the path position is
+
+``s(t) = s_k + v_k tau + a_k tau^2 / 2 + j_k tau^3 / 6``,  ``tau = t - t_k``,
+
+with constant jerk ``j_k``. Path velocity is continuous (``v`` lives on the knots);
+acceleration may step at knots (BRISK profiles, curvature jumps). This represents
+exactly the constant-acceleration profiles of the convex oracle (``b = v^2`` linear in
+``s`` means ``s''`` constant), trapezoids, 7-phase S-curves, jerk-NLP solutions and
+resampled recordings, so :func:`reference.core.constraints.check_profile` can judge
+all of them analytically inside every interval.
+
+Intervals with ``s_{k+1} = s_k`` are *holds* (dwell, exact-stop settling). Each interval
+is attributed to one NC block (``block``) so that block times sum to the total.
+
+Units: s, mm, mm/s, mm/s^2, mm/s^3. Shapes: ``K`` intervals, ``K + 1`` knots.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ProfileError
+from .tolerances import POS_TOL_MM, VEL_TOL_MM_S
+
+
+def _ro(a, dtype=np.float64) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=dtype)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Profile:
+    """Path motion ``s(t)`` as a piecewise-constant-jerk spline.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (K + 1,)
+        Knot times, s, non-decreasing, ``t[0] = 0``.
+    s : numpy.ndarray, shape (K + 1,)
+        Path position at the knots, mm, non-decreasing.
+    v : numpy.ndarray, shape (K + 1,)
+        Path velocity at the knots, mm/s, >= 0.
+    a : numpy.ndarray, shape (K,)
+        Path acceleration at the *start* of each interval, mm/s^2.
+    j : numpy.ndarray, shape (K,)
+        Path jerk, constant inside each interval, mm/s^3.
+    block : numpy.ndarray of int, shape (K,)
+        NC block each interval belongs to; -1 = derive it from the path position.
+    """
+
+    t: np.ndarray
+    s: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    j: np.ndarray
+    block: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("t", "s", "v", "a", "j"):
+            object.__setattr__(self, name, _ro(getattr(self, name)))
+        object.__setattr__(self, "block", _ro(self.block, np.int64))
+        K = self.a.size
+        if self.t.shape != (K + 1,) or self.s.shape != (K + 1,) or self.v.shape != (K + 1,):
+            raise ProfileError(f"knot arrays must have {K + 1} entries for {K} intervals "
+                               f"(t {self.t.shape}, s {self.s.shape}, v {self.v.shape})")
+        if self.j.shape != (K,) or self.block.shape != (K,):
+            raise ProfileError("a, j and block need one entry per interval")
+        for name in ("t", "s", "v", "a", "j"):
+            arr = getattr(self, name)
+            if not np.all(np.isfinite(arr)):
+                k = int(np.flatnonzero(~np.isfinite(arr))[0])
+                raise ProfileError(f"profile {name}[{k}] is not finite ({arr[k]})")
+        h = np.diff(self.t)
+        if np.any(h < 0):
+            k = int(np.flatnonzero(h < 0)[0])
+            raise ProfileError(f"time runs backwards at knot {k + 1}")
+        if np.any(self.v < -VEL_TOL_MM_S):
+            k = int(np.argmin(self.v))
+            raise ProfileError(f"negative path velocity {self.v[k]:.6g} mm/s at knot {k}")
+        s_end, v_end = self._integrate_end(h)
+        scale = max(1.0, float(np.max(np.abs(self.s)))) if self.s.size else 1.0
+        ds = np.abs(s_end - self.s[1:])
+        if ds.size and ds.max() > POS_TOL_MM * scale:
+            k = int(np.argmax(ds))
+            raise ProfileError(f"interval {k}: integrated position {s_end[k]:.9g} mm does "
+                               f"not meet the next knot {self.s[k + 1]:.9g} mm")
+        vscale = max(1.0, float(np.max(np.abs(self.v)))) if self.v.size else 1.0
+        dv = np.abs(v_end - self.v[1:])
+        if dv.size and dv.max() > 1e-6 * vscale:
+            k = int(np.argmax(dv))
+            raise ProfileError(f"interval {k}: integrated velocity {v_end[k]:.9g} mm/s does "
+                               f"not meet the next knot {self.v[k + 1]:.9g} mm/s")
+
+    def _integrate_end(self, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        s_end = self.s[:-1] + self.v[:-1] * h + self.a * h * h / 2 + self.j * h ** 3 / 6
+        v_end = self.v[:-1] + self.a * h + self.j * h * h / 2
+        return s_end, v_end
+
+    # ------------------------------------------------------------ constructors
+    @classmethod
+    def from_phases(cls, durations, a0, jerk, *, s0: float = 0.0, v0: float = 0.0,
+                    block=None) -> "Profile":
+        """Integrate phases of constant jerk exactly.
+
+        Parameters
+        ----------
+        durations : array_like, shape (K,)
+            Phase durations, s (>= 0).
+        a0 : array_like, shape (K,)
+            Acceleration at the start of each phase, mm/s^2.
+        jerk : array_like, shape (K,)
+            Jerk in each phase, mm/s^3.
+        s0, v0 : float
+            Initial position (mm) and velocity (mm/s).
+        block : array_like of int, shape (K,), optional
+            Block of each phase (-1 = unknown).
+
+        Returns
+        -------
+        Profile
+        """
+        h = np.asarray(durations, dtype=np.float64)
+        a = np.asarray(a0, dtype=np.float64)
+        j = np.asarray(jerk, dtype=np.float64)
+        dv = a * h + j * h * h / 2
+        v = np.concatenate(([v0], v0 + np.cumsum(dv)))
+        ds = v[:-1] * h + a * h * h / 2 + j * h ** 3 / 6
+        s = np.concatenate(([s0], s0 + np.cumsum(ds)))
+        t = np.concatenate(([0.0], np.cumsum(h)))
+        # Clip round-off below zero velocity (a stop reached exactly by a ramp).
+        v = np.where(np.abs(v) <= VEL_TOL_MM_S, np.maximum(v, 0.0), v)
+        blk = np.full(h.size, -1) if block is None else np.asarray(block)
+        return cls(t=t, s=s, v=v, a=a, j=j, block=blk)
+
+    @classmethod
+    def from_path_velocity(cls, s, v, block=None) -> "Profile":
+        """Profile with ``v^2`` linear in ``s`` between nodes (constant acceleration).
+
+        This is the exact continuous profile behind the discretised convex problem
+        (``b = v^2`` piecewise linear in ``s``): ``a_k = (v_{k+1}^2 - v_k^2) / (2 ds_k)``
+        and ``dt_k = 2 ds_k / (v_k + v_{k+1})``.
+
+        Parameters
+        ----------
+        s : array_like, shape (N,)
+            Increasing path nodes, mm (repeated nodes are dropped).
+        v : array_like, shape (N,)
+            Path velocity at the nodes, mm/s (>= 0).
+        block : array_like of int, shape (N - 1,), optional
+            Block of each interval.
+
+        Returns
+        -------
+        Profile
+
+        Raises
+        ------
+        ProfileError
+            An interval of positive length with zero velocity at both ends.
+        """
+        s = np.asarray(s, dtype=np.float64)
+        v = np.maximum(np.asarray(v, dtype=np.float64), 0.0)
+        blk = np.full(s.size - 1, -1) if block is None else np.asarray(block)
+        ds = np.diff(s)
+        keep = ds > 0
+        if not np.all(keep):
+            node_keep = np.concatenate(([True], keep))
+            s, v, blk, ds = s[node_keep], v[node_keep], blk[keep], ds[keep]
+        vs = v[:-1] + v[1:]
+        if np.any(vs <= 0):
+            k = int(np.flatnonzero(vs <= 0)[0])
+            raise ProfileError(f"path velocity is zero at both ends of [{s[k]:.6g}, "
+                               f"{s[k + 1]:.6g}] mm: the motion never gets there")
+        h = 2 * ds / vs
+        a = (v[1:] - v[:-1]) / h      # = (v1^2 - v0^2) / (2 ds), better conditioned
+        t = np.concatenate(([0.0], np.cumsum(h)))
+        return cls(t=t, s=s, v=v, a=a, j=np.zeros(h.size), block=blk)
+
+    # ------------------------------------------------------------ evaluation
+    @property
+    def duration(self) -> float:
+        """Total time, s."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def n_intervals(self) -> int:
+        """Number of intervals ``K``."""
+        return int(self.a.size)
+
+    def state(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Exact ``s, v, a, j`` at times ``t`` (clamped to the profile's span).
+
+        Parameters
+        ----------
+        t : array_like, shape (N,)
+            Times, s.
+
+        Returns
+        -------
+        s, v, a, j : numpy.ndarray, shape (N,)
+            mm, mm/s, mm/s^2, mm/s^3.
+        """
+        t = np.clip(np.atleast_1d(np.asarray(t, dtype=np.float64)), self.t[0], self.t[-1])
+        if self.n_intervals == 0:
+            z = np.zeros_like(t)
+            return z + self.s[0], z + self.v[0], z, z
+        k = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.n_intervals - 1)
+        tau = t - self.t[k]
+        a0, j = self.a[k], self.j[k]
+        s = self.s[k] + self.v[k] * tau + a0 * tau ** 2 / 2 + j * tau ** 3 / 6
+        v = self.v[k] + a0 * tau + j * tau ** 2 / 2
+        return s, v, a0 + j * tau, j
+
+    def time_at(self, s_query, which: str = "first") -> np.ndarray:
+        """Time at which the motion reaches path positions ``s_query``.
+
+        Parameters
+        ----------
+        s_query : array_like, shape (N,)
+            Path positions within ``[s[0], s[-1]]``, mm.
+        which : {"first", "last"}
+            At a hold, the time of arrival (``"first"``) or of departure (``"last"``).
+
+        Returns
+        -------
+        numpy.ndarray, shape (N,)
+            Times, s. Found by bisection on the monotone cubic of the interval, to
+            1e-13 relative of the interval length.
+        """
+        q = np.atleast_1d(np.asarray(s_query, dtype=np.float64))
+        if self.n_intervals == 0:
+            return np.zeros_like(q)
+        if which == "first":
+            k = np.searchsorted(self.s, q, side="left") - 1
+        else:
+            k = np.searchsorted(self.s, q, side="right") - 1
+        k = np.clip(k, 0, self.n_intervals - 1)
+        h = self.t[k + 1] - self.t[k]
+        lo = np.zeros_like(q)
+        hi = h.copy()
+        s0, v0, a0, j = self.s[k], self.v[k], self.a[k], self.j[k]
+        # exact hits on knots
+        at_start = q <= s0
+        at_end = q >= self.s[k + 1]
+        for _ in range(64):
+            mid = 0.5 * (lo + hi)
+            sm = s0 + v0 * mid + a0 * mid ** 2 / 2 + j * mid ** 3 / 6
+            below = sm < q
+            lo = np.where(below, mid, lo)
+            hi = np.where(below, hi, mid)
+        tau = 0.5 * (lo + hi)
+        tau = np.where(at_start, 0.0, np.where(at_end, h, tau))
+        return self.t[k] + tau
+
+    def sample(self, dt: float) -> tuple[np.ndarray, ...]:
+        """Sample at a fixed period (the IPO cycle), ending exactly at the end.
+
+        Parameters
+        ----------
+        dt : float
+            Sampling period, s (> 0).
+
+        Returns
+        -------
+        t, s, v, a, j : numpy.ndarray, shape (N,)
+            Sample times and states.
+        """
+        if not dt > 0:
+            raise ProfileError(f"sampling period must be > 0 s, got {dt}")
+        n = int(np.floor(self.duration / dt + 1e-9))
+        t = np.arange(n + 1) * dt + self.t[0]
+        if t[-1] < self.t[-1] - 1e-12:
+            t = np.append(t, self.t[-1])
+        return (t, *self.state(t))
+
+    # ------------------------------------------------------------ accounting
+    def split_at(self, s_cuts) -> "Profile":
+        """Same motion with extra knots where it first crosses each ``s_cuts`` value.
+
+        Parameters
+        ----------
+        s_cuts : array_like
+            Path positions, mm; values on existing knots or outside the span are ignored.
+
+        Returns
+        -------
+        Profile
+            Equivalent profile whose moving intervals never straddle a cut.
+        """
+        cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
+        cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
+        cuts = cuts[~np.isin(cuts, self.s)]
+        if cuts.size == 0 or self.n_intervals == 0:
+            return self
+        tc = self.time_at(cuts)
+        k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
+        sc, vc, ac, _ = self.state(tc)
+        order = np.argsort(tc, kind="stable")
+        tc, k, sc, vc, ac = tc[order], k[order], cuts[order], vc[order], ac[order]
+        t = np.insert(self.t, k + 1, tc)
+        s = np.insert(self.s, k + 1, sc)
+        v = np.insert(self.v, k + 1, np.maximum(vc, 0.0))
+        a = np.insert(self.a, k + 1, ac)
+        jj = np.insert(self.j, k + 1, self.j[k])
+        blk = np.insert(self.block, k + 1, self.block[k])
+        # Re-derive knot positions from the integration so round-off cannot accumulate.
+        return Profile(t=t, s=s, v=v, a=a, j=jj, block=blk)
+
+    def interval_blocks(self, path) -> np.ndarray:
+        """Block of every interval: given labels, else by position on ``path``.
+
+        Moving intervals without a label take the block at their mid-point; holds
+        without a label go to the last block (in program order) ending at their
+        position, which is the dwell or stop block when there is one.
+
+        Parameters
+        ----------
+        path : reference.core.geometry.Path
+            The path the profile runs on.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (K,)
+        """
+        blk = self.block.copy()
+        todo = blk < 0
+        if not np.any(todo) or not path.blocks:
+            return blk
+        mid = 0.5 * (self.s[:-1] + self.s[1:])
+        moving = self.s[1:] > self.s[:-1]
+        if path.n_segments:
+            by_pos = path.block_of(mid)
+        else:
+            by_pos = np.full(mid.size, path.blocks[-1].block)
+        ends = np.array([b.s_end for b in path.blocks])
+        ids = np.array([b.block for b in path.blocks])
+        # last block (program order) whose end is at or before each hold position
+        last_end = np.searchsorted(ends, self.s[:-1], side="right") - 1
+        hold_blk = ids[np.clip(last_end, 0, len(ids) - 1)]
+        blk[todo & moving] = by_pos[todo & moving]
+        blk[todo & ~moving] = hold_blk[todo & ~moving]
+        return blk
+
+    def block_times(self, path) -> np.ndarray:
+        """Time spent in each NC block; sums to :attr:`duration`.
+
+        Parameters
+        ----------
+        path : reference.core.geometry.Path
+            The path the profile runs on (its ``blocks`` define the block boundaries).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_blocks,)
+            Indexed by block index (``path.blocks[i].block``), s.
+        """
+        n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
+        cuts = [b.s_end for b in path.blocks if b.s_end > b.s_start]
+        prof = self.split_at(cuts)
+        blk = prof.interval_blocks(path)
+        return np.bincount(blk, weights=np.diff(prof.t), minlength=n_blocks)
+
+    def segment_times(self, path) -> np.ndarray:
+        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s."""
+        prof = self.split_at(path.s_breaks)
+        moving = prof.s[1:] > prof.s[:-1]
+        mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+        seg = path.segment_index(mid)
+        return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
+                           minlength=path.n_segments)

@@ -1,0 +1,41 @@
+"""Named numerical tolerances, one per quantity, with units and the reason for each value.
+
+No other module defines a bare epsilon; each test of a tolerance checks its meaning at
+0.5x and 1.5x (tests/core/test_tolerances.py).
+"""
+
+from __future__ import annotations
+
+#: Positions closer than this are the same point, mm. A thousandth of the 1 um
+#: resolution of a typical linear scale, far above float64 noise on 1 m travels (1e-13 mm).
+POS_TOL_MM = 1e-6
+
+#: Path lengths below this add no segment (zero-length block), mm. Same as POS_TOL_MM.
+MIN_SEGMENT_LENGTH_MM = POS_TOL_MM
+
+#: Velocities below this count as standstill, mm/s. 1e-6 mm/s moves 4 pm per 4 ms IPO
+#: cycle, far below any encoder; above float64 noise of v = sqrt(b) near b = 0 (1e-8).
+VEL_TOL_MM_S = 1e-6
+
+#: Two unit tangents are the same direction when the angle between them is below this,
+#: rad. A 1e-7 rad kink at 100 m/min changes an axis velocity by 1.7e-4 mm/s, far below
+#: the smallest overload allowance (A*(ovl-1)*T_ipo >= 0.01 mm/s for real machine data).
+TANGENT_TOL_RAD = 1e-7
+
+#: Arc start and end radius may differ by this much, mm (absolute part). LinuxCNC's
+#: rs274ngc uses 0.002 mm; SINUMERIK's MD21000 CIRCLE_ERROR_CONST defaults to 0.01 mm.
+#: We take the LinuxCNC value: CAM posts write 3-4 decimals, so 0.002 mm still accepts
+#: rounding of the last digit while rejecting wrong centres.
+ARC_RADIUS_TOL_MM = 0.002
+
+#: Relative part of the arc radius check (MD21010 CIRCLE_ERROR_FACTOR is 0.001 as well):
+#: the accepted difference is max(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * radius).
+ARC_RADIUS_REL_TOL = 1e-3
+
+#: A constraint counts as violated when value/limit exceeds 1 + RATIO_TOL. 1e-6 is
+#: above the float64 round-off of the checker's own arithmetic (about 1e-12) and of
+#: solvers' primal feasibility (1e-8 scaled) yet small enough that no real excess hides.
+RATIO_TOL = 1e-6
+
+#: Relative agreement demanded between two exact methods on the same discrete problem.
+DISCRETE_AGREEMENT_RTOL = 1e-5

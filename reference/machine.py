@@ -1,0 +1,366 @@
+"""Machine data (``machine.toml``): load, validate and convert once to mm and s.
+
+Names follow SINUMERIK machine data so values can be copied from a control; units are
+the control's at the boundary (see the tables below) and mm, s, degrees inside.
+Unknown keys, wrong types, non-positive limits and implausible magnitudes (the usual
+sign of a unit mix-up, e.g. MAX_AX_ACCEL given in mm/s^2) raise
+:class:`~reference.core.errors.MachineDataError` naming the key, the value and the rule.
+"""
+
+from __future__ import annotations
+
+import difflib
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path as FsPath
+from typing import Any
+
+from .core.errors import MachineDataError
+from .core.limits import AxisLimits, MachineLimits
+from .core.units import m_to_mm, mm_min_to_mm_s, rev_to_deg
+
+DEFAULT_MACHINE = "default"
+BUNDLED_MACHINES = ("default", "linuxcnc_xyz")
+
+
+@dataclass(frozen=True, slots=True)
+class _Key:
+    """One machine-data key: expected type, unit, plausible range (in file units)."""
+
+    kind: type | tuple[type, ...]
+    unit: str
+    lo: float | None = None       # exclusive lower bound (None: no check)
+    hi: float | None = None       # inclusive upper bound: above it the unit is likely wrong
+    doc: str = ""
+
+
+# Plausible ranges cover real machines from small routers to large gantries; a value
+# outside is almost always a unit error (m/min for mm/min, mm/s^2 for m/s^2), so it is
+# rejected with the unit named instead of silently giving a 1000x wrong answer.
+_MACHINE_KEYS: dict[str, _Key] = {
+    "name": _Key(str, ""),
+    "ipo_cycle_ms": _Key((int, float), "ms", 0.0, 100.0, "IPO cycle (MD10050 x MD10070)"),
+}
+
+_CHANNEL_KEYS: dict[str, _Key] = {
+    "SMOOTHING_MODE": _Key(int, "", -1, 99999, "MD20480 decimal digit map"),
+    "IGNORE_OVL_FACTOR_FOR_ADIS": _Key(bool, "", doc="MD20490"),
+    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0, "MD20460"),
+    "ADAPT_PATH_DYNAMIC": _Key(list, "", doc="MD20465 [BRISK, SOFT], each >= 1"),
+    "lookahead_blocks": _Key(int, "blocks", 0, 100000, "LookAhead horizon"),
+    "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465"),
+    "SMOOTH_ORI_TOL": _Key((int, float), "deg", 0.0, 90.0, "SD42466"),
+    "CUTCOM_CORNER_LIMIT": _Key((int, float), "deg", 0.0, 180.0, "MD20210"),
+    "acceleration_mode": _Key(str, "", doc="BRISK | SOFT"),
+    "MAX_PATH_JERK": _Key((int, float), "m/s^3", 0.0, 1e6, "MD20600"),
+    "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560"),
+    "rounding_length_clamp": _Key((int, float), "", 0.0, 0.5, "block-length clamp c"),
+}
+
+_AXIS_KEYS: dict[str, _Key] = {
+    "type": _Key(str, "", doc="linear | rotary"),
+    "MAX_AX_VELO": _Key((int, float), "mm/min", 1.0, 1e7, "MD32000 (rotary: rev/min)"),
+    "MAX_AX_ACCEL": _Key((int, float), "m/s^2", 0.0, 200.0, "MD32300 (rotary: rev/s^2)"),
+    "MAX_AX_JERK": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32431 (rotary: rev/s^3)"),
+    "MAX_ACCEL_OVL_FACTOR": _Key((int, float), "", None, 10.0, "MD32310, >= 1"),
+    "LOOKAH_FREQUENCY": _Key((int, float), "Hz", 0.0, 1000.0, "MD32440"),
+    "PATH_TRANS_JERK_LIM": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32432"),
+    "COMPRESS_POS_TOL": _Key((int, float), "mm", 0.0, 100.0, "MD33100"),
+    "EPS_TLIFT_TANG_STEP": _Key((int, float), "deg", 0.0, 180.0, "MD37400"),
+    "POSCTRL_GAIN": _Key((int, float), "(m/min)/mm", 0.0, 100.0, "MD32200"),
+    "STOP_LIMIT_FINE": _Key((int, float), "mm", 0.0, 10.0, "MD36010"),
+    "STOP_LIMIT_COARSE": _Key((int, float), "mm", 0.0, 10.0, "MD36000"),
+    "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433"),
+    "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434"),
+    "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435"),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class AxisSettings:
+    """Per-axis machine data the heuristic uses beyond the dynamic limits (mm, s, deg).
+
+    Attributes
+    ----------
+    compress_pos_tol_mm : float
+        MD33100 COMPRESS_POS_TOL, mm (degrees for rotary axes).
+    eps_tlift_deg : float
+        MD37400 EPS_TLIFT_TANG_STEP, degrees.
+    kv_per_s : float
+        Position-controller gain MD32200 converted to 1/s (1 (m/min)/mm = 16.667 1/s).
+    stop_fine_mm, stop_coarse_mm : float
+        MD36010 / MD36000 exact-stop windows, mm.
+    soft_accel_factor, g00_accel_factor, g00_jerk_factor : float
+        MD32433 / MD32434 / MD32435.
+    """
+
+    compress_pos_tol_mm: float = 0.01
+    eps_tlift_deg: float = 5.0
+    kv_per_s: float = 1.0 * 1000.0 / 60.0
+    stop_fine_mm: float = 0.01
+    stop_coarse_mm: float = 0.04
+    soft_accel_factor: float = 1.0
+    g00_accel_factor: float = 1.0
+    g00_jerk_factor: float = 1.0
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelSettings:
+    """Channel machine data that drive the heuristic (mm, s).
+
+    Attributes
+    ----------
+    smoothing_mode : int
+        MD20480 SMOOTHING_MODE (decimal digits, see sinumerik-model 5.9).
+    ignore_ovl_factor_for_adis : bool
+        MD20490.
+    lookahead_smooth_factor_pct : float
+        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss (0 = smoothing off here).
+    adapt_path_dynamic : tuple[float, float]
+        MD20465 ADAPT_PATH_DYNAMIC for [BRISK, SOFT]; 1.0 = off.
+    lookahead_blocks : int
+        Prepared blocks the LookAhead sees; v = 0 is assumed at the horizon end.
+    smooth_contour_tol_mm : float
+        SD42465 SMOOTH_CONTUR_TOL, mm.
+    smooth_ori_tol_deg : float
+        SD42466 SMOOTH_ORI_TOL, degrees.
+    cutcom_corner_limit_deg : float
+        MD20210 CUTCOM_CORNER_LIMIT, degrees.
+    acceleration_mode : {"BRISK", "SOFT"}
+        Default group-21 mode.
+    max_path_jerk : float
+        MD20600 MAX_PATH_JERK, mm/s^3.
+    g0_tolerance_factor : float
+        MD20560 G0_TOLERANCE_FACTOR.
+    rounding_length_clamp : float
+        Model knob c: a rounding distance is at most c times each neighbouring block.
+    """
+
+    smoothing_mode: int = 0
+    ignore_ovl_factor_for_adis: bool = False
+    lookahead_smooth_factor_pct: float = 0.0
+    adapt_path_dynamic: tuple[float, float] = (1.0, 1.0)
+    lookahead_blocks: int = 200
+    smooth_contour_tol_mm: float = 0.05
+    smooth_ori_tol_deg: float = 1.0
+    cutcom_corner_limit_deg: float = 100.0
+    acceleration_mode: str = "SOFT"
+    max_path_jerk: float = 1e8
+    g0_tolerance_factor: float = 3.0
+    rounding_length_clamp: float = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class Machine:
+    """A whole machine: dynamic limits (shared with the oracle) plus control settings.
+
+    Attributes
+    ----------
+    name : str
+        Machine name.
+    source : str
+        File it was loaded from (``"<bundled:default>"`` for bundled data).
+    limits : MachineLimits
+        Per-axis v, a, j, overload factor, frequency and the IPO cycle.
+    channel : ChannelSettings
+        Channel machine data.
+    axis_settings : tuple[tuple[str, AxisSettings], ...]
+        Per-axis settings by axis name.
+    """
+
+    name: str
+    source: str
+    limits: MachineLimits
+    channel: ChannelSettings
+    axis_settings: tuple[tuple[str, AxisSettings], ...]
+
+    def settings_of(self, axis: str) -> AxisSettings:
+        """Per-axis settings by axis name (defaults for an unknown axis)."""
+        for name, st in self.axis_settings:
+            if name == axis:
+                return st
+        return AxisSettings()
+
+
+def _check(section: str, key: str, value: Any, spec: _Key, source: str) -> None:
+    dotted = f"{section}.{key}" if section else key
+    kinds = spec.kind if isinstance(spec.kind, tuple) else (spec.kind,)
+    # bool is an int in Python; a number key must not accept true/false
+    if isinstance(value, bool) and bool not in kinds:
+        ok = False
+    else:
+        ok = isinstance(value, kinds)
+    if not ok:
+        want = " or ".join(k.__name__ for k in kinds).replace("int or float", "number")
+        raise MachineDataError(dotted, value, f"must be a {want}"
+                               + (f" in {spec.unit}" if spec.unit else ""), source)
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if value != value or value in (float("inf"), float("-inf")):
+            raise MachineDataError(dotted, value, "must be finite", source)
+        if spec.lo is not None and not value > spec.lo:
+            raise MachineDataError(dotted, value, f"must be > {spec.lo:g} {spec.unit}".rstrip(),
+                                   source)
+        if spec.hi is not None and value > spec.hi:
+            raise MachineDataError(
+                dotted, value, f"is above the plausible maximum {spec.hi:g} {spec.unit}; "
+                f"check the unit ({spec.doc} is given in {spec.unit})", source)
+
+
+def _unknown(section: str, key: str, value: Any, known: dict[str, _Key], source: str):
+    close = difflib.get_close_matches(key.upper(), list(known), n=1, cutoff=0.6) or [
+        k for k in known if k.lower() == key.lower()]
+    hint = f" (did you mean {close[0]}?)" if close else ""
+    raise MachineDataError(f"{section}.{key}" if section else key, value,
+                           f"unknown key{hint}; known keys: {', '.join(sorted(known))}", source)
+
+
+def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
+    """Validate a parsed ``machine.toml`` and convert it to internal units.
+
+    Parameters
+    ----------
+    data : dict
+        The TOML document as a dict (sections ``machine``, ``channel``, ``axis.<NAME>``).
+    source : str
+        Where it came from, for messages.
+
+    Returns
+    -------
+    Machine
+
+    Raises
+    ------
+    MachineDataError
+        Unknown section or key, wrong type, non-positive or implausible value.
+    """
+    for sec in data:
+        if sec not in ("machine", "channel", "axis"):
+            raise MachineDataError(sec, data[sec], "unknown section; expected [machine], "
+                                   "[channel] and [axis.<NAME>]", source)
+    mach = data.get("machine", {})
+    for k, v in mach.items():
+        if k not in _MACHINE_KEYS:
+            _unknown("machine", k, v, _MACHINE_KEYS, source)
+        _check("machine", k, v, _MACHINE_KEYS[k], source)
+    if "ipo_cycle_ms" not in mach:
+        raise MachineDataError("machine.ipo_cycle_ms", None, "is required (IPO cycle in ms)",
+                               source)
+    t_ipo = mach["ipo_cycle_ms"] / 1000.0
+    name = mach.get("name", FsPath(source).stem)
+
+    ch = data.get("channel", {})
+    for k, v in ch.items():
+        if k not in _CHANNEL_KEYS:
+            _unknown("channel", k, v, _CHANNEL_KEYS, source)
+        _check("channel", k, v, _CHANNEL_KEYS[k], source)
+    adapt = ch.get("ADAPT_PATH_DYNAMIC", [1.0, 1.0])
+    if (len(adapt) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                   and x >= 1.0 for x in adapt)):
+        raise MachineDataError("channel.ADAPT_PATH_DYNAMIC", adapt,
+                               "must be two numbers >= 1.0 ([BRISK, SOFT]; 1.0 = off)", source)
+    mode = ch.get("acceleration_mode", "SOFT")
+    if mode not in ("BRISK", "SOFT"):
+        raise MachineDataError("channel.acceleration_mode", mode, "must be BRISK or SOFT",
+                               source)
+    channel = ChannelSettings(
+        smoothing_mode=ch.get("SMOOTHING_MODE", 0),
+        ignore_ovl_factor_for_adis=ch.get("IGNORE_OVL_FACTOR_FOR_ADIS", False),
+        lookahead_smooth_factor_pct=float(ch.get("LOOKAH_SMOOTH_FACTOR", 0.0)),
+        adapt_path_dynamic=(float(adapt[0]), float(adapt[1])),
+        lookahead_blocks=ch.get("lookahead_blocks", 200),
+        smooth_contour_tol_mm=float(ch.get("SMOOTH_CONTUR_TOL", 0.05)),
+        smooth_ori_tol_deg=float(ch.get("SMOOTH_ORI_TOL", 1.0)),
+        cutcom_corner_limit_deg=float(ch.get("CUTCOM_CORNER_LIMIT", 100.0)),
+        acceleration_mode=mode,
+        max_path_jerk=m_to_mm(float(ch.get("MAX_PATH_JERK", 1e5))),
+        g0_tolerance_factor=float(ch.get("G0_TOLERANCE_FACTOR", 3.0)),
+        rounding_length_clamp=float(ch.get("rounding_length_clamp", 0.5)))
+
+    axes_raw = data.get("axis", {})
+    if not isinstance(axes_raw, dict) or not axes_raw:
+        raise MachineDataError("axis", axes_raw, "at least one [axis.<NAME>] section is "
+                               "required", source)
+    axes: list[AxisLimits] = []
+    settings: list[tuple[str, AxisSettings]] = []
+    for ax, tbl in axes_raw.items():
+        if not isinstance(tbl, dict):
+            raise MachineDataError(f"axis.{ax}", tbl, "must be a table [axis.NAME]", source)
+        sec = f"axis.{ax}"
+        for k, v in tbl.items():
+            if k not in _AXIS_KEYS:
+                _unknown(sec, k, v, _AXIS_KEYS, source)
+            _check(sec, k, v, _AXIS_KEYS[k], source)
+        for req in ("MAX_AX_VELO", "MAX_AX_ACCEL", "MAX_AX_JERK"):
+            if req not in tbl:
+                raise MachineDataError(f"{sec}.{req}", None,
+                                       f"is required ({_AXIS_KEYS[req].unit})", source)
+        kind = tbl.get("type", "rotary" if ax in ("A", "B", "C") else "linear")
+        if kind not in ("linear", "rotary"):
+            raise MachineDataError(f"{sec}.type", kind, "must be linear or rotary", source)
+        rotary = kind == "rotary"
+        conv = rev_to_deg if rotary else m_to_mm
+        ovl = tbl.get("MAX_ACCEL_OVL_FACTOR", 1.2)
+        if ovl < 1.0:
+            raise MachineDataError(f"{sec}.MAX_ACCEL_OVL_FACTOR", ovl,
+                                   "must be >= 1.0 (1.0 = stop at every corner)", source)
+        v_mm_min = tbl["MAX_AX_VELO"] * (360.0 if rotary else 1.0)
+        j = conv(tbl["MAX_AX_JERK"])
+        axes.append(AxisLimits(
+            name=ax, v_max=mm_min_to_mm_s(v_mm_min), a_max=conv(tbl["MAX_AX_ACCEL"]),
+            j_max=j, overload_factor=float(ovl),
+            frequency_hz=float(tbl.get("LOOKAH_FREQUENCY", 10.0)),
+            path_trans_jerk=conv(tbl.get("PATH_TRANS_JERK_LIM", tbl["MAX_AX_JERK"])),
+            rotary=rotary))
+        settings.append((ax, AxisSettings(
+            compress_pos_tol_mm=float(tbl.get("COMPRESS_POS_TOL", 0.01)),
+            eps_tlift_deg=float(tbl.get("EPS_TLIFT_TANG_STEP", 5.0)),
+            kv_per_s=float(tbl.get("POSCTRL_GAIN", 1.0)) * 1000.0 / 60.0,
+            stop_fine_mm=float(tbl.get("STOP_LIMIT_FINE", 0.01)),
+            stop_coarse_mm=float(tbl.get("STOP_LIMIT_COARSE", 0.04)),
+            soft_accel_factor=float(tbl.get("SOFT_ACCEL_FACTOR", 1.0)),
+            g00_accel_factor=float(tbl.get("G00_ACCEL_FACTOR", 1.0)),
+            g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)))))
+    for geo in ("X", "Y", "Z"):
+        if geo not in axes_raw:
+            raise MachineDataError(f"axis.{geo}", None, "geometry axes X, Y and Z are "
+                                   "required", source)
+    limits = MachineLimits(axes=tuple(axes), t_ipo_s=t_ipo, name=name)
+    return Machine(name=name, source=source, limits=limits, channel=channel,
+                   axis_settings=tuple(settings))
+
+
+def load_machine(path: str | FsPath | None = None) -> Machine:
+    """Load machine data from a TOML file, or a bundled machine by name.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path or None
+        A ``.toml`` file, or the name of a bundled machine (``"default"``,
+        ``"linuxcnc_xyz"``); ``None`` gives the default SINUMERIK-like 3-axis mill.
+
+    Returns
+    -------
+    Machine
+
+    Raises
+    ------
+    MachineDataError
+        The file is missing, is not valid TOML, or breaks a rule.
+    """
+    if path is None or str(path) in BUNDLED_MACHINES:
+        name = DEFAULT_MACHINE if path is None else str(path)
+        text = resources.files("reference.machines").joinpath(f"{name}.toml").read_text()
+        source = f"<bundled:{name}>"
+    else:
+        p = FsPath(path)
+        if not p.is_file():
+            raise MachineDataError("--machine", str(path), "file not found (bundled machines: "
+                                   + ", ".join(BUNDLED_MACHINES) + ")")
+        text = p.read_text(encoding="utf-8")
+        source = str(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise MachineDataError("<file>", source, f"is not valid TOML: {exc}", source) from None
+    return machine_from_dict(data, source)

@@ -1,0 +1,1 @@
+"""Bundled machine-data files (TOML)."""

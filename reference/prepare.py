@@ -1,0 +1,281 @@
+"""Stage: resolved NC blocks -> :class:`~reference.core.geometry.Path`.
+
+This is the one path that the heuristic and the oracle both run on. Each moving block
+becomes one segment (line, arc or helix); zero-length blocks add no segment but keep
+their :class:`~reference.core.geometry.BlockSpan` (they may carry stops or aux words).
+
+Stops (``Path.stop_reason``) are decided here, as the control decides them before the
+LookAhead (sinumerik-model sections 3 and 5.2). Model choices, each a documented rule:
+
+* exact stop (G60 modal, G9 non-modal; NGC G61.1) -> rest at the block end;
+* NGC G61 (exact path) -> rest at every non-tangential block end;
+* a block without path motion that the main run executes (G4 dwell, M/S/T/D/H words,
+  ``MSG``, a kept cycle) -> rest where it sits; pure calculation, label or modal-only
+  blocks are handled in block preparation and do not stop the path;
+* M0, M1 (programmed stop), M2, M30 (end) in a moving block -> rest at its end;
+  M6 (tool change) in a moving block -> rest at its start (aux output before motion);
+  other M, S, T, D, H words in a moving block are output during motion: no stop.
+
+Stops that only the heuristic makes (BRISK/SOFT change, geometry axes appearing) belong
+to the reference planner, not to the path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .core.errors import MachineDataError, PathError
+from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segment, line_segments
+from .core.limits import MachineLimits
+from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM,
+                              TANGENT_TOL_RAD)
+from .nc.program import Block, Program, ProgramWarning
+
+_PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
+_STOP_AT_END_M = {0: "M0 programmed stop", 1: "M1 optional stop", 2: "M2 program end",
+                  30: "M30 program end", 17: "M17 subprogram end"}
+_STOP_AT_START_M = {6: "M6 tool change"}
+
+
+def _aux_stops(block: Block) -> tuple[str, str]:
+    """(reason at block start, reason at block end) caused by M words of a moving block."""
+    start = end = ""
+    for letter, value in block.aux:
+        if letter != "M" or value != int(value):
+            continue
+        code = int(value)
+        if code in _STOP_AT_START_M:
+            start = _STOP_AT_START_M[code]
+        if code in _STOP_AT_END_M:
+            end = _STOP_AT_END_M[code]
+    return start, end
+
+
+def _idle_stop(block: Block) -> str:
+    """Stop reason of a block without path motion, or "" if the main run skips it."""
+    if block.dwell_s is not None:
+        return f"dwell G4 {block.dwell_s:g} s"
+    for letter, value in block.aux:
+        if letter == "M" and value == int(value) and int(value) in _STOP_AT_END_M:
+            return _STOP_AT_END_M[int(value)]
+        if letter == "M" and value == int(value) and int(value) in _STOP_AT_START_M:
+            return _STOP_AT_START_M[int(value)]
+    if block.aux:
+        words = " ".join(f"{l}{v:g}" for l, v in block.aux)
+        return f"block without path motion ({words})"
+    if block.message is not None:
+        return "block without path motion (MSG)"
+    if block.kept_unmodelled:
+        return f"block without path motion ({block.kept_unmodelled[0]})"
+    return ""
+
+
+def prepare(program: Program) -> Path:
+    """Build the path of a program.
+
+    Parameters
+    ----------
+    program : Program
+        Parsed program (absolute positions in mm / degrees).
+
+    Returns
+    -------
+    Path
+        One segment per moving block, a :class:`BlockSpan` for every block, stop flags.
+
+    Raises
+    ------
+    PathError
+        An arc whose radii do not match or with zero radius (names file, line, block).
+    """
+    axes = program.axes
+    n = len(axes)
+    geometry = np.array([a in ("X", "Y", "Z") for a in axes])
+    index = {a: i for i, a in enumerate(axes)}
+    blocks = program.blocks
+    nb = len(blocks)
+
+    starts = np.array([b.start for b in blocks], dtype=np.float64).reshape(nb, n)
+    ends = np.array([b.end for b in blocks], dtype=np.float64).reshape(nb, n)
+    is_motion = np.array([b.motion is not None for b in blocks], dtype=bool)
+    is_arc = np.array([b.motion in ("G2", "G3") for b in blocks], dtype=bool)
+    delta = ends - starts
+    geo = np.sqrt(np.sum(delta[:, geometry] ** 2, axis=1))
+    allax = np.sqrt(np.sum(delta ** 2, axis=1))
+    line_len = np.where(geo > POS_TOL_MM, geo, allax)
+    moving_line = is_motion & ~is_arc & (line_len > POS_TOL_MM)
+    moving = moving_line | is_arc  # arcs decided below (a full circle has start == end)
+
+    # --- packed parameters, one row per moving block, in block order -------------
+    rows = np.flatnonzero(moving)
+    lines = line_segments(starts[rows], ends[rows], geometry, rows)
+    packed = {k: v.copy() for k, v in lines.items()}
+    keep = np.ones(rows.size, dtype=bool)
+    for r_i in np.flatnonzero(is_arc[rows]):
+        b = blocks[rows[r_i]]
+        u, v = (index[a] for a in _PLANES[b.plane])
+        center = np.asarray(b.center, dtype=np.float64)
+        r0 = float(np.hypot(starts[rows[r_i], u] - center[u], starts[rows[r_i], v] - center[v]))
+        tol = max(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * r0)
+        try:
+            arc = arc_segment(starts[rows[r_i]], ends[rows[r_i]], center, (u, v),
+                              b.motion == "G2", b.turns, geometry, int(rows[r_i]), tol)
+        except PathError as exc:
+            raise PathError(f"{program.file}:{b.line}: {exc}", b.index) from None
+        if arc["length"][0] <= POS_TOL_MM:
+            keep[r_i] = False
+            continue
+        for k in packed:
+            packed[k][r_i] = arc[k][0]
+    if not np.all(keep):
+        rows = rows[keep]
+        packed = {k: v[keep] for k, v in packed.items()}
+    m = rows.size
+    seg_of_block = np.full(nb, -1, dtype=np.int64)
+    seg_of_block[rows] = np.arange(m)
+
+    feed = np.array([np.inf if (blocks[r].motion == "G0" or blocks[r].feed_mm_s is None)
+                     else blocks[r].feed_mm_s for r in rows], dtype=np.float64)
+    rapid = np.array([blocks[r].motion == "G0" for r in rows], dtype=bool)
+
+    # --- stops at the m + 1 breaks -----------------------------------------------
+    reasons = [""] * (m + 1)
+    spans: list[BlockSpan] = []
+    next_break = 0            # break index in front of the next segment
+    s_breaks = np.concatenate(([0.0], np.cumsum(packed["length"])))
+    for b in blocks:
+        seg = seg_of_block[b.index]
+        if seg >= 0:
+            at_start, at_end = _aux_stops(b)
+            if at_start and not reasons[seg]:
+                reasons[seg] = at_start
+            end_reason = at_end
+            if b.exact_stop_here:
+                end_reason = end_reason or ("exact stop G60" if b.continuous_mode == "G60"
+                                            else "exact stop G9")
+            if end_reason:
+                reasons[seg + 1] = end_reason
+            spans.append(BlockSpan(
+                block=b.index, line=b.line, label=b.label, kind=b.motion or "none",
+                s_start=float(s_breaks[seg]), s_end=float(s_breaks[seg + 1]),
+                first_segment=int(seg), n_segments=1,
+                feed_mm_s=float(feed[seg]), stop_reason=end_reason))
+            next_break = seg + 1
+        else:
+            why = _idle_stop(b)
+            if why and not reasons[next_break]:
+                reasons[next_break] = why
+            kind = "none" if b.motion is None else b.motion
+            spans.append(BlockSpan(
+                block=b.index, line=b.line, label=b.label, kind=kind,
+                s_start=float(s_breaks[next_break]), s_end=float(s_breaks[next_break]),
+                first_segment=next_break, n_segments=0, stop_reason=why,
+                dwell_s=float(b.dwell_s or 0.0)))
+    reasons[0] = reasons[0] or "start"
+    reasons[m] = reasons[m] or "end"
+
+    path = Path(axes=tuple(axes), geometry=geometry, rotary=np.array(program.rotary),
+                feed=feed, rapid=rapid, stop=np.array([bool(r) for r in reasons]),
+                stop_reason=tuple(reasons), blocks=tuple(spans), source=program.file,
+                **packed)
+    return _exact_path_stops(path, program)
+
+
+def _exact_path_stops(path: Path, program: Program) -> Path:
+    """NGC G61: rest at every non-tangential break whose block before is in G61."""
+    if path.n_segments < 2:
+        return path
+    modes = np.array([program.blocks[b].continuous_mode == "G61" for b in path.block[:-1]])
+    if not modes.any():
+        return path
+    t_in, t_out = path.junction_tangents()
+    cosang = np.sum(t_in * t_out, axis=1) / np.maximum(
+        np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1), 1e-300)
+    kink = np.arccos(np.clip(cosang, -1.0, 1.0)) > TANGENT_TOL_RAD
+    reasons = list(path.stop_reason)
+    for k in np.flatnonzero(modes & kink):
+        reasons[k + 1] = reasons[k + 1] or "exact path G61 corner"
+    fields = {f: getattr(path, f) for f in ("axes", "geometry", "rotary", "origin", "e1",
+              "e2", "d", "radius", "omega", "theta0", "length", "block", "kind", "feed",
+              "rapid", "blocks", "source")}
+    return Path(stop=np.array([bool(r) for r in reasons]), stop_reason=tuple(reasons),
+                **fields)
+
+
+def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
+    """Warnings for programmed features the path does not apply yet (TRC, TANG).
+
+    Parameters
+    ----------
+    program : Program
+
+    Returns
+    -------
+    tuple[ProgramWarning, ...]
+        At most one warning per feature, naming the first line that uses it.
+    """
+    out: list[ProgramWarning] = []
+    trc = next((b for b in program.blocks if b.tool_compensation != "G40"), None)
+    if trc is not None:
+        out.append(ProgramWarning(program.file, trc.line,
+                                  f"tool radius compensation {trc.tool_compensation} is not "
+                                  "applied: the path is the programmed contour"))
+    tang = next((b for b in program.blocks if b.tangential is not None), None)
+    if tang is not None:
+        out.append(ProgramWarning(program.file, tang.line,
+                                  "tangential control is not applied: the following axis "
+                                  "moves only as programmed"))
+    return tuple(out)
+
+
+def require_axes(path: Path, limits: MachineLimits) -> None:
+    """Check that the machine has limits for every axis the path moves.
+
+    Raises
+    ------
+    MachineDataError
+        Naming the axis and the first source line that moves it.
+    """
+    have = set(limits.names)
+    for i, name in enumerate(path.axes):
+        if name in have:
+            continue
+        moved = np.flatnonzero(np.abs(path.d[:, i]) + path.radius * (
+            np.abs(path.e1[:, i]) + np.abs(path.e2[:, i])) > 0)
+        if moved.size:
+            blk = int(path.block[moved[0]])
+            line = next((b.line for b in path.blocks if b.block == blk), 0)
+            raise MachineDataError(
+                f"axis.{name}", None,
+                f"{path.source}:{line}: the program moves axis {name}, but machine "
+                f"'{limits.name}' defines no limits for it (add an [axis.{name}] section)")
+
+
+def restrict_to_machine(path: Path, limits: MachineLimits) -> Path:
+    """Drop axes the program names but never moves and the machine does not have.
+
+    Parameters
+    ----------
+    path : Path
+    limits : MachineLimits
+
+    Returns
+    -------
+    Path
+        The same path over the axes that the machine knows (after :func:`require_axes`).
+    """
+    require_axes(path, limits)
+    keep = np.array([a in set(limits.names) for a in path.axes])
+    if keep.all():
+        return path
+    f = {k: getattr(path, k) for k in ("radius", "omega", "theta0", "length", "block",
+                                       "kind", "feed", "rapid", "stop", "stop_reason",
+                                       "blocks", "source")}
+    return Path(axes=tuple(a for a, k in zip(path.axes, keep) if k),
+                geometry=path.geometry[keep], rotary=path.rotary[keep],
+                origin=path.origin[:, keep], e1=path.e1[:, keep], e2=path.e2[:, keep],
+                d=path.d[:, keep], **f)
+
+
+__all__ = ["prepare", "require_axes", "restrict_to_machine", "unmodelled_features",
+           "KIND_CODES"]

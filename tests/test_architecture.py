@@ -1,0 +1,93 @@
+"""Import rules of DESIGN section 1, checked on the source with ``ast``.
+
+- reference/core/ imports only the standard library, numpy and scipy;
+- reference/ never imports optimal or compare;
+- optimal/ imports reference.core only (never the NC parser or the heuristic), and
+  solver packages only inside optimal/backends/;
+- nothing imports compare (except compare itself and the tests).
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLVERS = {"cvxpy", "clarabel", "osqp", "highspy", "casadi", "toppra", "ruckig"}
+STDLIB = set(sys.stdlib_module_names)
+
+
+def _imports(py: Path) -> list[tuple[int, str]]:
+    """Absolute module names imported by a file (relative imports resolved)."""
+    tree = ast.parse(py.read_text(encoding="utf-8"))
+    pkg = py.relative_to(ROOT).with_suffix("").parts[:-1]
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg[: len(pkg) - node.level + 1]
+                mod = ".".join(base + ((node.module,) if node.module else ()))
+            else:
+                mod = node.module or ""
+            out.append((node.lineno, mod))
+    return out
+
+
+def _files(folder: str) -> list[Path]:
+    return sorted((ROOT / folder).rglob("*.py"))
+
+
+def _top(mod: str) -> str:
+    return mod.split(".")[0]
+
+
+@pytest.mark.parametrize("py", _files("reference/core"), ids=lambda p: p.name)
+def test_core_imports_only_stdlib_numpy_scipy(py: Path) -> None:
+    for line, mod in _imports(py):
+        top = _top(mod)
+        ok = top in STDLIB or top in ("numpy", "scipy") or mod.startswith("reference.core")
+        assert ok, f"{py.relative_to(ROOT)}:{line} imports {mod}"
+
+
+@pytest.mark.parametrize("py", _files("reference"), ids=lambda p: str(p.relative_to(ROOT)))
+def test_reference_never_imports_optimal_or_compare(py: Path) -> None:
+    for line, mod in _imports(py):
+        assert _top(mod) not in ("optimal", "compare"), (
+            f"{py.relative_to(ROOT)}:{line} imports {mod}")
+
+
+@pytest.mark.parametrize("py", _files("optimal"), ids=lambda p: str(p.relative_to(ROOT)))
+def test_optimal_imports_reference_core_only(py: Path) -> None:
+    in_backends = "backends" in py.relative_to(ROOT).parts
+    for line, mod in _imports(py):
+        top = _top(mod)
+        if top == "reference":
+            assert mod.startswith("reference.core"), (
+                f"{py.relative_to(ROOT)}:{line} imports {mod} (only reference.core allowed)")
+        assert top != "compare", f"{py.relative_to(ROOT)}:{line} imports {mod}"
+        if top in SOLVERS:
+            assert in_backends, (f"{py.relative_to(ROOT)}:{line} imports solver {mod} "
+                                 "outside optimal/backends/")
+
+
+@pytest.mark.parametrize("folder", ["reference", "optimal"])
+def test_nothing_imports_compare(folder: str) -> None:
+    for py in _files(folder):
+        for line, mod in _imports(py):
+            assert _top(mod) != "compare", f"{py.relative_to(ROOT)}:{line} imports {mod}"
+
+
+def test_rules_catch_a_violation(tmp_path: Path) -> None:
+    """The checker itself must see a forbidden import (guards against a vacuous test)."""
+    bad = ROOT / "reference" / "core" / "_probe_tmp.py"
+    try:
+        bad.write_text("import cvxpy\nfrom ..planner import plan\n")
+        mods = [m for _, m in _imports(bad)]
+        assert "cvxpy" in mods and "reference.planner" in mods
+    finally:
+        bad.unlink()
