@@ -114,11 +114,16 @@ def prepare(program: Program) -> Path:
     for r_i in np.flatnonzero(is_arc[rows]):
         b = blocks[rows[r_i]]
         u, v = (index[a] for a in _PLANES[b.plane])
+        plane = (u, v)
+        if b.plane_basis is not None:       # a rotated frame tilts the plane
+            e = np.zeros((2, n))
+            e[:, :3] = np.asarray(b.plane_basis)
+            plane = (e[0], e[1])
         center = np.asarray(b.center, dtype=np.float64)
         r0 = float(np.hypot(starts[rows[r_i], u] - center[u], starts[rows[r_i], v] - center[v]))
         tol = max(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * r0)
         try:
-            arc = arc_segment(starts[rows[r_i]], ends[rows[r_i]], center, (u, v),
+            arc = arc_segment(starts[rows[r_i]], ends[rows[r_i]], center, plane,
                               b.motion == "G2", b.turns, geometry, int(rows[r_i]), tol)
         except PathError as exc:
             raise PathError(f"{program.file}:{b.line}: {exc}", b.index) from None

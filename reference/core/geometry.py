@@ -182,18 +182,19 @@ def line_segments(starts: np.ndarray, ends: np.ndarray, geometry: np.ndarray,
 
 
 def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
-                plane: tuple[int, int], clockwise: bool, turns: int,
+                plane, clockwise: bool, turns: int,
                 geometry: np.ndarray, block: int, radius_tol: float) -> dict[str, np.ndarray]:
     """Packed parameters of one circular arc or helix.
 
     Parameters
     ----------
     start, end, center : numpy.ndarray, shape (n,)
-        Start and end points and the arc centre (absolute; only the plane components of
-        ``center`` are used), mm / degrees.
-    plane : tuple of int
-        Axis indices ``(u, v)`` of the plane; counter-clockwise means from ``u`` to ``v``
-        (G17: X->Y, G18: Z->X, G19: Y->Z).
+        Start and end points and the arc centre (absolute; only the in-plane part of
+        ``center`` is used), mm / degrees.
+    plane : tuple of two int, or tuple of two numpy.ndarray of shape (n,)
+        The plane as axis indices ``(u, v)`` (G17: X->Y, G18: Z->X, G19: Y->Z) or as
+        orthonormal vectors ``(e1, e2)``; counter-clockwise means from the first to the
+        second.
     clockwise : bool
         True for G2.
     turns : int
@@ -215,41 +216,44 @@ def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
     PathError
         Zero radius, or start and end radius differing by more than ``radius_tol``.
     """
-    u, v = plane
     start = np.asarray(start, dtype=np.float64)
     end = np.asarray(end, dtype=np.float64)
+    center = np.asarray(center, dtype=np.float64)
     n = start.size
-    r0 = float(np.hypot(start[u] - center[u], start[v] - center[v]))
-    r1 = float(np.hypot(end[u] - center[u], end[v] - center[v]))
+    if isinstance(plane[0], (int, np.integer)):
+        e1 = np.zeros(n)
+        e2 = np.zeros(n)
+        e1[plane[0]] = 1.0
+        e2[plane[1]] = 1.0
+    else:
+        e1 = np.asarray(plane[0], dtype=np.float64)
+        e2 = np.asarray(plane[1], dtype=np.float64)
+    ps, pe = start - center, end - center
+    su, sv = float(ps @ e1), float(ps @ e2)
+    eu, ev = float(pe @ e1), float(pe @ e2)
+    r0 = float(np.hypot(su, sv))
+    r1 = float(np.hypot(eu, ev))
     if r0 <= POS_TOL_MM:
         raise PathError("arc with zero radius (centre on the start point)", block)
     if abs(r1 - r0) > radius_tol:
         raise PathError(
             f"arc start radius {r0:.6g} mm and end radius {r1:.6g} mm differ by "
             f"{abs(r1 - r0):.3g} mm (> {radius_tol:.3g} mm)", block)
-    th0 = float(np.arctan2(start[v] - center[v], start[u] - center[u]))
-    th1 = float(np.arctan2(end[v] - center[v], end[u] - center[u]))
-    sweep = th1 - th0
+    th0 = float(np.arctan2(sv, su))
+    th1 = float(np.arctan2(ev, eu))
     # Direction decides the sweep; an arc ending where it started (in the plane) is a
     # full turn, as both dialects define it.
-    closed = float(np.hypot(end[u] - start[u], end[v] - start[v])) <= POS_TOL_MM
+    closed = float(np.hypot(eu - su, ev - sv)) <= POS_TOL_MM
     if clockwise:
         sweep = -2 * np.pi if closed else -((th0 - th1) % (2 * np.pi))
     else:
         sweep = 2 * np.pi if closed else (th1 - th0) % (2 * np.pi)
     sweep += (-1 if clockwise else 1) * 2 * np.pi * turns
-    lin = end - start
-    lin[u] = 0.0
-    lin[v] = 0.0
+    delta = end - start
+    lin = delta - (delta @ e1) * e1 - (delta @ e2) * e2
     geo_lin = float(np.sqrt(np.sum(lin[geometry] ** 2)))
     length = float(np.hypot(r0 * sweep, geo_lin))
-    e1 = np.zeros(n)
-    e2 = np.zeros(n)
-    e1[u] = 1.0
-    e2[v] = 1.0
-    origin = np.array(start, dtype=np.float64)
-    origin[u] = center[u]
-    origin[v] = center[v]
+    origin = start - r0 * (np.cos(th0) * e1 + np.sin(th0) * e2)
     return dict(origin=origin[None], e1=e1[None], e2=e2[None], d=(lin / length)[None],
                 radius=np.array([r0]), omega=np.array([sweep / length]),
                 theta0=np.array([th0]), length=np.array([length]),

@@ -72,46 +72,25 @@ class Tangential:
     tlift: bool = False
 
 
-@dataclass(frozen=True, slots=True)
-class Block:
-    """One executable NC block after modal resolution.
+_MODAL_FIELDS = ("plane", "continuous_mode", "exact_stop_criterion", "adis_mm", "adispos_mm",
+                 "contour_tol_mm", "orientation_tol_deg", "axis_tol", "naive_cam_tol_mm",
+                 "accel_mode", "tool_compensation", "trc_corner", "disc", "tool",
+                 "tool_offset", "tangential")
+_EXTRA_FIELDS = ("center", "turns", "dwell_s", "aux", "message", "comment",
+                 "kept_unmodelled", "column_of_motion", "plane_basis")
 
-    Every source line that holds anything other than whitespace/comments becomes one
-    block, also when it does not move (dwell, M words, assignments, messages); blocks
-    skipped by control flow are not emitted, and a line executed several times by a
-    loop yields several blocks (same ``line``, increasing ``index``).
+
+@dataclass(frozen=True, slots=True)
+class Modal:
+    """Modal state in force for a block. One object is shared by consecutive blocks
+    while nothing modal changes (which also keeps 10^5-block programs cheap).
 
     Attributes
     ----------
-    index : int
-        Position in :attr:`Program.blocks`, 0-based.
-    line : int
-        1-based source line number.
-    column_of_motion : int
-        1-based column of the motion word (for error messages); 1 if none.
-    source : str
-        The source line as written (without the line ending).
-    label : str
-        Block number or label as written (``"N10"``, ``"LOOP1"``), ``""`` if none.
-    motion : {"G0", "G1", "G2", "G3"} or None
-        Active motion of this block if it programs an axis move, else ``None``.
-    start, end : tuple[float, ...]
-        Absolute machine positions before and after the block, shape ``(n_axes,)``,
-        mm for linear axes, degrees for rotary axes. Equal for non-motion blocks.
-    center : tuple[float, ...] or None
-        Arc centre, absolute, shape ``(n_axes,)`` (only the two plane components are
-        meaningful); ``None`` for lines.
     plane : {"G17", "G18", "G19"}
         Active working plane (G17 = XY, G18 = ZX, G19 = YZ).
-    turns : int
-        Additional full turns of an arc (SINUMERIK ``TURN=``, NGC ``P`` minus 1), >= 0.
-    feed_mm_s : float or None
-        Active programmed path feed F converted to mm/s, ``None`` if none programmed yet
-        (legal only for G0 and non-motion blocks).
     continuous_mode : str
         Active group-10 mode (see :data:`ContinuousMode`).
-    exact_stop_here : bool
-        True when the block ends in exact stop (G60 active, or non-modal G9).
     exact_stop_criterion : {"G601", "G602", "G603"}
         Block-change criterion for exact stop.
     adis_mm, adispos_mm : float
@@ -138,32 +117,10 @@ class Block:
         Active tool offset (D on SINUMERIK, H/D on NGC).
     tangential : Tangential or None
         Active tangential control, ``None`` if off.
-    dwell_s : float or None
-        Dwell time of a G4 block in seconds (F/S forms converted), else ``None``.
-    aux : tuple[tuple[str, float], ...]
-        M, S, T, D, H words of this block in source order, e.g. ``(("M", 3.0), ("S", 12000.0))``.
-    message : str or None
-        ``MSG("...")`` or ``(MSG, ...)`` text of this block.
-    comment : str
-        Comment text of the line (both comment styles), ``""`` if none.
-    kept_unmodelled : tuple[str, ...]
-        Words/cycles kept but not modelled (e.g. ``"CYCLE800(...)"``); each also raised
-        a :class:`ProgramWarning`.
     """
 
-    index: int
-    line: int
-    source: str
-    label: str
-    motion: Motion | None
-    start: tuple[float, ...]
-    end: tuple[float, ...]
-    center: tuple[float, ...] | None = None
     plane: Plane = "G17"
-    turns: int = 0
-    feed_mm_s: float | None = None
     continuous_mode: ContinuousMode = "G64"
-    exact_stop_here: bool = False
     exact_stop_criterion: ExactStopCriterion = "G601"
     adis_mm: float = 0.0
     adispos_mm: float = 0.0
@@ -178,12 +135,122 @@ class Block:
     tool: int | None = None
     tool_offset: int | None = None
     tangential: Tangential | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class BlockExtra:
+    """Per-block data most blocks do not have (shared empty instance otherwise).
+
+    Attributes
+    ----------
+    center : tuple[float, ...] or None
+        Arc centre, absolute, shape ``(n_axes,)`` (only the two plane components are
+        meaningful); ``None`` for lines.
+    turns : int
+        Additional full turns of an arc (SINUMERIK ``TURN=``, NGC ``P`` minus 1), >= 0.
+    dwell_s : float or None
+        Dwell time of a G4 block in seconds, else ``None``.
+    aux : tuple[tuple[str, float], ...]
+        M, S, T, D, H words of this block in source order, e.g. ``(("M", 3.0),)``.
+    message : str or None
+        ``MSG("...")`` or ``(MSG, ...)`` text of this block.
+    comment : str
+        Comment text of the line (both comment styles), ``""`` if none.
+    kept_unmodelled : tuple[str, ...]
+        Words/cycles kept but not modelled (e.g. ``"CYCLE800(...)"``); each also raised
+        a :class:`ProgramWarning`.
+    column_of_motion : int
+        1-based column of the motion word (for error messages); 1 if none.
+    plane_basis : tuple of two 3-tuples or None
+        Unit vectors (in X, Y, Z) of the arc plane from its first to its second axis,
+        when a rotated frame tilts the plane out of G17/G18/G19; ``None`` otherwise.
+    """
+
+    center: tuple[float, ...] | None = None
+    turns: int = 0
     dwell_s: float | None = None
     aux: tuple[tuple[str, float], ...] = ()
     message: str | None = None
     comment: str = ""
     kept_unmodelled: tuple[str, ...] = ()
     column_of_motion: int = 1
+    plane_basis: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+
+
+NO_EXTRA = BlockExtra()
+DEFAULT_MODAL = Modal()
+
+
+def _delegate(holder: str, name: str):
+    def get(self):
+        return getattr(getattr(self, holder), name)
+    get.__doc__ = f"Same as ``{holder}.{name}``."
+    return property(get)
+
+
+@dataclass(frozen=True, slots=True)
+class Block:
+    """One executable NC block after modal resolution.
+
+    Every source line that holds anything other than whitespace, comments or control
+    flow becomes one block, also when it does not move (dwell, M words, assignments,
+    messages); blocks skipped by control flow are not emitted, and a line executed
+    several times by a loop yields several blocks (same ``line``, increasing ``index``).
+    The modal state and the rarer per-block data live in :class:`Modal` and
+    :class:`BlockExtra`; their fields are also readable directly on the block
+    (``block.continuous_mode``, ``block.dwell_s``, ...).
+
+    Attributes
+    ----------
+    index : int
+        Position in :attr:`Program.blocks`, 0-based.
+    line : int
+        1-based source line number.
+    source : str
+        The source line as written (without the line ending).
+    label : str
+        Block number or label as written (``"N10"``, ``"LOOP1"``), ``""`` if none.
+    motion : {"G0", "G1", "G2", "G3"} or None
+        Active motion of this block if it programs an axis move, else ``None``.
+    start, end : tuple[float, ...]
+        Absolute machine positions before and after the block, shape ``(n_axes,)``,
+        mm for linear axes, degrees for rotary axes. Equal for non-motion blocks.
+    feed_mm_s : float or None
+        Active programmed path feed F converted to mm/s, ``None`` if none programmed yet
+        (legal only for G0 and non-motion blocks).
+    exact_stop_here : bool
+        True when the block ends in exact stop (G60 active, or non-modal G9).
+    modal : Modal
+        Modal state in force.
+    extra : BlockExtra
+        Arc centre, dwell, aux words, message, comment, ...
+    """
+
+    index: int
+    line: int
+    source: str
+    label: str
+    motion: Motion | None
+    start: tuple[float, ...]
+    end: tuple[float, ...]
+    feed_mm_s: float | None = None
+    exact_stop_here: bool = False
+    modal: Modal = DEFAULT_MODAL
+    extra: BlockExtra = NO_EXTRA
+
+    for _n in _MODAL_FIELDS:
+        locals()[_n] = _delegate("modal", _n)
+    for _n in _EXTRA_FIELDS:
+        locals()[_n] = _delegate("extra", _n)
+    del _n
+
+    @classmethod
+    def make(cls, **kw) -> "Block":
+        """Build a block from flat keywords (modal and extra fields included)."""
+        modal = {k: kw.pop(k) for k in _MODAL_FIELDS if k in kw}
+        extra = {k: kw.pop(k) for k in _EXTRA_FIELDS if k in kw}
+        return cls(modal=Modal(**modal) if modal else DEFAULT_MODAL,
+                   extra=BlockExtra(**extra) if extra else NO_EXTRA, **kw)
 
     @property
     def is_arc(self) -> bool:
@@ -193,8 +260,7 @@ class Block:
     @property
     def moves(self) -> bool:
         """True when any axis position changes (or an arc does full turns)."""
-        return self.motion is not None and (self.start != self.end or self.turns > 0 or (
-            self.is_arc and self.center is not None))
+        return self.motion is not None and (self.start != self.end or self.is_arc)
 
 
 @dataclass(frozen=True, slots=True)

@@ -20,7 +20,7 @@ def _prog(specs, axes=AX) -> Program:
         end = pos if end is None else tuple(float(x) for x in end)
         kw = dict(kw)
         kw.setdefault("feed_mm_s", 10.0)
-        blocks.append(Block(index=i, line=i + 1, source=f"line {i + 1}", label=f"N{i + 1}",
+        blocks.append(Block.make(index=i, line=i + 1, source=f"line {i + 1}", label=f"N{i + 1}",
                             motion=motion, start=pos, end=end, **kw))
         pos = end
     return Program(file="t.mpf", dialect="sinumerik", axes=axes,

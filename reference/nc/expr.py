@@ -1,0 +1,266 @@
+"""Safe arithmetic expressions of both NC dialects (never Python ``eval``).
+
+Expressions are parsed once into a tiny AST of tuples and evaluated many times (loops
+re-run their lines). Trigonometric functions work in degrees, as on both controls.
+
+Grammar (precedence low to high): ``OR``, ``XOR``, ``AND``, comparisons
+(``== <> < > <= >=``, NGC ``EQ NE LT GT LE GE``), ``+ -``, ``* / DIV MOD``, ``**`` /
+``^`` (NGC), unary ``- + NOT``. Atoms: numbers, variables (``R1``, ``R[2]``, ``#5``,
+``#<name>``, declared names), parenthesised (SINUMERIK) or bracketed (NGC) expressions,
+function calls (``SIN(30)``, ``SIN[30]``, ``ATAN[y]/[x]``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Callable, Mapping
+
+NUMBER = re.compile(r"\d+\.?\d*|\.\d+")
+NAME = re.compile(r"[A-Z_$][A-Z0-9_$]*")
+
+_D = math.pi / 180.0
+FUNCS1: dict[str, Callable[[float], float]] = {
+    "SIN": lambda x: math.sin(x * _D), "COS": lambda x: math.cos(x * _D),
+    "TAN": lambda x: math.tan(x * _D),
+    "ASIN": lambda x: math.asin(x) / _D, "ACOS": lambda x: math.acos(x) / _D,
+    "ATAN": lambda x: math.atan(x) / _D,
+    "SQRT": math.sqrt, "ABS": abs, "EXP": math.exp, "LN": math.log,
+    "TRUNC": lambda x: float(math.trunc(x)), "ROUND": lambda x: float(math.floor(x + 0.5)),
+    "FIX": lambda x: float(math.floor(x)), "FUP": lambda x: float(math.ceil(x)),
+    "POT": lambda x: x * x, "EXISTS": lambda x: 1.0,
+}
+FUNCS2: dict[str, Callable[[float, float], float]] = {
+    "ATAN2": lambda y, x: math.atan2(y, x) / _D,
+    "MINVAL": min, "MAXVAL": max,
+}
+_BINOPS = {
+    "OR": (1, lambda a, b: float(bool(a) or bool(b))),
+    "XOR": (2, lambda a, b: float(bool(a) != bool(b))),
+    "AND": (3, lambda a, b: float(bool(a) and bool(b))),
+    "==": (4, lambda a, b: float(a == b)), "EQ": (4, lambda a, b: float(a == b)),
+    "<>": (4, lambda a, b: float(a != b)), "NE": (4, lambda a, b: float(a != b)),
+    "<": (4, lambda a, b: float(a < b)), "LT": (4, lambda a, b: float(a < b)),
+    ">": (4, lambda a, b: float(a > b)), "GT": (4, lambda a, b: float(a > b)),
+    "<=": (4, lambda a, b: float(a <= b)), "LE": (4, lambda a, b: float(a <= b)),
+    ">=": (4, lambda a, b: float(a >= b)), "GE": (4, lambda a, b: float(a >= b)),
+    "+": (5, lambda a, b: a + b), "-": (5, lambda a, b: a - b),
+    "*": (6, lambda a, b: a * b), "/": (6, None), "DIV": (6, None), "MOD": (6, None),
+    "**": (7, lambda a, b: a ** b), "^": (7, lambda a, b: a ** b),
+}
+_SYMOPS = ("**", "==", "<>", "<=", ">=", "<", ">", "+", "-", "*", "/", "^")
+_WORDOPS = ("OR", "XOR", "AND", "DIV", "MOD", "EQ", "NE", "LT", "GT", "LE", "GE")
+
+
+class ExprError(Exception):
+    """A malformed or non-evaluable expression; ``col`` is the 0-based offset."""
+
+    def __init__(self, message: str, col: int) -> None:
+        super().__init__(message)
+        self.col = col
+
+
+class Cursor:
+    """A position in one (upper-cased) source line."""
+
+    __slots__ = ("text", "pos", "ngc")
+
+    def __init__(self, text: str, pos: int = 0, ngc: bool = False) -> None:
+        self.text = text
+        self.pos = pos
+        self.ngc = ngc
+
+    def ws(self) -> None:
+        t, p = self.text, self.pos
+        while p < len(t) and t[p] in " \t":
+            p += 1
+        self.pos = p
+
+    def peek(self) -> str:
+        self.ws()
+        return self.text[self.pos] if self.pos < len(self.text) else ""
+
+    def match(self, pattern: re.Pattern) -> re.Match | None:
+        self.ws()
+        m = pattern.match(self.text, self.pos)
+        if m:
+            self.pos = m.end()
+        return m
+
+
+def parse_expr(cur: Cursor, min_prec: int = 0):
+    """Parse an expression at the cursor (precedence climbing). Returns an AST."""
+    left = _atom(cur)
+    while True:
+        cur.ws()
+        op = _peek_op(cur)
+        if op is None:
+            return left
+        prec, _ = _BINOPS[op]
+        if prec < min_prec or prec <= 0:
+            return left
+        cur.pos += len(op)
+        right = parse_expr(cur, prec + (0 if op in ("**", "^") else 1))
+        left = ("bin", op, left, right, cur.pos)
+
+
+def _peek_op(cur: Cursor) -> str | None:
+    t, p = cur.text, cur.pos
+    for op in _SYMOPS:
+        if t.startswith(op, p):
+            return op
+    for op in _WORDOPS:
+        if t.startswith(op, p):
+            end = p + len(op)
+            if end >= len(t) or not (t[end].isalnum() or t[end] == "_"):
+                # NGC words are unspaced: AND/OR/MOD are operators only between operands
+                return op
+    return None
+
+
+def _atom(cur: Cursor):
+    cur.ws()
+    start = cur.pos
+    ch = cur.peek()
+    if not ch:
+        raise ExprError("expression expected", start)
+    if ch in "+-":
+        cur.pos += 1
+        inner = _atom(cur)
+        return ("neg", inner) if ch == "-" else inner
+    if cur.text.startswith("NOT", cur.pos) and not cur.ngc:
+        cur.pos += 3
+        return ("not", _atom(cur))
+    if ch == "(" and not cur.ngc or ch == "[" :
+        close = ")" if ch == "(" else "]"
+        cur.pos += 1
+        e = parse_expr(cur)
+        if cur.peek() != close:
+            raise ExprError(f"missing '{close}'", cur.pos)
+        cur.pos += 1
+        return e
+    if ch == "#":
+        return _ngc_param(cur)
+    m = cur.match(NUMBER)
+    if m:
+        return ("num", float(m.group()))
+    m = cur.match(NAME)
+    if not m:
+        raise ExprError(f"unexpected '{ch}' in expression", start)
+    name = m.group()
+    if name in ("TRUE", "FALSE"):
+        return ("num", 1.0 if name == "TRUE" else 0.0)
+    if name in FUNCS1 or name in FUNCS2:
+        opener = cur.peek()
+        if opener in "([":
+            close = ")" if opener == "(" else "]"
+            cur.pos += 1
+            args = [parse_expr(cur)]
+            while cur.peek() == ",":
+                cur.pos += 1
+                args.append(parse_expr(cur))
+            if cur.peek() != close:
+                raise ExprError(f"missing '{close}' after {name}", cur.pos)
+            cur.pos += 1
+            # NGC two-argument arc tangent: ATAN[y]/[x]
+            if cur.ngc and name == "ATAN" and cur.peek() == "/":
+                save = cur.pos
+                cur.pos += 1
+                if cur.peek() == "[":
+                    args.append(_atom(cur))
+                    return ("call", "ATAN2", args, start)
+                cur.pos = save
+            if name in FUNCS2 and len(args) != 2 or name in FUNCS1 and len(args) != 1:
+                raise ExprError(f"{name} takes {2 if name in FUNCS2 else 1} argument(s)", start)
+            return ("call", name, args, start)
+    if name.startswith("$"):
+        raise ExprError(f"system variable {name} needs a real control and cannot be "
+                        "evaluated here", start)
+    if cur.peek() == "[" and not cur.ngc:      # R[1], array-like index
+        cur.pos += 1
+        idx = parse_expr(cur)
+        if cur.peek() != "]":
+            raise ExprError("missing ']'", cur.pos)
+        cur.pos += 1
+        return ("idx", name, idx, start)
+    return ("var", name, start)
+
+
+def _ngc_param(cur: Cursor):
+    start = cur.pos
+    cur.pos += 1
+    ch = cur.peek()
+    if ch == "<":
+        end = cur.text.find(">", cur.pos)
+        if end < 0:
+            raise ExprError("missing '>' after '#<'", start)
+        name = "#<" + cur.text[cur.pos + 1:end].replace(" ", "").replace("\t", "") + ">"
+        cur.pos = end + 1
+        return ("var", name, start)
+    if ch == "[" or ch == "#":
+        return ("pidx", _atom(cur), start)
+    m = cur.match(re.compile(r"\d+"))
+    if not m:
+        raise ExprError("parameter number expected after '#'", start)
+    return ("var", f"#{int(m.group())}", start)
+
+
+def evaluate(node, env: Mapping[str, float]) -> float:
+    """Evaluate an AST; unknown variables and math errors raise :class:`ExprError`."""
+    kind = node[0]
+    if kind == "num":
+        return node[1]
+    if kind == "var":
+        name = node[1]
+        if name in env:
+            return env[name]
+        if name.startswith("#") and name[1:].isdigit():
+            return 0.0  # numbered NGC parameters default to 0, as in rs274ngc
+        raise ExprError(f"unknown variable {name}", node[2])
+    if kind == "idx":
+        i = evaluate(node[2], env)
+        key = f"{node[1]}{int(i)}" if node[1] == "R" else f"{node[1]}[{int(i)}]"
+        if key in env:
+            return env[key]
+        if node[1] == "R":
+            return 0.0
+        raise ExprError(f"unknown variable {key}", node[3])
+    if kind == "pidx":
+        i = evaluate(node[1], env)
+        return env.get(f"#{int(i)}", 0.0)
+    if kind == "neg":
+        return -evaluate(node[1], env)
+    if kind == "not":
+        return float(not evaluate(node[1], env))
+    if kind == "call":
+        args = [evaluate(a, env) for a in node[2]]
+        try:
+            if node[1] in FUNCS2:
+                return float(FUNCS2[node[1]](*args))
+            return float(FUNCS1[node[1]](args[0]))
+        except (ValueError, OverflowError) as exc:
+            raise ExprError(f"{node[1]}({', '.join(f'{a:g}' for a in args)}) is undefined "
+                            f"({exc})", node[3]) from None
+    if kind == "bin":
+        op = node[1]
+        a = evaluate(node[2], env)
+        b = evaluate(node[3], env)
+        if op in ("/", "DIV", "MOD"):
+            if b == 0:
+                raise ExprError("division by zero", node[4])
+            if op == "/":
+                return a / b
+            if op == "DIV":
+                return float(math.trunc(a / b))
+            return math.fmod(a, b)
+        return float(_BINOPS[op][1](a, b))
+    raise ExprError(f"bad expression node {kind}", 0)  # pragma: no cover
+
+
+def constant(node) -> float | None:
+    """The value of a constant AST (a plain number), else ``None``."""
+    if node[0] == "num":
+        return node[1]
+    if node[0] == "neg" and node[1][0] == "num":
+        return -node[1][1]
+    return None

@@ -1,0 +1,449 @@
+"""Stage 1 of parsing: one source line -> one :class:`Stmt` (both dialects).
+
+Lines are parsed once; loops re-execute the parsed statements. Values are expression
+ASTs from :mod:`reference.nc.expr` (constants for plain numbers), so execution never
+re-reads text. Columns are 1-based and refer to the line as written.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from .expr import NAME, NUMBER, Cursor, ExprError, parse_expr
+
+#: Single-letter addresses that take a number (both dialects).
+ADDRESSES = frozenset("ABCDEFGHIJKLMNPQRSTUVWXYZ")
+#: SINUMERIK named addresses written ``NAME=value``.
+NAMED_ADDRESSES = frozenset({"CR", "ADIS", "ADISPOS", "TURN", "CTOL", "OTOL", "DISC", "AR",
+                             "RND", "RNDM", "STOLF", "SF", "FA", "OFFN", "RPL", "SPOS",
+                             "SPOSA", "FB", "AP", "RP", "CIP", "CT"})
+#: SINUMERIK keywords that are a whole word on their own.
+FLAGS = frozenset({"BRISK", "SOFT", "DRIVE", "SUPA", "CFC", "CFTCP", "CFIN",
+                   "FNORM", "FLIN", "FCUB", "COMPON", "COMPOF", "COMPCURV", "COMPCAD",
+                   "ORISON", "ORISOF", "FFWON", "FFWOF", "TRANS", "ATRANS", "ROT", "AROT",
+                   "SCALE", "ASCALE", "MIRROR", "AMIRROR", "TRAORI", "TRAFOOF", "CDON",
+                   "CDOF", "CDOF2", "DYNNORM", "DYNPOS", "DYNROUGH", "DYNSEMIFIN",
+                   "DYNFINISH", "RET", "STOPRE", "BRISKA", "SOFTA", "DRIVEA"})
+CONTROL = frozenset({"IF", "ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "REPEAT",
+                     "UNTIL", "LOOP", "ENDLOOP", "GOTOF", "GOTOB", "GOTOC", "GOTO", "CASE",
+                     "DEF", "PROC", "DEFINE", "EXTERN"})
+_NUM_SIGNED = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)")
+_LABEL = re.compile(r"([A-Z_][A-Z0-9_]*):(?!=)")
+_BLOCKNO = re.compile(r"N(\d+)|:(\d+)")
+_INT = re.compile(r"\d+")
+
+
+@dataclass(slots=True)
+class Word:
+    """One address word: ``name`` (``"G"``, ``"X"``, ``"CR"``, ``"ELX"``), value AST."""
+
+    name: str
+    value: tuple
+    col: int
+    mode: str = ""          # "" | "AC" | "IC"
+
+
+@dataclass(slots=True)
+class Stmt:
+    """One parsed line.
+
+    ``kind`` is ``"block"`` for ordinary lines and the control keyword otherwise
+    (``"IF"``, ``"ENDWHILE"``, ``"O:IF"`` for NGC O-words, ...).
+    """
+
+    line: int
+    text: str
+    kind: str = "block"
+    label: str = ""
+    words: list = field(default_factory=list)       # Word
+    assigns: list = field(default_factory=list)     # (target, AST, col)
+    calls: list = field(default_factory=list)       # (NAME, raw args, col)
+    flags: list = field(default_factory=list)       # (NAME, col)
+    cond: tuple | None = None
+    target: str = ""                                 # GOTO label / O-word name
+    case: list = field(default_factory=list)        # [(value AST or None, label)]
+    decl: list = field(default_factory=list)        # DEF names
+    comment: str = ""
+    message: str | None = None
+    empty: bool = False
+
+
+class LineError(Exception):
+    """Syntax error at a 0-based column of the upper-cased code part."""
+
+    def __init__(self, message: str, col: int) -> None:
+        super().__init__(message)
+        self.col = col
+
+
+# ----------------------------------------------------------------------- SINUMERIK
+def _split_comment_sin(text: str) -> tuple[str, str]:
+    in_str = False
+    for i, ch in enumerate(text):
+        if ch == '"':
+            in_str = not in_str
+        elif ch == ";" and not in_str:
+            return text[:i], text[i + 1:].strip()
+    return text, ""
+
+
+def _call_args(cur: Cursor) -> str:
+    """Raw text between a '(' at the cursor and its matching ')'."""
+    start = cur.pos
+    depth, in_str, p, t = 0, False, cur.pos, cur.text
+    while p < len(t):
+        ch = t[p]
+        if ch == '"':
+            in_str = not in_str
+        elif not in_str and ch == "(":
+            depth += 1
+        elif not in_str and ch == ")":
+            depth -= 1
+            if depth == 0:
+                cur.pos = p + 1
+                return t[start + 1:p]
+        p += 1
+    raise LineError("missing ')'", start)
+
+
+# A line of plain ``letter number`` words (the bulk of CAM output): parsed by one regex.
+_SIMPLE_LINE = re.compile(r"[ \t]*(N\d+[ \t]+)?((?:[A-MP-Z][-+]?(?:\d+\.?\d*|\.\d+)[ \t]*)+)"
+                          r"(?:;(.*))?$")
+_SIMPLE_WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
+
+
+def _simple(lineno: int, raw: str) -> Stmt | None:
+    """Fast path for plain word lines; None when the line needs the full grammar."""
+    up = raw.upper()
+    m = _SIMPLE_LINE.match(up)
+    if m is None:
+        return None
+    st = Stmt(line=lineno, text=raw, comment=(m.group(3) or "").strip())
+    if m.group(1):
+        st.label = m.group(1).strip()
+    st.words = [Word(w.group(1), ("num", float(w.group(2))), w.start() + 1)
+                for w in _SIMPLE_WORD.finditer(up, m.start(2), m.end(2))]
+    return st
+
+
+def parse_sinumerik(lineno: int, raw: str) -> Stmt:
+    """Parse one SINUMERIK line."""
+    st = _simple(lineno, raw)
+    if st is not None:
+        return st
+    code, comment = _split_comment_sin(raw)
+    st = Stmt(line=lineno, text=raw, comment=comment)
+    up = code.upper()
+    cur = Cursor(up)
+    cur.ws()
+    if cur.peek() == "/":            # block delete: the skip switch is off
+        cur.pos += 1
+    if not cur.peek():
+        st.empty = True
+        return st
+    m = cur.match(_BLOCKNO)
+    if m:
+        st.label = "N" + m.group(1) if m.group(1) else ":" + m.group(2)
+    m = _LABEL.match(up, (cur.ws(), cur.pos)[1])
+    if m and m.group(1) not in ("N",):
+        st.label = m.group(1)
+        cur.pos = m.end()
+    cur.ws()
+    m = NAME.match(up, cur.pos)
+    if m and m.group() in CONTROL:
+        _control_sin(st, cur, m, code)
+        return st
+    _words_sin(st, cur, code)
+    return st
+
+
+def _expr(cur: Cursor):
+    try:
+        return parse_expr(cur)
+    except ExprError as exc:
+        raise LineError(str(exc), exc.col) from None
+
+
+def _control_sin(st: Stmt, cur: Cursor, m: re.Match, code: str) -> None:
+    kw = m.group()
+    cur.pos = m.end()
+    st.kind = kw
+    if kw in ("IF", "WHILE", "UNTIL"):
+        st.cond = _expr(cur)
+        rest = NAME.match(cur.text, (cur.ws(), cur.pos)[1])
+        if kw == "IF" and rest and rest.group() in ("GOTOF", "GOTOB", "GOTOC", "GOTO"):
+            cur.pos = rest.end()
+            st.kind = "IFGOTO"
+            st.target = _goto_target(cur, rest.group())
+            st.case = [(None, rest.group())]
+        elif cur.peek():
+            raise LineError(f"unexpected text after {kw} condition", cur.pos)
+    elif kw in ("GOTOF", "GOTOB", "GOTOC", "GOTO"):
+        st.target = _goto_target(cur, kw)
+    elif kw == "FOR":
+        var = cur.match(NAME)
+        if not var or cur.peek() != "=":
+            raise LineError("FOR needs 'FOR variable = start TO end'", cur.pos)
+        cur.pos += 1
+        start = _expr(cur)
+        to = cur.match(NAME)
+        if not to or to.group() != "TO":
+            raise LineError("FOR needs 'TO'", cur.pos)
+        st.target = var.group()
+        st.assigns = [(var.group(), start, 0)]
+        st.cond = _expr(cur)
+    elif kw == "CASE":
+        st.cond = _expr(cur)
+        of = cur.match(NAME)
+        if not of or of.group() != "OF":
+            raise LineError("CASE needs 'OF'", cur.pos)
+        while cur.peek():
+            dm = NAME.match(cur.text, cur.pos)
+            if dm and dm.group() == "DEFAULT":
+                cur.pos = dm.end()
+                val = None
+            else:
+                val = _expr(cur)
+            g = cur.match(NAME)
+            if not g or not g.group().startswith("GOTO"):
+                raise LineError("CASE entries need 'value GOTOF label'", cur.pos)
+            st.case.append((val, _goto_target(cur, g.group()), g.group()))
+    elif kw in ("DEF", "DEFINE", "EXTERN", "PROC"):
+        if kw != "DEF":
+            return
+        typ = cur.match(NAME)
+        if not typ or typ.group() not in ("REAL", "INT", "BOOL", "CHAR", "STRING", "AXIS", "FRAME"):
+            raise LineError("DEF needs a type (REAL, INT, BOOL, ...)", cur.pos)
+        while cur.peek():
+            nm = cur.match(NAME)
+            if not nm:
+                raise LineError("variable name expected after DEF type", cur.pos)
+            if cur.peek() == "[":
+                _call_args_bracket(cur)
+            st.decl.append((nm.group(), typ.group()))
+            if cur.peek() == "=":
+                cur.pos += 1
+                st.assigns.append((nm.group(), _expr(cur), nm.start()))
+            if cur.peek() == ",":
+                cur.pos += 1
+    elif cur.peek():
+        if kw in ("ELSE", "ENDIF", "ENDWHILE", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT"):
+            raise LineError(f"unexpected text after {kw}", cur.pos)
+
+
+def _call_args_bracket(cur: Cursor) -> str:
+    start = cur.pos
+    end = cur.text.find("]", start)
+    if end < 0:
+        raise LineError("missing ']'", start)
+    cur.pos = end + 1
+    return cur.text[start + 1:end]
+
+
+def _goto_target(cur: Cursor, kw: str) -> str:
+    m = cur.match(re.compile(r"[A-Z_][A-Z0-9_]*|:\d+"))
+    if not m:
+        raise LineError(f"{kw} needs a label", cur.pos)
+    return m.group()
+
+
+def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
+    t = cur.text
+    while True:
+        ch = cur.peek()
+        if not ch:
+            return
+        start = cur.pos
+        m = NAME.match(t, start)
+        if not m:
+            if ch == "$":
+                raise LineError("system variable assignment", start)
+            raise LineError(f"unexpected '{ch}'", start)
+        name = m.group()
+        cur.pos = m.end()
+        nxt = t[cur.pos] if cur.pos < len(t) else ""
+        after = cur.peek()
+        if name.startswith("$"):
+            # system variables need a real control: keep the statement, evaluate nothing
+            st.calls.append((name, t[start:].strip(), start))
+            cur.pos = len(t)
+            return
+        if after == "(" and not (name in ("AC", "IC")):
+            cur.pos = t.index("(", cur.pos)
+            args = _call_args(cur)
+            raw_args = code[start + (t.index("(", start) - start) + 1:cur.pos - 1]
+            st.calls.append((name, raw_args, start))
+            continue
+        if after == "[" and name != "R" or (name == "R" and after == "["):
+            cur.pos = t.index("[", cur.pos)
+            idx = _call_args_bracket(cur)
+            if cur.peek() != "=":
+                raise LineError(f"'=' expected after {name}[{idx}]", cur.pos)
+            cur.pos += 1
+            st.assigns.append((f"{name}[{idx.strip()}]", _expr(cur), start))
+            continue
+        if after == "=" and not t.startswith("==", cur.pos):
+            cur.pos = t.index("=", cur.pos) + 1
+            mode = ""
+            mm = re.compile(r"(AC|IC|ACP|ACN|DC)\s*\(").match(t, (cur.ws(), cur.pos)[1])
+            if mm:
+                mode = mm.group(1)
+                cur.pos = mm.end() - 1
+                cur.pos += 1
+                val = _expr(cur)
+                if cur.peek() != ")":
+                    raise LineError(f"missing ')' after {mode}(", cur.pos)
+                cur.pos += 1
+            else:
+                val = _expr(cur)
+            st.words.append(Word(name, val, start + 1, mode if mode in ("AC", "IC") else ""))
+            continue
+        # address + number, possibly glued (G1, X10.5, Y-2., G1X10Y5)
+        if name[0] in ADDRESSES and _ADDR_NUM.match(t, start) and name not in FLAGS:
+            cur.pos = start
+            _address_word(st, cur)
+            continue
+        if name in FLAGS:
+            st.flags.append((name, start))
+            continue
+        # a bare name: subprogram call or an unknown keyword, kept with a warning
+        st.calls.append((name, "", start))
+
+
+_ADDR_NUM = re.compile(r"([A-Z])[ \t]*([-+]?(?:\d+\.?\d*|\.\d+))")
+_NEXT_WORD = re.compile(r"[A-Z][-+]?[\d.]|[A-Z_][A-Z0-9_]*\s*[=(\[]")
+
+
+def _address_word(st: Stmt, cur: Cursor) -> None:
+    """One ``letter number`` word at the cursor; checks the word ends cleanly."""
+    t = cur.text
+    m = _ADDR_NUM.match(t, cur.pos)
+    end = m.end()
+    if end < len(t) and t[end] not in " \t":
+        # a glued next word (G1X10) is fine; anything else is a typo such as Y1O
+        nm = NAME.match(t, end)
+        if not (t[end].isalpha() and _NEXT_WORD.match(t, end)) and not (
+                nm and nm.group() in FLAGS):
+            bad = re.compile(r"[^ \t]+").match(t, m.start(2)).group()
+            raise LineError(f"invalid number '{bad}' after address {m.group(1)}", m.start(2))
+    st.words.append(Word(m.group(1), ("num", float(m.group(2))), m.start() + 1))
+    cur.pos = end
+
+
+# ----------------------------------------------------------------------------- NGC
+def _strip_ngc(raw: str) -> tuple[str, list[int], str, str | None]:
+    """Remove comments and whitespace; return (code, column map, comment, message)."""
+    out, cols, comments, msg = [], [], [], None
+    i, n = 0, len(raw)
+    while i < n:
+        ch = raw[i]
+        if ch == "(":
+            j = raw.find(")", i)
+            if j < 0:
+                raise LineError("comment '(' is not closed with ')'", len(out))
+            body = raw[i + 1:j]
+            if body.strip().upper().startswith("MSG,"):
+                msg = body.strip()[4:].strip()
+            comments.append(body.strip())
+            i = j + 1
+            continue
+        if ch == ";":
+            comments.append(raw[i + 1:].strip())
+            break
+        if ch not in " \t\r":
+            out.append(ch.upper())
+            cols.append(i)
+        i += 1
+    return "".join(out), cols, " ".join(c for c in comments if c), msg
+
+
+_OWORD = re.compile(r"O(<[^>]*>|\d+)(IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|REPEAT|ENDREPEAT|"
+                    r"SUB|ENDSUB|CALL|RETURN|BREAK|CONTINUE)?")
+_NGC_WORD = re.compile(r"([A-Z])")
+
+
+def parse_ngc(lineno: int, raw: str) -> Stmt:
+    """Parse one RS274/NGC (LinuxCNC) line."""
+    st = _simple(lineno, raw)
+    if st is not None:
+        return st
+    code, cols, comment, msg = _strip_ngc(raw)
+    st = Stmt(line=lineno, text=raw, comment=comment, message=msg)
+    if code.startswith("/"):
+        code, cols = code[1:], cols[1:]
+    if not code or code == "%":
+        st.empty = msg is None
+        return st
+    cur = Cursor(code, ngc=True)
+    try:
+        _parse_ngc_code(st, cur)
+    except LineError as exc:
+        exc.col = cols[min(exc.col, len(cols) - 1)] if cols else 0
+        raise
+    except ExprError as exc:
+        raise LineError(str(exc), cols[min(exc.col, len(cols) - 1)] if cols else 0) from None
+    for w in st.words:
+        w.col = cols[min(w.col - 1, len(cols) - 1)] + 1
+    return st
+
+
+def _parse_ngc_code(st: Stmt, cur: Cursor) -> None:
+    t = cur.text
+    m = _BLOCKNO.match(t, 0)
+    if m and m.group(1):
+        st.label = "N" + m.group(1)
+        cur.pos = m.end()
+    if t.startswith("O", cur.pos):
+        m = _OWORD.match(t, cur.pos)
+        if m and m.group(2):
+            st.kind = "O:" + m.group(2)
+            st.target = m.group(1).lower() if m.group(1).startswith("<") else m.group(1)
+            cur.pos = m.end()
+            if cur.peek() == "[" and m.group(2) in ("IF", "ELSEIF", "WHILE", "REPEAT"):
+                st.cond = parse_expr(cur)
+            elif m.group(2) in ("CALL", "RETURN", "ENDSUB"):
+                args = []
+                while cur.peek() == "[":
+                    args.append(parse_expr(cur))
+                st.case = args
+            if cur.peek():
+                raise LineError(f"unexpected text after O-word {m.group(2).lower()}", cur.pos)
+            return
+        if m and not m.group(2):
+            st.label = "O" + m.group(1)   # a program number
+            cur.pos = m.end()
+    while cur.pos < len(t):
+        ch = t[cur.pos]
+        start = cur.pos
+        if ch == "#":
+            target = parse_expr(cur)     # parses the parameter reference only (an atom)
+            if cur.peek() != "=":
+                raise LineError("'=' expected after parameter", cur.pos)
+            cur.pos += 1
+            val = parse_expr(cur)
+            st.assigns.append((target, val, start))
+            continue
+        if not ch.isalpha():
+            raise LineError(f"unexpected '{ch}'", start)
+        cur.pos += 1
+        nxt = t[cur.pos] if cur.pos < len(t) else ""
+        if nxt in "[#":
+            val = parse_expr(cur)
+        elif nxt in "+-" and cur.pos + 1 < len(t) and t[cur.pos + 1] in "[#":
+            cur.pos += 1
+            inner = parse_expr(cur)
+            val = ("neg", inner) if nxt == "-" else inner
+        else:
+            m = _NUM_SIGNED.match(t, cur.pos)
+            if not m:
+                bad = re.compile(r"[^A-Z]*").match(t, cur.pos).group() or nxt or "end of line"
+                raise LineError(f"number expected after address {ch}, found '{bad}'", cur.pos)
+            cur.pos = m.end()
+            # a letter glued to a number is the next word; anything else is a typo (Y1O)
+            if cur.pos < len(t) and t[cur.pos] in "O" and ch not in "GM" and (
+                    cur.pos + 1 >= len(t) or not t[cur.pos + 1].isalpha()):
+                raise LineError(f"invalid number '{m.group()}{t[cur.pos]}' after address {ch}",
+                                m.start())
+            val = ("num", float(m.group()))
+        st.words.append(Word(ch, val, start + 1))
