@@ -50,7 +50,8 @@ import numpy as np
 from .geometry import Path
 from .limits import MachineLimits
 from .profile import Profile
-from .tolerances import RATIO_TOL, TANGENT_TOL_RAD, VEL_TOL_MM_S
+from .errors import ProfileError
+from .tolerances import POS_TOL_MM, RATIO_TOL, TANGENT_TOL_RAD, VEL_TOL_MM_S
 
 CONSTRAINTS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "feed", "velocity_jump",
                                 "stop", "frequency")
@@ -219,6 +220,12 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
     """
     lim = limits.for_axes(path.axes)
     axes = path.axes
+    if profile.s.size and (abs(profile.s[0]) > POS_TOL_MM or
+                           abs(profile.s[-1] - path.total_length) > POS_TOL_MM * max(
+                               1.0, path.total_length)):
+        raise ProfileError(f"profile starts at s = {profile.s[0]:.6g} mm and ends at s = "
+                           f"{profile.s[-1]:.6g} mm but the path is "
+                           f"{path.total_length:.6g} mm long")
     n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
     worst = {c: _Worst(n_blocks) for c in CONSTRAINTS}
     if path.n_segments == 0 or profile.n_intervals == 0:

@@ -99,9 +99,10 @@ def parse_expr(cur: Cursor, min_prec: int = 0):
         prec, _ = _BINOPS[op]
         if prec < min_prec or prec <= 0:
             return left
+        op_pos = cur.pos
         cur.pos += len(op)
         right = parse_expr(cur, prec + (0 if op in ("**", "^") else 1))
-        left = ("bin", op, left, right, cur.pos)
+        left = ("bin", op, left, right, op_pos)
 
 
 def _peek_op(cur: Cursor) -> str | None:
@@ -112,8 +113,8 @@ def _peek_op(cur: Cursor) -> str | None:
     for op in _WORDOPS:
         if t.startswith(op, p):
             end = p + len(op)
-            if end >= len(t) or not (t[end].isalnum() or t[end] == "_"):
-                # NGC words are unspaced: AND/OR/MOD are operators only between operands
+            # NGC text has no spaces (7MOD4); SINUMERIK needs a word boundary (MODE != MOD)
+            if cur.ngc or end >= len(t) or not (t[end].isalnum() or t[end] == "_"):
                 return op
     return None
 

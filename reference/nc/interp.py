@@ -135,7 +135,12 @@ class _Interp:
         try:
             return evaluate(node, self.vars)
         except ExprError as exc:
-            raise self.err(st, col, str(exc)) from None
+            # the expression knows where it failed (an offset into the line's code)
+            where = col
+            if exc.col > 0:
+                where = (st.colmap[min(exc.col, len(st.colmap) - 1)] + 1 if st.colmap
+                         else exc.col + 1)
+            raise self.err(st, where, str(exc)) from None
 
     # ----------------------------------------------------------------- helpers
     def lin(self, axis: str) -> float:
@@ -571,6 +576,9 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     p_word = q_word = r_word = l_word = None
     for w in st.words:
         name = w.name
+        if not ngc and name in ip.declared:          # a DEF variable, also if one letter
+            ip.vars[name] = ip.ev(st, w.value, w.col)
+            continue
         if not ngc and len(name) > 1 or (not ngc and name not in "GMFSTDHIJKPQRLXYZABCUVWEN"):
             if name in ("CR", "ADIS", "ADISPOS", "TURN", "CTOL", "OTOL", "DISC", "AR", "RPL",
                         "STOLF", "RND", "RNDM", "SF", "OFFN"):

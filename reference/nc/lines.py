@@ -67,6 +67,7 @@ class Stmt:
     comment: str = ""
     message: str | None = None
     empty: bool = False
+    colmap: list | None = None                      # NGC: code offset -> line column
 
 
 class LineError(Exception):
@@ -385,6 +386,7 @@ def parse_ngc(lineno: int, raw: str) -> Stmt:
         raise LineError(str(exc), cols[min(exc.col, len(cols) - 1)] if cols else 0) from None
     for w in st.words:
         w.col = cols[min(w.col - 1, len(cols) - 1)] + 1
+    st.colmap = cols
     return st
 
 

@@ -1,0 +1,123 @@
+"""Exact geometry: derivatives vs finite differences, arc-length consistency (seeded)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from reference.core.errors import PathError
+from reference.core.geometry import arc_segment, line_segments, path_from_pieces
+
+AX = ("X", "Y", "Z", "A", "B")
+GEO = np.array([True, True, True, False, False])
+PLANES = {"G17": (0, 1), "G18": (2, 0), "G19": (1, 2)}
+
+
+def random_arc(rng, plane, clockwise, turns=0, helix=True):
+    u, v = PLANES[plane]
+    w = 3 - u - v
+    c = rng.uniform(-50, 50, 5)
+    r = rng.uniform(0.5, 30)
+    a0, a1 = rng.uniform(-np.pi, np.pi, 2)
+    start = c.copy()
+    start[u] += r * np.cos(a0)
+    start[v] += r * np.sin(a0)
+    end = c.copy()
+    end[u] += r * np.cos(a1)
+    end[v] += r * np.sin(a1)
+    end[w] = start[w] + (rng.uniform(-20, 20) if helix else 0.0)
+    end[3:] = start[3:] + rng.uniform(-90, 90, 2)
+    return start, end, c, (u, v), clockwise, turns
+
+
+def fd_check(seg, rng):
+    L = seg.length
+    s = rng.uniform(0.05 * L, 0.95 * L, 20)
+    h = 1e-5 * max(L, 1.0)
+    for k in range(3):
+        fp = seg.evaluate(s + h)[k]
+        fm = seg.evaluate(s - h)[k]
+        np.testing.assert_allclose((fp - fm) / (2 * h), seg.evaluate(s)[k + 1],
+                                   rtol=1e-5, atol=1e-6 * (1 + np.abs(seg.evaluate(s)[k + 1]).max()))
+
+
+@pytest.mark.parametrize("plane", ["G17", "G18", "G19"])
+@pytest.mark.parametrize("clockwise", [False, True])
+def test_arc_and_helix_derivatives_and_length(plane, clockwise):
+    rng = np.random.default_rng(hash((plane, clockwise)) % 2**32)
+    for _ in range(10):
+        start, end, c, pl, cw, turns = random_arc(rng, plane, clockwise, int(rng.integers(0, 2)))
+        p = path_from_pieces(AX, [arc_segment(start, end, c, pl, cw, turns, GEO, 0, 1e-6)])
+        seg = p.segment(0)
+        fd_check(seg, rng)
+        np.testing.assert_allclose(seg.start, start, atol=1e-9)
+        np.testing.assert_allclose(seg.end, end, atol=1e-7)
+        # s is the arc length of the geometry axes: |q'_geo| = 1 everywhere
+        s = np.linspace(0, seg.length, 50)
+        np.testing.assert_allclose(np.linalg.norm(seg.evaluate(s)[1][:, :3], axis=1), 1.0,
+                                   rtol=1e-12)
+        integral, _ = quad(lambda x: np.linalg.norm(seg.evaluate(x)[1][0, :3]), 0, seg.length,
+                           limit=200)
+        assert integral == pytest.approx(seg.length, rel=1e-9)
+        q = seg.evaluate(np.linspace(0, seg.length, 20001))[0][:, :3]
+        chords = np.sum(np.linalg.norm(np.diff(q, axis=0), axis=1))
+        assert chords == pytest.approx(seg.length, rel=1e-6)
+
+
+@pytest.mark.parametrize("plane", ["G17", "G18", "G19"])
+def test_direction_of_rotation(plane):
+    u, v = PLANES[plane]
+    start = np.zeros(5)
+    start[u] = 10.0
+    end = np.zeros(5)
+    end[v] = 10.0                     # quarter turn counter-clockwise from u to v
+    for cw, sweep in ((False, np.pi / 2), (True, 3 * np.pi / 2)):
+        seg = path_from_pieces(AX, [arc_segment(start, end, np.zeros(5), (u, v), cw, 0, GEO,
+                                                0, 1e-9)]).segment(0)
+        assert seg.length == pytest.approx(10 * sweep)
+        mid = seg.evaluate(seg.length / 2)[0][0]
+        assert (mid[v] < 0) == cw      # the clockwise arc goes the long way through -v
+
+
+def test_full_circle_and_extra_turns():
+    start = np.array([5.0, 0, 0, 0, 0])
+    for turns in (0, 2):
+        seg = path_from_pieces(AX, [arc_segment(start, start, np.zeros(5), (0, 1), True, turns,
+                                                GEO, 0, 1e-9)]).segment(0)
+        assert seg.length == pytest.approx(2 * np.pi * 5 * (turns + 1))
+
+
+def test_lines_with_extra_axes_and_rotary_only_moves():
+    rng = np.random.default_rng(7)
+    starts = rng.uniform(-10, 10, (20, 5))
+    ends = starts + rng.uniform(-5, 5, (20, 5))
+    ends[0, :3] = starts[0, :3]                  # only rotary axes move
+    p = path_from_pieces(AX, [line_segments(starts, ends, GEO, np.arange(20))])
+    np.testing.assert_allclose(p.length[1:], np.linalg.norm((ends - starts)[1:, :3], axis=1))
+    assert p.length[0] == pytest.approx(np.linalg.norm(ends[0, 3:] - starts[0, 3:]))
+    for i in range(20):
+        fd_check(p.segment(i), rng)
+        np.testing.assert_allclose(p.segment(i).end, ends[i], atol=1e-12)
+
+
+def test_arc_radius_mismatch_and_zero_radius():
+    s = np.array([10.0, 0, 0, 0, 0])
+    e = np.array([0.0, 10.01, 0, 0, 0])
+    with pytest.raises(PathError, match=r"start radius 10 mm and end radius 10\.01 mm"):
+        arc_segment(s, e, np.zeros(5), (0, 1), False, 0, GEO, 0, 0.002)
+    with pytest.raises(PathError, match="zero radius"):
+        arc_segment(s, e, s, (0, 1), False, 0, GEO, 0, 0.002)
+
+
+def test_path_evaluate_sides_at_breaks_and_junction_tangents():
+    pts = np.array([[0, 0, 0, 0, 0], [10, 0, 0, 0, 0], [10, 10, 0, 0, 0]], float)
+    p = path_from_pieces(AX, [line_segments(pts[:-1], pts[1:], GEO, np.arange(2))])
+    left = p.evaluate(np.array([10.0]), side="left")[1][0]
+    right = p.evaluate(np.array([10.0]), side="right")[1][0]
+    np.testing.assert_allclose(left[:3], [1, 0, 0])
+    np.testing.assert_allclose(right[:3], [0, 1, 0])
+    t_in, t_out = p.junction_tangents()
+    np.testing.assert_allclose(t_in[0, :3], [1, 0, 0])
+    np.testing.assert_allclose(t_out[0, :3], [0, 1, 0])
+    assert p.block_of(np.array([5.0, 15.0])).tolist() == [0, 1]
