@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 install: $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/feedoracle compare examples/demo.mpf --report reports --json reports/demo.json
+	$(VENV)/bin/feedoracle inspect examples/demo.mpf
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2 --dist loadgroup

@@ -93,9 +93,6 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("program")
     common(sp)
     sp.set_defaults(func=cmd_inspect)
-
-    from . import commands  # the planning sub-commands live beside the report code
-    commands.register(sub, common)
     return p
 
 
@@ -111,6 +108,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         progress.done()
         print(f"feedoracle: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        # output piped into a pager or head that closed early: not an error of ours
+        sys.stderr.close()
+        return EXIT_OK
     except OSError as exc:
         progress.done()
         name = exc.filename if exc.filename is not None else ""
