@@ -453,34 +453,32 @@ def _oword(ip: _Interp, st: Stmt, i: int, pairs: dict, subs: dict, calls: list) 
     return i + 1
 
 
-def _o_next_branch(ip: _Interp, i: int) -> int | None:
+def _o_scan(ip: _Interp, i: int, stop_at_branch: bool) -> int | None:
+    """From the o-if (or a branch) at ``i``: index of the next same-level elseif/else
+    (when ``stop_at_branch``; None if the endif comes first) or of the matching endif."""
     name = ip.stmts[i].target
     depth = 0
     for j in range(i + 1, len(ip.stmts)):
         s = ip.stmts[j]
-        if s.kind == "O:IF" and s.target == name:
+        if s.target != name:
+            continue
+        if s.kind == "O:IF":
             depth += 1
-        elif s.kind == "O:ENDIF" and s.target == name:
+        elif s.kind == "O:ENDIF":
             if depth == 0:
-                return None
+                return None if stop_at_branch else j
             depth -= 1
-        elif s.kind in ("O:ELSEIF", "O:ELSE") and s.target == name and depth == 0:
+        elif stop_at_branch and s.kind in ("O:ELSEIF", "O:ELSE") and depth == 0:
             return j
-    return None
+    raise ip.err(ip.stmts[i], 1, f"o{name} if is never closed")  # pragma: no cover
+
+
+def _o_next_branch(ip: _Interp, i: int) -> int | None:
+    return _o_scan(ip, i, True)
 
 
 def _o_endif(ip: _Interp, i: int, pairs: dict) -> int:
-    name = ip.stmts[i].target
-    depth = 0
-    for j in range(i + 1, len(ip.stmts)):
-        s = ip.stmts[j]
-        if s.kind == "O:IF" and s.target == name:
-            depth += 1
-        elif s.kind == "O:ENDIF" and s.target == name:
-            if depth == 0:
-                return j
-            depth -= 1
-    raise ip.err(ip.stmts[i], 1, f"o{name} if is never closed")  # pragma: no cover
+    return _o_scan(ip, i, False)
 
 
 # ====================================================================== one block
