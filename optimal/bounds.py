@@ -1,0 +1,460 @@
+"""Certified lower bound and checker-verified upper bound of the minimum time.
+
+Lower bound: why it is one
+==========================
+Let ``b(s) = v(s)^2`` be *any* motion that satisfies the continuous problem: ``b`` is
+Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhere,
+``|q'_j(s) a + q''_j(s) b| <= A_j`` almost everywhere, ``b = 0`` at stops and
+``v |t_out_j - t_in_j| <= jump_j`` at breaks. Its time is ``T = int ds / sqrt(b)``.
+
+1. *A-priori bounds per interval* ``I_k = [s_k, s_{k+1}]`` (one segment, length ``D``):
+   ``b <= Bbar_k`` on ``I_k``, where ``Bbar_k`` is the smallest of the feed, the axis
+   velocity caps with ``|q'_j|`` bounded below on ``I_k`` (mid value minus
+   ``D/2 sup|q''_j|``) and, on arcs, the two-axis elimination
+   ``|q'_l q''_j - q'_j q''_l| b <= |q'_l| A_j + |q'_j| A_i`` (``a`` eliminated; the
+   coefficient is bounded below via ``sup|q'''|``). Then ``|a| <= (A_j + sup|q''_j| Bbar)
+   / inf|q'_j|`` for every axis ``j``, so ``|b'| <= M_k`` (twice the best such bound).
+2. *Interval-exact rows.* Integrating ``q'_j a + q''_j b`` over ``I_k`` by parts
+   (``a = b'/2``) gives exactly
+   ``[q'_j b]_{s_k}^{s_{k+1}} / 2 + int q''_j b / 2 ds``, and its average is at most
+   ``A_j`` (and at least ``-A_j``). Writing ``b = b_lin + e`` with ``b_lin`` the chord
+   through the end values, ``|e(s)| <= 2 M t (D - t) / D`` (Lipschitz), so
+   ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 6 =: E_jk``. Hence the end values satisfy the
+   linear rows ``sigma ([q'_j b]/2 + w0 b_k + w1 b_{k+1}) <= A_j D + E_jk`` with
+   ``w0, w1 = int q''_j (1 - t/D) / 2, int q''_j (t/D) / 2`` (closed form on helices).
+   On lines ``q'' = 0``: the row is the exact ``|q'_j (b_{k+1} - b_k)| / (2D) <= A_j``.
+   Rows that are not in lattice form are relaxed further (one term dropped, ``b >= 0``).
+3. *Node caps* are those of the continuous problem at the nodes (velocity on both sides,
+   feed, stops, the junction rule with the checker's allowance), plus ``Bbar`` of both
+   neighbouring intervals. So the node values ``(b(s_k))`` are feasible for this
+   relaxed discrete problem, whose greatest element ``bhat`` (solved exactly by
+   :mod:`optimal.backends.fast`) therefore dominates them: ``b(s_k) <= bhat_k``.
+4. *Time.* On ``I_k``, ``b(s) <= min(Bbar_k, bhat_k + M t, bhat_{k+1} + M (D - t))``
+   (Lipschitz from both ends), so ``T >= sum_k int_0^D dt / sqrt(that tent)``, a closed
+   form. This is ``lower_bound_s`` (less ``LB_ROUNDOFF_REL`` for round-off), plus dwells.
+
+Every step only weakens constraints or over-estimates ``b``; the bound holds for every
+grid. Its looseness is O(D) on arcs and vanishes on lines (the tent is then exact
+wherever the optimum accelerates at the limit), so refinement closes the gap.
+
+Upper bound
+===========
+The grid optimum ``b`` defines a motion with ``b`` linear in ``s`` per interval
+(:meth:`Profile.from_path_velocity`). ``check_profile`` judges it inside every interval;
+if any ratio of the ``acc`` bound set exceeds 1 the profile is slowed down in time by
+``time_scale_factor`` (velocity ratios scale with ``1/lam``, accelerations with
+``1/lam^2``), and ``upper_bound_s`` is the duration of that accepted profile.
+
+Units: mm, s. Shapes: ``N`` intervals, ``n`` axes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
+                                        scale_time, time_scale_factor)
+from reference.core.geometry import Path
+from reference.core.limits import AxisArrays, MachineLimits
+from reference.core.profile import Profile
+
+from .backends.fast import sweep
+from .grid import Grid
+from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
+                      interval_geometry, moving_axes)
+from .tolerances import LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Relaxation:
+    """The lower-bound relaxation on one grid and its a-priori interval bounds.
+
+    Attributes
+    ----------
+    problem : DiscreteProblem
+        The relaxed discrete problem (``kind = "relaxed"``).
+    b_bar : numpy.ndarray, shape (N,)
+        Upper bound of ``b`` on each interval, mm^2/s^2.
+    slope : numpy.ndarray, shape (N,)
+        Upper bound ``M_k`` of ``|db/ds|`` on each interval, mm/s^2.
+    """
+
+    problem: DiscreteProblem
+    b_bar: np.ndarray
+    slope: np.ndarray
+
+
+def _g_series(x: np.ndarray) -> np.ndarray:
+    """``(sin x - x cos x) / x^2`` without cancellation (odd, ~ x/3 near 0)."""
+    out = np.empty_like(x)
+    small = np.abs(x) < 1e-2
+    xs = x[small]
+    x2 = xs * xs
+    out[small] = xs * (1 / 3 - x2 * (1 / 30 - x2 * (1 / 840 - x2 / 45360)))
+    xl = x[~small]
+    out[~small] = (np.sin(xl) - xl * np.cos(xl)) / (xl * xl)
+    return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _IntervalData:
+    """Grid-dependent data of the relaxation, computed once per grid."""
+
+    ds: np.ndarray            # (N,)
+    dq0: np.ndarray           # (N, n) tangent at interval starts
+    dq1: np.ndarray           # (N, n) tangent at interval ends
+    k2: np.ndarray            # (N, n) sup |q''_j| on the segment
+    lo: np.ndarray            # (N, n) inf |q'_j| on the interval
+    I0: np.ndarray            # (N, n) int q''_j (1 - t/D) / 2
+    I1: np.ndarray            # (N, n) int q''_j (t/D) / 2
+    b_static: np.ndarray      # (N,) a-priori bound of b on the interval
+    node_mvc: np.ndarray      # (N + 1,) static maximum-velocity curve at the nodes
+    axes_used: np.ndarray     # indices of moving axes
+
+
+def _pair_mvc(dq: np.ndarray, ddq: np.ndarray, a_max: np.ndarray) -> np.ndarray:
+    """Exact static bound ``max b`` s.t. some ``a`` has ``|q'_j a + q''_j b| <= A_j``.
+
+    The 2-variable LP's optimum is the smallest optimum over its two-constraint
+    sub-problems: ``(A_j |q'_l| + A_l |q'_j|) / |q'_l q''_j - q'_j q''_l|`` for axis pairs
+    and ``A_j / |q''_j|`` for an axis with ``q'_j = 0``. Shape ``(K, n) -> (K,)``.
+    """
+    K, n = dq.shape
+    out = np.full(K, np.inf)
+    for j in range(n):
+        single = (dq[:, j] == 0) & (ddq[:, j] != 0)
+        if np.any(single):
+            out[single] = np.minimum(out[single], a_max[j] / np.abs(ddq[single, j]))
+        for m in range(j + 1, n):
+            W = np.abs(dq[:, m] * ddq[:, j] - dq[:, j] * ddq[:, m])
+            ok = W > 0
+            if np.any(ok):
+                val = (a_max[j] * np.abs(dq[ok, m]) + a_max[m] * np.abs(dq[ok, j])) / W[ok]
+                out[ok] = np.minimum(out[ok], val)
+    return out
+
+
+def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
+    seg = grid.segment
+    ds = np.diff(grid.s)
+    N = ds.size
+    n = path.n_axes
+    dq0, ddq0, dq1, ddq1 = interval_geometry(path, grid)
+    mid = 0.5 * (grid.s[:-1] + grid.s[1:])
+    _, dqm, ddqm, _ = path.evaluate(mid, segment=seg)
+    r = path.radius[seg]
+    w = path.omega[seg]
+    plane = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)          # (N, n)
+    k2 = np.abs(r * w * w)[:, None] * plane                          # sup |q''_j|
+    k3 = np.abs(r * w ** 3)[:, None] * plane                         # sup |q^(3)_j|
+    half = 0.5 * ds[:, None]
+    lo = np.maximum(np.abs(dqm) - half * k2, 0.0)                    # inf |q'_j| on I_k
+    hi = np.abs(dqm) + half * k2                                     # sup |q'_j| on I_k
+    # ---- a-priori bound of b on each interval
+    feed = path.feed[seg]
+    b_bar = np.where(np.isfinite(feed), feed ** 2, np.inf)
+    with np.errstate(divide="ignore"):
+        vcap = np.where(lo > 0, (lim.v_max[None, :] / np.where(lo > 0, lo, 1.0)) ** 2,
+                        np.inf)
+    b_bar = np.minimum(b_bar, vcap.min(axis=1))
+    arc = r > 0
+    if np.any(arc):
+        ia = np.flatnonzero(arc)
+        for j in range(n):
+            for m in range(j + 1, n):
+                W = dqm[ia, m] * ddqm[ia, j] - dqm[ia, j] * ddqm[ia, m]
+                dW = hi[ia, m] * k3[ia, j] + hi[ia, j] * k3[ia, m]
+                Wlo = np.abs(W) - half[ia, 0] * dW
+                ok = Wlo > 0
+                if np.any(ok):
+                    num = hi[ia, m] * lim.a_max[j] + hi[ia, j] * lim.a_max[m]
+                    val = np.full(ia.size, np.inf)
+                    val[ok] = num[ok] / Wlo[ok]
+                    b_bar[ia] = np.minimum(b_bar[ia], val)
+    # ---- exact static bound at the nodes, from both sides
+    node_mvc = np.full(N + 1, np.inf)
+    node_mvc[:-1] = _pair_mvc(dq0, ddq0, lim.a_max)
+    node_mvc[1:] = np.minimum(node_mvc[1:], _pair_mvc(dq1, ddq1, lim.a_max))
+    # ---- closed-form weights of the interval-exact rows
+    phi_m = path.theta0[seg] + w * (mid - path.s_breaks[seg])
+    x = w * 0.5 * ds
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sinc = np.where(x != 0, np.sin(x) / np.where(x != 0, x, 1.0), 1.0)
+    g = _g_series(x)
+    along = -path.e1[seg] * np.sin(phi_m)[:, None] + path.e2[seg] * np.cos(phi_m)[:, None]
+    S0 = (sinc * ds)[:, None] * ddqm                                  # int q'' du
+    S1 = (-(r * w * w) * 2.0 * (0.5 * ds) ** 2 * g)[:, None] * along  # int u q'' du
+    I0 = S0 / 4 - S1 / (2 * ds[:, None])
+    I1 = S0 / 4 + S1 / (2 * ds[:, None])
+    return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
+                         moving_axes(dq0, ddq0, dq1, ddq1))
+
+
+def _slope_bound(geo: _IntervalData, lim: AxisArrays, B: np.ndarray) -> np.ndarray:
+    """``M = min_j 2 (A_j + sup|q''_j| B) / inf|q'_j|``: bound of ``|b'|`` where b <= B."""
+    lo = geo.lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        curv = np.where(geo.k2 > 0, geo.k2 * B[:, None], 0.0)      # 0 * inf -> 0
+        acap = np.where(lo > 0, (lim.a_max[None, :] + curv) / np.where(lo > 0, lo, 1.0),
+                        np.inf)
+    return 2.0 * acap.min(axis=1)
+
+
+def _gronwall_peak(geo: _IntervalData, lim: AxisArrays, b_node: np.ndarray) -> np.ndarray:
+    """Bound of ``b`` on each interval from bounds of its end values.
+
+    With ``|b'| <= alpha + beta b`` (``alpha = 2 A_j / inf|q'_j|``,
+    ``beta = 2 sup|q''_j| / inf|q'_j|`` for one axis ``j``), ``b`` stays below
+    ``(b_k + c) e^{beta t} - c`` from the left and the mirror image from the right
+    (``c = alpha / beta``); the bound is the largest value of the smaller of the two.
+    """
+    b0 = np.maximum(b_node[:-1], 0.0)
+    b1 = np.maximum(b_node[1:], 0.0)
+    ref = np.maximum(b0, b1)
+    lo = geo.lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        score = np.where(lo > 0, (lim.a_max[None, :] + geo.k2 * ref[:, None])
+                         / np.where(lo > 0, lo, 1.0), np.inf)
+    j = np.argmin(score, axis=1)
+    ar = np.arange(j.size)
+    loj = lo[ar, j]
+    ok = loj > 0
+    alpha = np.where(ok, 2 * lim.a_max[j] / np.where(ok, loj, 1.0), np.inf)
+    beta = np.where(ok, 2 * geo.k2[ar, j] / np.where(ok, loj, 1.0), np.inf)
+    D = geo.ds
+    out = np.full(j.size, np.inf)
+    lin = ok & (beta == 0)
+    if np.any(lin):
+        a, x0, x1, d = alpha[lin], b0[lin], b1[lin], D[lin]
+        tp = np.clip((x1 - x0 + a * d) / (2 * a), 0.0, d)
+        out[lin] = np.minimum(x0 + a * tp, x1 + a * (d - tp))
+    ex = ok & (beta > 0) & (beta * D < 50.0)
+    if np.any(ex):
+        bt, c = beta[ex], alpha[ex] / beta[ex]
+        x0, x1, d = b0[ex], b1[ex], D[ex]
+        tp = np.clip((np.log((x1 + c) / (x0 + c)) + bt * d) / (2 * bt), 0.0, d)
+        f = x0 + (x0 + c) * np.expm1(bt * tp)
+        g = x1 + (x1 + c) * np.expm1(bt * (d - tp))
+        out[ex] = np.minimum(f, g)
+    return out
+
+
+def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData,
+                     B: np.ndarray, b_node: np.ndarray | None = None) -> Relaxation:
+    N = geo.ds.size
+    ds = geo.ds
+    slope = _slope_bound(geo, lim, B)
+    good = np.isfinite(B) & np.isfinite(slope)
+    caps = common_node_caps(path, lim, grid, geo.dq0, geo.dq1, permissive=True)
+    left = np.arange(N)
+    caps.add(left[good], B[good], CAP_BOUND)
+    caps.add(left[good] + 1, B[good], CAP_BOUND)
+    fin_mvc = np.isfinite(geo.node_mvc)
+    caps.add(np.flatnonzero(fin_mvc), geo.node_mvc[fin_mvc], CAP_BOUND)
+    if b_node is not None:
+        fin = np.isfinite(b_node)
+        caps.add(np.flatnonzero(fin), np.maximum(b_node[fin], 0.0), CAP_BOUND)
+    margin = np.where(good, slope, 0.0) * ds * ds / 6.0
+    E = np.where(good[:, None], geo.k2 * margin[:, None], np.inf)
+    cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
+    for j in geo.axes_used:
+        hrow = lim.a_max[j] + E[:, j] / ds
+        fin = np.isfinite(hrow)
+        for sigma in (1.0, -1.0):
+            c1 = sigma * (-0.5 * geo.dq0[:, j] + geo.I0[:, j]) / ds
+            c2 = sigma * (0.5 * geo.dq1[:, j] + geo.I1[:, j]) / ds
+            c1 = np.where(fin, c1, 0.0)
+            c2 = np.where(fin, c2, 0.0)
+            both = (c1 > 0) & (c2 > 0)
+            if np.any(both):
+                # relax: drop one term at a time (b >= 0)
+                caps.add(left[both], hrow[both] / c1[both], CAP_BOUND)
+                caps.add(left[both] + 1, hrow[both] / c2[both], CAP_BOUND)
+            cols_c1.append(np.where(both, 0.0, c1))
+            cols_c2.append(np.where(both, 0.0, c2))
+            cols_h.append(np.where(fin, hrow, 1.0))
+            row_axis.append(j)
+    prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
+    return Relaxation(prob, B, slope)
+
+
+def build_relaxation(path: Path, lim: AxisArrays, grid: Grid,
+                     b_node: np.ndarray | None = None) -> Relaxation:
+    """The relaxed discrete problem of the module docstring on ``grid``.
+
+    Parameters
+    ----------
+    path : Path
+        Path with at least one segment.
+    lim : AxisArrays
+        Limits in the path's axis order.
+    grid : Grid
+        Nodes.
+    b_node : numpy.ndarray, shape (N + 1,), optional
+        Valid upper bounds of ``b`` at the nodes (the optimum of an earlier relaxation
+        on this grid); they tighten the interval bounds (:func:`_gronwall_peak`).
+
+    Returns
+    -------
+    Relaxation
+    """
+    geo = _interval_data(path, lim, grid)
+    B = geo.b_static
+    if b_node is not None:
+        B = np.minimum(B, _gronwall_peak(geo, lim, b_node))
+    return _relaxed_problem(path, lim, grid, geo, B, b_node)
+
+
+def tent_times(s: np.ndarray, b: np.ndarray, b_bar: np.ndarray, slope: np.ndarray
+               ) -> np.ndarray:
+    """Lower estimate of the time on every interval (step 4 of the module docstring).
+
+    ``int_0^D dt / sqrt(min(Bbar, b_k + M t, b_{k+1} + M (D - t)))`` in closed form.
+
+    Parameters
+    ----------
+    s : numpy.ndarray, shape (N + 1,)
+        Nodes, mm.
+    b : numpy.ndarray, shape (N + 1,)
+        Upper bounds of ``b`` at the nodes (the relaxation's optimum), mm^2/s^2.
+    b_bar, slope : numpy.ndarray, shape (N,)
+        Interval bounds of ``b`` and ``|b'|``; where not finite the estimate is 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Seconds.
+    """
+    D = np.diff(s)
+    good = np.isfinite(b_bar) & np.isfinite(slope) & (slope > 0)
+    B = np.where(good, b_bar, 1.0)
+    M = np.where(good, slope, 1.0)
+    b0 = np.minimum(np.maximum(b[:-1], 0.0), B)
+    b1 = np.minimum(np.maximum(b[1:], 0.0), B)
+    tp = np.clip((b1 - b0 + M * D) / (2 * M), 0.0, D)
+
+    def ramp(b_start, length):
+        tc = np.clip((B - b_start) / M, 0.0, length)
+        top = np.sqrt(b_start + M * tc) + np.sqrt(b_start)
+        up = np.where(tc > 0, 2 * tc / np.where(top > 0, top, 1.0), 0.0)
+        flat = np.where(length - tc > 0, (length - tc) / np.sqrt(np.where(B > 0, B, 1.0)),
+                        0.0)
+        return up + np.where(B > 0, flat, np.where(length - tc > 0, np.inf, 0.0))
+
+    t = ramp(b0, tp) + ramp(b1, D - tp)
+    return np.where(good, t, 0.0)
+
+
+def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROUNDS,
+                b_node: np.ndarray | None = None
+                ) -> tuple[float, np.ndarray, Relaxation, np.ndarray]:
+    """Certified lower bound of the motion time on ``grid`` (dwells excluded).
+
+    Round 0 uses the a-priori interval bounds; each further round bounds ``b`` inside
+    the intervals from the previous round's node values (still valid for every
+    feasible motion, step 1 of the module docstring), which shrinks the Lipschitz
+    margins. Rounds stop early when the bound improves by less than
+    ``LB_ROUND_IMPROVEMENT``.
+
+    Parameters
+    ----------
+    path, lim, grid
+        Problem data.
+    rounds : int
+        Largest number of rounds.
+    b_node : numpy.ndarray, shape (N + 1,), optional
+        Upper bounds of ``b`` at the nodes that hold for *every* feasible motion (for
+        example mapped from a relaxation on a coarser grid with :func:`node_bounds_on`);
+        they are added as node caps and start the interval bounds.
+
+    Returns
+    -------
+    lb_s : float
+        Seconds, already reduced by ``LB_ROUNDOFF_REL``.
+    t_lb : numpy.ndarray, shape (N,)
+        Per-interval lower estimates, s.
+    relaxation : Relaxation
+        The relaxed problem of the best round.
+    b_hat : numpy.ndarray, shape (N + 1,)
+        Its greatest element, mm^2/s^2.
+    """
+    geo = _interval_data(path, lim, grid)
+    B = geo.b_static
+    if b_node is not None:
+        B = np.minimum(B, _gronwall_peak(geo, lim, b_node))
+    best = None
+    for _ in range(max(rounds, 1)):
+        rel = _relaxed_problem(path, lim, grid, geo, B, b_node)
+        b_hat, _, _ = sweep(rel.problem)
+        t = tent_times(grid.s, b_hat, rel.b_bar, rel.slope)
+        T = float(t.sum())
+        improved = best is None or T > best[0] * (1 + LB_ROUND_IMPROVEMENT)
+        if best is None or T > best[0]:
+            best = (T, t, rel, b_hat)
+        if not improved:
+            break
+        B = np.minimum(B, _gronwall_peak(geo, lim, b_hat))
+    T, t, rel, b_hat = best
+    return T * (1.0 - LB_ROUNDOFF_REL), t, rel, b_hat
+
+
+def node_bounds_on(new: Grid, old: Grid, b_hat: np.ndarray, b_bar: np.ndarray
+                   ) -> np.ndarray:
+    """Valid node bounds on a refined grid from a relaxation on the coarser one.
+
+    Old nodes keep the old optimum ``b_hat`` (it dominates every feasible motion there);
+    new nodes inside old interval ``k`` get that interval's bound ``b_bar[k]``.
+
+    Parameters
+    ----------
+    new, old : Grid
+        ``new`` contains every node of ``old``.
+    b_hat : numpy.ndarray, shape (N_old + 1,)
+    b_bar : numpy.ndarray, shape (N_old,)
+
+    Returns
+    -------
+    numpy.ndarray, shape (N_new + 1,)
+    """
+    idx = np.searchsorted(old.s, new.s, side="left")
+    idx = np.clip(idx, 0, old.s.size - 1)
+    on_old = old.s[idx] == new.s
+    k = np.clip(idx - 1, 0, b_bar.size - 1)
+    return np.where(on_old, b_hat[idx], b_bar[k])
+
+
+def verified_profile(path: Path, limits: MachineLimits, s: np.ndarray, b: np.ndarray,
+                     block: np.ndarray, bounds: str = "acc"
+                     ) -> tuple[Profile, float, ConstraintReport]:
+    """The grid profile, judged by ``check_profile`` and time-scaled until accepted.
+
+    Parameters
+    ----------
+    path : Path
+        The path.
+    limits : MachineLimits
+        Machine limits.
+    s, b : numpy.ndarray, shape (N + 1,)
+        Nodes (mm) and squared speeds (mm^2/s^2).
+    block : numpy.ndarray of int, shape (N,)
+        NC block of each interval.
+    bounds : str
+        Bound set of :data:`BOUND_SETS`.
+
+    Returns
+    -------
+    profile : Profile
+        The accepted (possibly slowed-down) profile.
+    lam : float
+        Time-scale factor applied (>= 1).
+    report : ConstraintReport
+        The checker's report on the *unscaled* grid profile.
+    """
+    prof = Profile.from_path_velocity(s, np.sqrt(np.maximum(b, 0.0)), block)
+    report = check_profile(path, limits, prof)
+    lam = time_scale_factor(report, BOUND_SETS[bounds])
+    if lam > 1.0:
+        prof = scale_time(prof, lam)
+    return prof, lam, report

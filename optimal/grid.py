@@ -1,0 +1,157 @@
+"""Piece-aware grids on a path: every segment break is a node, arcs get enough nodes.
+
+A :class:`Grid` has nodes ``s_0 < s_1 < ... < s_N`` and assigns every interval
+``[s_k, s_{k+1}]`` to exactly one segment. Segment breaks are nodes, so an interval never
+straddles a break: the geometry on each interval is that of one piece, and the node at a
+break carries the constraints of both sides (the "double node" of the formulation note,
+without an artificial epsilon: ``b`` is continuous, only the geometry jumps).
+
+Units: mm. Shapes: ``N`` intervals, ``N + 1`` nodes, ``m`` segments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.core.geometry import Path
+
+from .tolerances import (DEFAULT_INITIAL_INTERVALS, MAX_ARC_STEP_RAD, MIN_ARC_INTERVALS,
+                         MIN_SEGMENT_INTERVALS)
+
+#: Intervals shorter than this fraction of their segment are never split again: a
+#: guard against splitting down to float64 resolution (1e-12 of a segment).
+_MIN_SPLIT_REL = 1e-12
+
+
+def _ro(a: np.ndarray, dtype=np.float64) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=dtype)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Grid:
+    """Nodes on a path and the segment of every interval.
+
+    Attributes
+    ----------
+    s : numpy.ndarray, shape (N + 1,)
+        Strictly increasing nodes, mm; ``s[0] = 0``, ``s[-1]`` = path length.
+    segment : numpy.ndarray of int, shape (N,)
+        Segment of each interval.
+    break_node : numpy.ndarray of int, shape (m + 1,)
+        Node index of every segment break (``path.s_breaks``).
+    """
+
+    s: np.ndarray
+    segment: np.ndarray
+    break_node: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "s", _ro(self.s))
+        object.__setattr__(self, "segment", _ro(self.segment, np.int64))
+        object.__setattr__(self, "break_node", _ro(self.break_node, np.int64))
+
+    @property
+    def n_intervals(self) -> int:
+        """Number of intervals ``N``."""
+        return int(self.segment.size)
+
+    @property
+    def n_points(self) -> int:
+        """Number of nodes ``N + 1``."""
+        return int(self.s.size)
+
+
+def _counts(path: Path, n_target: int, min_arc: int, arc_step: float) -> np.ndarray:
+    length = path.length
+    h0 = path.total_length / max(n_target, 1)
+    n = np.maximum(MIN_SEGMENT_INTERVALS, np.ceil(length / h0 * (1 - 1e-12))).astype(np.int64)
+    arc = path.radius > 0
+    sweep = np.abs(path.omega) * length
+    n_arc = np.maximum(min_arc, np.ceil(sweep / arc_step)).astype(np.int64)
+    return np.where(arc, np.maximum(n, n_arc), n)
+
+
+def grid_from_counts(path: Path, counts: np.ndarray) -> Grid:
+    """Grid with ``counts[i]`` equal intervals on segment ``i``.
+
+    Parameters
+    ----------
+    path : Path
+        The path.
+    counts : numpy.ndarray of int, shape (m,)
+        Intervals per segment (>= 1).
+
+    Returns
+    -------
+    Grid
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    seg = np.repeat(np.arange(path.n_segments), counts)
+    first = np.concatenate(([0], np.cumsum(counts)[:-1]))
+    j = np.arange(seg.size) - first[seg]
+    s = path.s_breaks[seg] + path.length[seg] * (j / counts[seg])
+    s = np.concatenate((s, [path.total_length]))
+    break_node = np.concatenate((first, [seg.size]))
+    return Grid(s=s, segment=seg, break_node=break_node)
+
+
+def initial_grid(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS, *,
+                 min_arc_intervals: int = MIN_ARC_INTERVALS,
+                 max_arc_step_rad: float = MAX_ARC_STEP_RAD) -> Grid:
+    """Piece-aware starting grid.
+
+    Each segment gets ``max(2, ceil(length / h))`` equal intervals with
+    ``h = total_length / n_intervals``; arcs and helices at least ``min_arc_intervals`` and
+    at most ``max_arc_step_rad`` of sweep per interval.
+
+    Parameters
+    ----------
+    path : Path
+        A path with at least one segment.
+    n_intervals : int
+        Target number of intervals spread by length (the result has at least this many
+        minus rounding, more when segments are short or arcs need more).
+    min_arc_intervals : int
+        Fewest intervals per arc.
+    max_arc_step_rad : float
+        Largest sweep per arc interval, rad.
+
+    Returns
+    -------
+    Grid
+    """
+    return grid_from_counts(path, _counts(path, n_intervals, min_arc_intervals,
+                                          max_arc_step_rad))
+
+
+def split(grid: Grid, path: Path, mark: np.ndarray) -> Grid:
+    """Halve the marked intervals.
+
+    Parameters
+    ----------
+    grid : Grid
+        Current grid.
+    path : Path
+        Its path (for the guard against splitting to round-off).
+    mark : numpy.ndarray of bool, shape (N,)
+        Intervals to split at their mid-point.
+
+    Returns
+    -------
+    Grid
+        The refined grid (the same object when nothing can be split).
+    """
+    ds = np.diff(grid.s)
+    ok = np.asarray(mark, bool) & (ds > _MIN_SPLIT_REL * path.length[grid.segment])
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return grid
+    mid = 0.5 * (grid.s[idx] + grid.s[idx + 1])
+    s = np.insert(grid.s, idx + 1, mid)
+    seg = np.insert(grid.segment, idx + 1, grid.segment[idx])
+    break_node = np.searchsorted(s, path.s_breaks)
+    return Grid(s=s, segment=seg, break_node=break_node)

@@ -1,0 +1,551 @@
+"""``optimal.solve``: minimum-time motion along a path with certified bounds.
+
+Pipeline (one pure function, no state kept between calls):
+
+1. validate (bound set, feeds, limits for every axis);
+2. piece-aware initial grid (:mod:`optimal.grid`);
+3. repeat: build the grid problem (:mod:`optimal.problem`), solve it with the chosen
+   backend, verify its profile with ``check_profile`` and time-scale it (upper bound),
+   solve the relaxation (lower bound, :mod:`optimal.bounds`); stop when
+   ``(upper - lower) / lower <= tol``; otherwise halve the intervals that carry most of
+   the gap (and the arc intervals of blocks where the checker found the grid profile too
+   fast) and go on, up to ``max_grid`` intervals;
+4. report the best bounds seen (both stay valid on every grid), the accepted profile,
+   times per segment and per NC block, and the active constraint along the path.
+
+Units: mm, s.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+
+from reference.core.constraints import BOUND_SETS, ConstraintReport
+from reference.core.errors import InfeasibleError
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.core.profile import Profile
+from reference.core.tolerances import VEL_TOL_MM_S
+
+from .backends import DEFAULT_BACKEND, get_backend
+from .bounds import lower_bound, node_bounds_on, verified_profile
+from .grid import Grid, initial_grid, split
+from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, DiscreteProblem,
+                      build_grid_problem, check_feed, interval_times)
+from .status import SolveStatus
+from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
+                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS)
+
+SUPPORTED_BOUNDS = ("acc",)
+
+ProgressFn = Callable[[str, float], None]
+
+
+@dataclass(frozen=True, slots=True)
+class BlockResult:
+    """The oracle's numbers for one NC block.
+
+    Attributes
+    ----------
+    block : int
+        Block index in the program.
+    line : int
+        1-based source line.
+    label : str
+        Block number or label.
+    kind : str
+        ``"G0"``, ``"G1"``, ... (from the path's block table).
+    length_mm : float
+        Path length of the block, mm.
+    t_oracle_s : float
+        Time the verified (upper-bound) profile spends in the block, s (dwell included).
+    v_exit_oracle : float
+        Path speed at the block end, mm/s.
+    limit_oracle : str
+        Constraint active over most of the block's time: ``"feed"``,
+        ``"velocity <axis>"``, ``"acceleration <axis>"``, ``"velocity_jump"``,
+        ``"stop"``; for blocks without motion the stop reason (or ``""``).
+    """
+
+    block: int
+    line: int
+    label: str
+    kind: str
+    length_mm: float
+    t_oracle_s: float
+    v_exit_oracle: float
+    limit_oracle: str
+
+
+@dataclass(frozen=True, slots=True)
+class IterationRecord:
+    """One refinement round: grid size and the bounds found on it (s).
+
+    ``upper_bound_s`` is ``inf`` in rounds where the checker was not run (the grid
+    optimum was still farther than the requested gap from the lower bound).
+    """
+
+    grid_points: int
+    lower_bound_s: float
+    upper_bound_s: float
+    objective_s: float
+    time_scale: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class OptimalSolution:
+    """Result of :func:`solve`; ``status`` is never ``None``.
+
+    Attributes
+    ----------
+    status : SolveStatus
+        ``optimal`` (gap met), ``gap_not_met``, ``infeasible`` or ``solver_error``.
+    profile : Profile or None
+        The verified profile whose duration is ``upper_bound_s`` (``None`` only on
+        ``solver_error``).
+    lower_bound_s, upper_bound_s : float
+        Certified lower bound and verified upper bound of the minimum time, s (dwells
+        included in both).
+    objective_s : float
+        Time of the grid optimum before time scaling, s.
+    gap : float
+        ``(upper - lower) / lower`` (0 for an empty path).
+    time_scale : float
+        Factor ``lam >= 1`` the grid profile was slowed down by to pass the checker.
+    segment_times_s : numpy.ndarray, shape (m,)
+        Time spent moving through each segment, s.
+    block_times_s : numpy.ndarray, shape (max block index + 1,)
+        Time spent in each NC block (by block index), s.
+    blocks : tuple[BlockResult, ...]
+        One row per block of ``path.blocks``.
+    grid : numpy.ndarray, shape (N + 1,)
+        Final grid nodes, mm.
+    active : tuple[str, ...]
+        Active constraint on each final grid interval (labels as in
+        :class:`BlockResult`).
+    grid_points : int
+        ``N + 1``.
+    iterations : int
+        Refinement rounds.
+    backend : str
+        Backend of the grid problem.
+    build_time_s, solve_time_s, check_time_s, bound_time_s, total_time_s : float
+        Problem construction, discrete solves, checker, lower-bound relaxation, and the
+        whole call, s (sums over rounds).
+    dwell_s : float
+        Total dwell time of the program, s.
+    report : ConstraintReport or None
+        The checker's report on the final grid profile before time scaling.
+    history : tuple[IterationRecord, ...]
+        Bounds per round.
+    message : str
+        Human-readable summary.
+    """
+
+    status: SolveStatus
+    profile: Profile | None
+    lower_bound_s: float
+    upper_bound_s: float
+    objective_s: float
+    gap: float
+    time_scale: float
+    segment_times_s: np.ndarray
+    block_times_s: np.ndarray
+    blocks: tuple[BlockResult, ...]
+    grid: np.ndarray
+    active: tuple[str, ...]
+    grid_points: int
+    iterations: int
+    backend: str
+    build_time_s: float
+    solve_time_s: float
+    check_time_s: float
+    bound_time_s: float
+    total_time_s: float
+    dwell_s: float
+    report: ConstraintReport | None = None
+    history: tuple[IterationRecord, ...] = field(default=())
+    message: str = ""
+
+
+# --------------------------------------------------------------------------- helpers
+def _block_name(path: Path, blk: int) -> str:
+    span = next((b for b in path.blocks if b.block == blk), None)
+    if span is None:
+        return f"block {blk}"
+    lab = f", {span.label}" if span.label else ""
+    return f"block {blk} (line {span.line}{lab})"
+
+
+def _with_holds(prof: Profile, path: Path) -> Profile:
+    """Insert the dwell holds (``s`` constant, ``v = 0``) at their blocks' positions."""
+    holds = [(b.s_end, b.block, b.dwell_s) for b in path.blocks if b.dwell_s > 0]
+    if not holds:
+        return prof
+    t, s, v = prof.t.copy(), prof.s.copy(), prof.v.copy()
+    a, j, blk = prof.a.copy(), prof.j.copy(), prof.block.copy()
+    for pos, block, dwell in reversed(holds):
+        i = int(np.clip(np.searchsorted(s, pos, side="left"), 0, s.size - 1))
+        if v[i] > VEL_TOL_MM_S:
+            continue
+        t = np.insert(t, i + 1, t[i])
+        t[i + 1:] += dwell
+        s = np.insert(s, i + 1, s[i])
+        v = np.insert(v, i + 1, 0.0)
+        v[i] = 0.0
+        a = np.insert(a, i, 0.0)
+        j = np.insert(j, i, 0.0)
+        blk = np.insert(blk, i, block)
+    return Profile(t=t, s=s, v=v, a=a, j=j, block=blk)
+
+
+def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
+    """Which constraint is tight on each interval of a solved grid problem.
+
+    Parameters
+    ----------
+    problem : DiscreteProblem
+        The grid problem.
+    b : numpy.ndarray, shape (N + 1,)
+        Its solution.
+
+    Returns
+    -------
+    tuple[str, ...]
+        Length ``N``: ``"feed"``, ``"velocity X"``, ``"acceleration X"``,
+        ``"velocity_jump"``, ``"stop"`` or ``"none"``.
+    """
+    N = problem.n_intervals
+    axes = problem.axes
+    cap = problem.cap
+    tight_node = np.where(cap > 0, b >= cap * (1 - ACTIVE_TOL_REL), b <= 0)
+
+    def cap_label(k: int) -> str:
+        code = int(problem.cap_code[k])
+        ax = int(problem.cap_axis[k])
+        if code in (CAP_VELOCITY, CAP_ACCELERATION) and ax >= 0:
+            return f"{CAP_NAMES[code]} {axes[ax]}"
+        return CAP_NAMES[code]
+
+    lhs = problem.c1 * b[:-1, None] + problem.c2 * b[1:, None]
+    scale = np.abs(problem.c1 * b[:-1, None]) + np.abs(problem.c2 * b[1:, None]) + problem.h
+    used = (problem.c1 != 0) | (problem.c2 != 0)
+    tight_row = used & (lhs >= problem.h - ACTIVE_TOL_REL * scale)
+    any_row = tight_row.any(axis=1)
+    first_row = np.argmax(tight_row, axis=1)
+    out = []
+    steady = (CAP_FEED, CAP_VELOCITY, CAP_ACCELERATION)
+    for k in range(N):
+        c0, c1 = int(problem.cap_code[k]), int(problem.cap_code[k + 1])
+        if (tight_node[k] and tight_node[k + 1] and c0 == c1 and c0 in steady
+                and problem.cap_axis[k] == problem.cap_axis[k + 1]):
+            out.append(cap_label(k))
+        elif any_row[k]:
+            out.append(f"acceleration {axes[int(problem.row_axis[first_row[k]])]}")
+        elif tight_node[k + 1]:
+            out.append(cap_label(k + 1))
+        elif tight_node[k]:
+            out.append(cap_label(k))
+        else:
+            out.append("none")
+    return tuple(out)
+
+
+def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, lam: float,
+                  report: ConstraintReport | None, budget: int) -> np.ndarray:
+    """Intervals to halve: those carrying most of the gap, plus arc intervals of blocks
+    where the checker needed time scaling."""
+    N = grid.n_intervals
+    mark = np.zeros(N, bool)
+    d = np.maximum(lam * t_prim - t_lb, 0.0)
+    disc = np.maximum(t_prim - t_lb, 0.0)
+    total = float(disc.sum())
+    if total > 0:
+        order = np.argsort(-disc, kind="stable")
+        cum = np.cumsum(disc[order])
+        n_take = int(np.searchsorted(cum, 0.6 * total)) + 1
+        mark[order[:n_take]] = True
+    scale_part = (lam - 1.0) * float(t_prim.sum())
+    if report is not None and lam > 1.0 and scale_part > 0.2 * float(d.sum()):
+        power = {"velocity": 1, "feed": 1, "velocity_jump": 1, "acceleration": 2}
+        bad_blocks = set()
+        for name, pw in power.items():
+            br = np.asarray(report.block_ratios.get(name, np.zeros(0)))
+            thr = 1.0 + 0.5 * (lam ** pw - 1.0)
+            bad_blocks.update(np.flatnonzero(br > thr).tolist())
+            w = report.worst(name)
+            if w.ratio > 1.0:
+                k = int(np.clip(np.searchsorted(grid.s, w.s) - 1, 0, N - 1))
+                mark[max(k - 2, 0):k + 3] = True
+        if bad_blocks:
+            blk = path.block[grid.segment]
+            arc = path.radius[grid.segment] > 0
+            mark |= np.isin(blk, list(bad_blocks)) & arc
+    n_mark = int(mark.sum())
+    if n_mark > budget:
+        idx = np.flatnonzero(mark)
+        keep = idx[np.argsort(-d[idx], kind="stable")[:max(budget, 0)]]
+        mark[:] = False
+        mark[keep] = True
+    return mark
+
+
+def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str
+                    ) -> OptimalSolution:
+    dwell = float(sum(b.dwell_s for b in path.blocks))
+    prof = _with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path)
+    n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
+    bt = prof.block_times(path) if path.blocks else np.zeros(0)
+    rows = tuple(BlockResult(b.block, b.line, b.label, b.kind, b.length,
+                             float(bt[b.block]) if b.block < bt.size else 0.0, 0.0,
+                             b.stop_reason) for b in path.blocks)
+    return OptimalSolution(
+        status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=dwell, upper_bound_s=dwell,
+        objective_s=dwell, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
+        block_times_s=np.asarray(bt if n_blocks else np.zeros(0)), blocks=rows,
+        grid=np.zeros(1), active=(), grid_points=1, iterations=0, backend=backend,
+        build_time_s=0.0, solve_time_s=0.0, check_time_s=0.0, bound_time_s=0.0,
+        total_time_s=time.perf_counter() - t0, dwell_s=dwell,
+        message="path without motion: time = dwell time")
+
+
+# --------------------------------------------------------------------------- solve
+def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
+          tol: float = DEFAULT_GAP_TOL, backend: str = DEFAULT_BACKEND,
+          backend_options: Mapping[str, object] | None = None,
+          max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
+          initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
+          progress: ProgressFn | None = None) -> OptimalSolution:
+    """Minimum-time motion along ``path`` with a certified lower and a verified upper bound.
+
+    Constraints (bound set ``"acc"``): programmed feed per segment (path speed of the
+    geometry axes; none for G0, where only the axes' limits apply), axis velocity, axis
+    acceleration including the centripetal part on arcs and helices, rest at
+    ``path.stop`` breaks (start, end, exact and forced stops), and at non-tangential
+    breaks the axis velocity jump of the machine data (``v <= min_i jump_i /
+    |t_out_i - t_in_i|``; with ``MAX_ACCEL_OVL_FACTOR = 1`` the motion stops there).
+
+    Parameters
+    ----------
+    path : Path
+        The path (lines, arcs, helices) with feeds, stops and the block table.
+    limits : MachineLimits
+        Machine limits; must define every axis of the path.
+    bounds : str
+        Bound set; only ``"acc"`` (velocity and acceleration) is supported.
+    tol : float
+        Requested relative gap ``(upper - lower) / lower`` (default 0.2 %).
+    backend : str
+        Backend of the grid problem (``"fast"`` default, ``"highs"``, ``"clarabel"``).
+    backend_options : Mapping, optional
+        Backend-specific options.
+    max_grid : int
+        Largest number of grid intervals before giving up with ``"gap_not_met"``.
+    max_iterations : int
+        Largest number of refinement rounds.
+    initial_intervals : int
+        Target size of the initial grid.
+    progress : callable, optional
+        Called as ``progress(stage_message, fraction_done)`` during refinement.
+
+    Returns
+    -------
+    OptimalSolution
+
+    Raises
+    ------
+    ValueError
+        Unknown bound set, option or backend; ``tol <= 0``.
+    InfeasibleError
+        A block with zero feed, or any other problem without a motion (names the block
+        and its source line).
+    MachineDataError
+        An axis of the path has no limits.
+    BackendNotFoundError
+        The backend's package is not installed (the message says what to install).
+    """
+    t_start = time.perf_counter()
+    if bounds not in BOUND_SETS:
+        raise ValueError(f"unknown bound set {bounds!r}; known: {', '.join(BOUND_SETS)}")
+    if bounds not in SUPPORTED_BOUNDS:
+        raise ValueError(f"bound set {bounds!r} is not supported by the oracle yet "
+                         f"(supported: {', '.join(SUPPORTED_BOUNDS)})")
+    if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol = {tol!r}: must be a finite number > 0")
+    if not (isinstance(max_grid, int) and max_grid >= 2):
+        raise ValueError(f"max_grid = {max_grid!r}: must be an int >= 2")
+    if not (isinstance(max_iterations, int) and max_iterations >= 1):
+        raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
+    solve_fn = get_backend(backend)
+    lim = limits.for_axes(path.axes)
+    if path.n_segments == 0:
+        if progress:
+            progress("no motion", 1.0)
+        return _empty_solution(path, limits, t_start, backend)
+    check_feed(path)
+    dwell = float(sum(b.dwell_s for b in path.blocks))
+
+    grid = initial_grid(path, min(initial_intervals, max_grid))
+    t_build = t_solve = t_check = t_bound = 0.0
+    history: list[IterationRecord] = []
+    best = None            # (ub, grid, problem, result, profile, lam, report, t_prim)
+    best_lb = 0.0
+    prev_lb = None         # (grid, b_hat, b_bar) of the last relaxation: warm start
+    status = SolveStatus.GAP_NOT_MET
+    gaps: list[float] = []     # first gap, for the progress fraction
+    frac = 0.0
+    it = 0
+    for it in range(1, max_iterations + 1):
+        ta = time.perf_counter()
+        problem = build_grid_problem(path, lim, grid)
+        tb = time.perf_counter()
+        res = solve_fn(problem, backend_options)
+        tc = time.perf_counter()
+        t_build += (tb - ta) + res.build_time_s
+        t_solve += tc - tb - res.build_time_s
+        if res.status == SolveStatus.INFEASIBLE:
+            k = _first_blocked_interval(problem, res)
+            blk = int(path.block[grid.segment[k]])
+            raise InfeasibleError(f"{_block_name(path, blk)}: no motion reaches "
+                                  f"s = {grid.s[k]:.6g}..{grid.s[k + 1]:.6g} mm "
+                                  f"({res.message})", blk)
+        if res.b is None or res.status not in (SolveStatus.OPTIMAL,
+                                               SolveStatus.OPTIMAL_INACCURATE):
+            status = SolveStatus.SOLVER_ERROR
+            msg = f"backend {backend!r}: {res.status} ({res.message})"
+            break
+        # lower bound first: while the grid optimum itself is farther than tol from it,
+        # the gap cannot be met and the checker (the expensive part) can wait
+        te = time.perf_counter()
+        b_node = (node_bounds_on(grid, *prev_lb) if prev_lb is not None else None)
+        lb, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
+        prev_lb = (grid, b_hat, rel.b_bar)
+        t_bound += time.perf_counter() - te
+        t_prim = interval_times(grid.s, res.b)
+        t_grid = float(t_prim.sum()) + dwell
+        best_lb = max(best_lb, lb + dwell)
+        budget = min(max_grid - grid.n_intervals, grid.n_intervals)
+        last = budget <= 0 or it == max_iterations
+        disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
+        new_grid = None
+        if not (disc_gap <= tol or last):
+            mark = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget)
+            new_grid = split(grid, path, mark)
+            if new_grid is grid:
+                last, new_grid = True, None
+        if new_grid is not None:
+            history.append(IterationRecord(grid.n_points, lb + dwell, math.inf, t_grid, 1.0))
+            gap = max(disc_gap, (best[0] - best_lb) / best_lb if best else disc_gap)
+            frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
+            grid = new_grid
+            continue
+        # upper bound: the checker judges the grid profile, time scaling fixes excesses
+        block_of = path.block[grid.segment]
+        td = time.perf_counter()
+        prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds)
+        t_check += time.perf_counter() - td
+        ub = prof.duration + dwell
+        if best is None or ub < best[0]:
+            best = (ub, grid, problem, res, prof, lam, report, t_prim)
+        history.append(IterationRecord(grid.n_points, lb + dwell, ub, t_grid, lam))
+        gap = (best[0] - best_lb) / best_lb if best_lb > 0 else math.inf
+        frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
+        if gap <= tol:
+            status = SolveStatus.OPTIMAL
+            break
+        if last:
+            break
+        mark = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget)
+        new_grid = split(grid, path, mark)
+        if new_grid is grid:
+            break
+        grid = new_grid
+    else:  # pragma: no cover - loop always breaks
+        pass
+
+    t_total = time.perf_counter() - t_start
+    if best is None:
+        return OptimalSolution(
+            status=SolveStatus.SOLVER_ERROR, profile=None, lower_bound_s=best_lb,
+            upper_bound_s=math.inf, objective_s=math.inf, gap=math.inf, time_scale=1.0,
+            segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
+            blocks=(), grid=grid.s, active=(), grid_points=grid.n_points, iterations=it,
+            backend=backend, build_time_s=t_build, solve_time_s=t_solve,
+            check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total, dwell_s=dwell,
+            history=tuple(history), message=msg)
+    ub, g, problem, res, prof, lam, report, t_prim = best
+    prof_h = _with_holds(prof, path)
+    seg_t = prof_h.segment_times(path)
+    blk_t = prof_h.block_times(path)
+    labels = active_labels(problem, res.b)
+    rows = _block_rows(path, g, prof_h, blk_t, labels, lam * t_prim)
+    gap = (ub - best_lb) / best_lb if best_lb > 0 else math.inf
+    if status == SolveStatus.SOLVER_ERROR:
+        message = msg
+    elif status == SolveStatus.OPTIMAL:
+        message = f"gap {gap:.4%} <= {tol:.4%} on {g.n_points} points"
+    else:
+        message = (f"gap {gap:.4%} > {tol:.4%} after {it} rounds ({g.n_points} points, "
+                   f"max_grid {max_grid}); both bounds are valid")
+    if progress:
+        progress("done", 1.0)
+    return OptimalSolution(
+        status=status, profile=prof_h, lower_bound_s=best_lb, upper_bound_s=ub,
+        objective_s=float(t_prim.sum()) + dwell, gap=gap, time_scale=lam,
+        segment_times_s=seg_t, block_times_s=blk_t, blocks=rows, grid=g.s, active=labels,
+        grid_points=g.n_points, iterations=it, backend=res.backend, build_time_s=t_build,
+        solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
+        total_time_s=time.perf_counter() - t_start, dwell_s=dwell, report=report,
+        history=tuple(history), message=message)
+
+
+def _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps) -> float:
+    """Call ``progress`` with a monotone fraction: log-progress of the gap towards tol
+    or of the grid towards its limit, whichever is further."""
+    if progress is None:
+        return frac
+    if not gaps:
+        gaps.append(max(gap, tol * 1.0001) if math.isfinite(gap) else 1.0)
+    g0 = gaps[0]
+    done = (math.log(g0 / max(gap, tol)) / math.log(g0 / tol)
+            if g0 > tol and math.isfinite(gap) else 0.0)
+    frac = max(frac, min(0.99, max(done, grid.n_intervals / max_grid)))
+    progress(f"round {it}: {grid.n_points} points, gap {gap:.3%}", frac)
+    return frac
+
+
+def _first_blocked_interval(problem: DiscreteProblem, res) -> int:
+    if res.b is None:
+        return 0
+    dt = interval_times(problem.s, res.b)
+    bad = np.flatnonzero(~np.isfinite(dt))
+    return int(bad[0]) if bad.size else 0
+
+
+def _block_rows(path: Path, grid: Grid, prof: Profile, blk_t: np.ndarray,
+                labels: tuple[str, ...], t_int: np.ndarray) -> tuple[BlockResult, ...]:
+    blk_of_int = path.block[grid.segment]
+    lab_arr = np.asarray(labels, dtype=object)
+    rows = []
+    for b in path.blocks:
+        i = int(np.clip(np.searchsorted(prof.s, b.s_end, side="left"), 0, prof.s.size - 1))
+        v_exit = float(prof.v[i])
+        if b.n_segments > 0:
+            sel = blk_of_int == b.block
+            if np.any(sel):
+                uniq, inv = np.unique(lab_arr[sel].astype(str), return_inverse=True)
+                w = np.bincount(inv, weights=t_int[sel])
+                limit = str(uniq[int(np.argmax(w))])
+            else:
+                limit = "none"
+        else:
+            limit = b.stop_reason
+        t_b = float(blk_t[b.block]) if b.block < blk_t.size else 0.0
+        rows.append(BlockResult(b.block, b.line, b.label, b.kind, float(b.length), t_b,
+                                v_exit, limit))
+    return tuple(rows)

@@ -1,0 +1,63 @@
+"""Named numerical tolerances and defaults of the oracle, one per quantity (G7).
+
+Each value says what it means, its unit and why it has that size. Backend-specific
+solver tolerances live in :mod:`optimal.backends.tolerances`.
+"""
+
+from __future__ import annotations
+
+#: Default requested relative gap ``(upper - lower) / lower`` at which refinement stops
+#: (0.2 %, the issue's default).
+DEFAULT_GAP_TOL = 2e-3
+
+#: Default largest number of grid intervals before refinement gives up with status
+#: ``"gap_not_met"`` (both bounds are still valid then).
+DEFAULT_MAX_GRID = 200_000
+
+#: Default largest number of refinement rounds (each at most doubles the grid).
+DEFAULT_MAX_ITERATIONS = 40
+
+#: Default number of intervals of the initial grid spread over the path by length (each
+#: segment gets at least :data:`MIN_SEGMENT_INTERVALS`, arcs more, see below).
+DEFAULT_INITIAL_INTERVALS = 1000
+
+#: Fewest intervals per segment. Two, so that a segment between two stops has a node in
+#: its interior where the speed can be positive (one interval with v = 0 at both ends
+#: would take infinite time).
+MIN_SEGMENT_INTERVALS = 2
+
+#: Fewest intervals per arc or helix (formulation note, pitfall 1: 8-16 per arc).
+MIN_ARC_INTERVALS = 8
+
+#: Largest angle swept by one interval of the initial grid on an arc, rad (5.625 deg:
+#: 16 intervals per quarter turn).
+MAX_ARC_STEP_RAD = 0.098174770424681
+
+#: Relative margin taken off the lower bound to absorb float64 round-off in the
+#: recurrences and closed-form integrals (their relative error is below 1e-12).
+LB_ROUNDOFF_REL = 1e-9
+
+#: A constraint counts as active (tight) at a node or interval when its slack is below
+#: this fraction of the constraint's scale.
+ACTIVE_TOL_REL = 1e-7
+
+#: Relative precision of the fixed point of the vectorised recurrence (policy
+#: iteration stops when no node changes by more than this, relative to the largest
+#: finite cap). Well below the 1e-5 agreement demanded between exact methods.
+RECURRENCE_RTOL = 1e-12
+
+#: Policy-iteration rounds of the vectorised recurrence before falling back to the
+#: sequential (pure Python) sweep, which is exact by construction.
+RECURRENCE_MAX_ROUNDS = 60
+
+#: Chunk length of the blocked prefix scan of clipped affine maps: bounds the size of
+#: products of slopes (no overflow) while keeping the Python loop over chunks short.
+SCAN_CHUNK = 256
+
+#: Rounds of the lower-bound relaxation on one grid: each bounds ``b`` inside the
+#: intervals by the previous round's node values (Gronwall envelope), shrinking the
+#: Lipschitz margins where the a-priori bounds are loose (e.g. one axis much stiffer).
+LB_ROUNDS = 4
+
+#: Stop the lower-bound rounds when the bound improves by less than this (relative).
+LB_ROUND_IMPROVEMENT = 1e-4
