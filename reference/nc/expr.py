@@ -3,11 +3,19 @@
 Expressions are parsed once into a tiny AST of tuples and evaluated many times (loops
 re-run their lines). Trigonometric functions work in degrees, as on both controls.
 
-Grammar (precedence low to high): ``OR``, ``XOR``, ``AND``, comparisons
-(``== <> < > <= >=``, NGC ``EQ NE LT GT LE GE``), ``+ -``, ``* / DIV MOD``, ``**`` /
-``^`` (NGC), unary ``- + NOT``. Atoms: numbers, variables (``R1``, ``R[2]``, ``#5``,
-``#<name>``, declared names), parenthesised (SINUMERIK) or bracketed (NGC) expressions,
-function calls (``SIN(30)``, ``SIN[30]``, ``ATAN[y]/[x]``).
+Operator priorities follow each control's manual (equal priority: left to right):
+
+* SINUMERIK (programming manual, "Priority of the operations"), high to low: unary
+  ``NOT B_NOT - +``; ``* / DIV MOD``; ``+ -``; ``B_AND``; ``B_XOR``; ``B_OR``; ``AND``;
+  ``XOR``; ``OR``; comparisons ``== <> < > <= >=``. Comparisons bind *weakest*, so
+  ``R1==1 AND R2==2`` groups as ``R1 == (1 AND R2) == 2``, as on the control: write
+  ``(R1==1) AND (R2==2)``.
+* RS274/NGC (LinuxCNC), high to low: ``**``; ``* / MOD``; ``+ -``; comparisons
+  ``EQ NE LT GT LE GE`` (also ``== <> < > <= >=``); ``AND OR XOR`` (one level).
+
+Atoms: numbers, variables (``R1``, ``R[2]``, ``#5``, ``#<name>``, declared names),
+parenthesised (SINUMERIK) or bracketed (NGC) expressions, function calls (``SIN(30)``,
+``SIN[30]``, ``ATAN[y]/[x]``).
 """
 
 from __future__ import annotations
@@ -18,6 +26,7 @@ from typing import Callable, Mapping
 
 NUMBER = re.compile(r"\d+\.?\d*|\.\d+")
 NAME = re.compile(r"[A-Z_$][A-Z0-9_$]*")
+_DIGITS = re.compile(r"\d+")
 
 _D = math.pi / 180.0
 FUNCS1: dict[str, Callable[[float], float]] = {
@@ -26,7 +35,8 @@ FUNCS1: dict[str, Callable[[float], float]] = {
     "ASIN": lambda x: math.asin(x) / _D, "ACOS": lambda x: math.acos(x) / _D,
     "ATAN": lambda x: math.atan(x) / _D,
     "SQRT": math.sqrt, "ABS": abs, "EXP": math.exp, "LN": math.log,
-    "TRUNC": lambda x: float(math.trunc(x)), "ROUND": lambda x: float(math.floor(x + 0.5)),
+    "TRUNC": lambda x: float(math.trunc(x)),
+    "ROUND": lambda x: float(math.copysign(math.floor(abs(x) + 0.5), x)),  # halves away from 0
     "FIX": lambda x: float(math.floor(x)), "FUP": lambda x: float(math.ceil(x)),
     "POT": lambda x: x * x, "EXISTS": lambda x: 1.0,
 }
@@ -34,22 +44,38 @@ FUNCS2: dict[str, Callable[[float, float], float]] = {
     "ATAN2": lambda y, x: math.atan2(y, x) / _D,
     "MINVAL": min, "MAXVAL": max,
 }
-_BINOPS = {
-    "OR": (1, lambda a, b: float(bool(a) or bool(b))),
-    "XOR": (2, lambda a, b: float(bool(a) != bool(b))),
-    "AND": (3, lambda a, b: float(bool(a) and bool(b))),
-    "==": (4, lambda a, b: float(a == b)), "EQ": (4, lambda a, b: float(a == b)),
-    "<>": (4, lambda a, b: float(a != b)), "NE": (4, lambda a, b: float(a != b)),
-    "<": (4, lambda a, b: float(a < b)), "LT": (4, lambda a, b: float(a < b)),
-    ">": (4, lambda a, b: float(a > b)), "GT": (4, lambda a, b: float(a > b)),
-    "<=": (4, lambda a, b: float(a <= b)), "LE": (4, lambda a, b: float(a <= b)),
-    ">=": (4, lambda a, b: float(a >= b)), "GE": (4, lambda a, b: float(a >= b)),
-    "+": (5, lambda a, b: a + b), "-": (5, lambda a, b: a - b),
-    "*": (6, lambda a, b: a * b), "/": (6, None), "DIV": (6, None), "MOD": (6, None),
-    "**": (7, lambda a, b: a ** b), "^": (7, lambda a, b: a ** b),
+def _div(a: float, b: float) -> float:      # zero divisors are caught before
+    return a / b
+
+
+_FN: dict[str, Callable[[float, float], float]] = {
+    "OR": lambda a, b: float(bool(a) or bool(b)),
+    "XOR": lambda a, b: float(bool(a) != bool(b)),
+    "AND": lambda a, b: float(bool(a) and bool(b)),
+    "B_OR": lambda a, b: float(int(a) | int(b)),
+    "B_XOR": lambda a, b: float(int(a) ^ int(b)),
+    "B_AND": lambda a, b: float(int(a) & int(b)),
+    "==": lambda a, b: float(a == b), "EQ": lambda a, b: float(a == b),
+    "<>": lambda a, b: float(a != b), "NE": lambda a, b: float(a != b),
+    "<": lambda a, b: float(a < b), "LT": lambda a, b: float(a < b),
+    ">": lambda a, b: float(a > b), "GT": lambda a, b: float(a > b),
+    "<=": lambda a, b: float(a <= b), "LE": lambda a, b: float(a <= b),
+    ">=": lambda a, b: float(a >= b), "GE": lambda a, b: float(a >= b),
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": _div, "**": lambda a, b: a ** b, "^": lambda a, b: a ** b,
 }
+#: Binding strength per dialect (higher binds tighter); see the module docstring.
+_PREC_SIN = {"==": 1, "<>": 1, "<": 1, ">": 1, "<=": 1, ">=": 1,
+             "EQ": 1, "NE": 1, "LT": 1, "GT": 1, "LE": 1, "GE": 1,
+             "OR": 2, "XOR": 3, "AND": 4, "B_OR": 5, "B_XOR": 6, "B_AND": 7,
+             "+": 8, "-": 8, "*": 9, "/": 9, "DIV": 9, "MOD": 9, "**": 10, "^": 10}
+_PREC_NGC = {"AND": 1, "OR": 1, "XOR": 1,
+             "==": 2, "<>": 2, "<": 2, ">": 2, "<=": 2, ">=": 2,
+             "EQ": 2, "NE": 2, "LT": 2, "GT": 2, "LE": 2, "GE": 2,
+             "+": 3, "-": 3, "*": 4, "/": 4, "MOD": 4, "**": 5, "^": 5}
 _SYMOPS = ("**", "==", "<>", "<=", ">=", "<", ">", "+", "-", "*", "/", "^")
-_WORDOPS = ("OR", "XOR", "AND", "DIV", "MOD", "EQ", "NE", "LT", "GT", "LE", "GE")
+_WORDOPS = ("B_AND", "B_XOR", "B_OR", "OR", "XOR", "AND", "DIV", "MOD", "EQ", "NE", "LT",
+            "GT", "LE", "GE")
 
 
 class ExprError(Exception):
@@ -91,17 +117,18 @@ class Cursor:
 def parse_expr(cur: Cursor, min_prec: int = 0):
     """Parse an expression at the cursor (precedence climbing). Returns an AST."""
     left = _atom(cur)
+    table = _PREC_NGC if cur.ngc else _PREC_SIN
     while True:
         cur.ws()
         op = _peek_op(cur)
-        if op is None:
+        if op is None or op not in table:
             return left
-        prec, _ = _BINOPS[op]
-        if prec < min_prec or prec <= 0:
+        prec = table[op]
+        if prec < min_prec:
             return left
         op_pos = cur.pos
         cur.pos += len(op)
-        right = parse_expr(cur, prec + (0 if op in ("**", "^") else 1))
+        right = parse_expr(cur, prec + 1)         # all operators group left to right
         left = ("bin", op, left, right, op_pos)
 
 
@@ -129,9 +156,12 @@ def _atom(cur: Cursor):
         cur.pos += 1
         inner = _atom(cur)
         return ("neg", inner) if ch == "-" else inner
-    if cur.text.startswith("NOT", cur.pos) and not cur.ngc:
-        cur.pos += 3
-        return ("not", _atom(cur))
+    for word, kind in (("NOT", "not"), ("B_NOT", "bnot")):
+        if not cur.ngc and cur.text.startswith(word, cur.pos):
+            end = cur.pos + len(word)
+            if end >= len(cur.text) or not (cur.text[end].isalnum() or cur.text[end] == "_"):
+                cur.pos = end
+                return (kind, _atom(cur))
     if ch == "(" and not cur.ngc or ch == "[" :
         close = ")" if ch == "(" else "]"
         cur.pos += 1
@@ -200,7 +230,7 @@ def _ngc_param(cur: Cursor):
         return ("var", name, start)
     if ch == "[" or ch == "#":
         return ("pidx", _atom(cur), start)
-    m = cur.match(re.compile(r"\d+"))
+    m = cur.match(_DIGITS)
     if not m:
         raise ExprError("parameter number expected after '#'", start)
     return ("var", f"#{int(m.group())}", start)
@@ -233,6 +263,8 @@ def evaluate(node, env: Mapping[str, float]) -> float:
         return -evaluate(node[1], env)
     if kind == "not":
         return float(not evaluate(node[1], env))
+    if kind == "bnot":
+        return float(~int(evaluate(node[1], env)))
     if kind == "call":
         args = [evaluate(a, env) for a in node[2]]
         try:
@@ -254,7 +286,10 @@ def evaluate(node, env: Mapping[str, float]) -> float:
             if op == "DIV":
                 return float(math.trunc(a / b))
             return math.fmod(a, b)
-        return float(_BINOPS[op][1](a, b))
+        try:
+            return float(_FN[op](a, b))
+        except (OverflowError, ValueError, ZeroDivisionError) as exc:
+            raise ExprError(f"{a:g} {op} {b:g} is undefined ({exc})", node[4]) from None
     raise ExprError(f"bad expression node {kind}", 0)  # pragma: no cover
 
 

@@ -8,9 +8,9 @@ re-reads text. Columns are 1-based and refer to the line as written.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from .expr import NAME, NUMBER, Cursor, ExprError, parse_expr
+from .expr import NAME, Cursor, ExprError, parse_expr
 
 #: Single-letter addresses that take a number (both dialects).
 ADDRESSES = frozenset("ABCDEFGHIJKLMNPQRSTUVWXYZ")
@@ -26,12 +26,16 @@ FLAGS = frozenset({"BRISK", "SOFT", "DRIVE", "SUPA", "CFC", "CFTCP", "CFIN",
                    "CDOF", "CDOF2", "DYNNORM", "DYNPOS", "DYNROUGH", "DYNSEMIFIN",
                    "DYNFINISH", "RET", "STOPRE", "BRISKA", "SOFTA", "DRIVEA"})
 CONTROL = frozenset({"IF", "ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "REPEAT",
-                     "UNTIL", "LOOP", "ENDLOOP", "GOTOF", "GOTOB", "GOTOC", "GOTO", "CASE",
-                     "DEF", "PROC", "DEFINE", "EXTERN"})
+                     "UNTIL", "LOOP", "ENDLOOP", "GOTOF", "GOTOB", "GOTOC", "GOTO", "GOTOS",
+                     "CASE", "DEF", "PROC", "DEFINE", "EXTERN"})
 _NUM_SIGNED = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)")
 _LABEL = re.compile(r"([A-Z_][A-Z0-9_]*):(?!=)")
 _BLOCKNO = re.compile(r"N(\d+)|:(\d+)")
 _INT = re.compile(r"\d+")
+_GOTO_TARGET = re.compile(r"[A-Z_][A-Z0-9_]*|:\d+")
+_MODE_CALL = re.compile(r"(AC|IC|ACP|ACN|DC)\s*\(")
+_NON_BLANK = re.compile(r"[^ \t]+")
+_NON_LETTERS = re.compile(r"[^A-Z]*")
 
 
 @dataclass(slots=True)
@@ -44,30 +48,62 @@ class Word:
     mode: str = ""          # "" | "AC" | "IC"
 
 
-@dataclass(slots=True)
 class Stmt:
     """One parsed line.
 
     ``kind`` is ``"block"`` for ordinary lines and the control keyword otherwise
     (``"IF"``, ``"ENDWHILE"``, ``"O:IF"`` for NGC O-words, ...).
+
+    Plain word lines (the bulk of CAM output) take a fast lane: they carry ``fast``, a
+    list of ``(letter, number text)`` pairs, and build their :class:`Word` list (with columns)
+    only when the interpreter needs it. The class attributes below are the (immutable)
+    defaults of such lines; :meth:`__init__` gives full-grammar lines fresh lists.
     """
 
-    line: int
-    text: str
-    kind: str = "block"
-    label: str = ""
-    words: list = field(default_factory=list)       # Word
-    assigns: list = field(default_factory=list)     # (target, AST, col)
-    calls: list = field(default_factory=list)       # (NAME, raw args, col)
-    flags: list = field(default_factory=list)       # (NAME, col)
+    kind = "block"
+    label = ""
+    assigns: list = ()          # (target, AST, col)
+    calls: list = ()            # (NAME, raw args, col)
+    flags: list = ()            # (NAME, col)
     cond: tuple | None = None
-    target: str = ""                                 # GOTO label / O-word name
-    case: list = field(default_factory=list)        # [(value AST or None, label)]
-    decl: list = field(default_factory=list)        # DEF names
-    comment: str = ""
+    target = ""                 # GOTO label / O-word name
+    case: list = ()             # [(value AST or None, label)]
+    decl: list = ()             # DEF names
+    comment = ""
     message: str | None = None
-    empty: bool = False
-    colmap: list | None = None                      # NGC: code offset -> line column
+    empty = False
+    colmap: list | None = None  # NGC: code offset -> line column
+    fast: list | None = None    # fast lane: [(letter, number text), ...]
+    dialect = "sinumerik"
+
+    def __init__(self, line: int, text: str, kind: str = "block", label: str = "",
+                 comment: str = "", message: str | None = None) -> None:
+        self.line = line
+        self.text = text
+        self.kind = kind
+        self.label = label
+        self.comment = comment
+        self.message = message
+        self._words = []
+        self.assigns = []
+        self.calls = []
+        self.flags = []
+        self.case = []
+        self.decl = []
+
+    @property
+    def words(self) -> list:
+        """Address words (:class:`Word`) with their columns."""
+        if self._words is None:                 # a fast-lane line: add the columns now
+            self._words = _fast_words(self)
+        return self._words
+
+    @words.setter
+    def words(self, value: list) -> None:
+        self._words = value
+
+
+_NEW = object.__new__
 
 
 class LineError(Exception):
@@ -108,39 +144,98 @@ def _call_args(cur: Cursor) -> str:
     raise LineError("missing ')'", start)
 
 
-# A line of plain ``letter number`` words (the bulk of CAM output): parsed by one regex.
-_SIMPLE_LINE = re.compile(r"[ \t]*(N\d+[ \t]+)?((?:[A-MP-Z][-+]?(?:\d+\.?\d*|\.\d+)[ \t]*)+)"
-                          r"(?:;(.*))?$")
+# A line of plain ``letter number`` words (the bulk of CAM output): one regex, no
+# per-word objects. SINUMERIK keeps blanks between words; NGC text is matched with all
+# blanks removed (LinuxCNC ignores them, also inside numbers).
+_SIMPLE_SIN = re.compile(r"[ \t]*(?:(N\d+)[ \t]+)?(?:([A-Z_][A-Z0-9_]*):(?!=)[ \t]*)?"
+                         r"((?:[A-MP-Z][-+]?(?:\d+\.?\d*|\.\d+)[ \t]*)+)(?:;(.*))?$")
+_SIMPLE_NGC = re.compile(r"(?:(N\d+))?((?:[A-MP-Z][-+]?(?:\d+\.?\d*|\.\d+))+)$")
 _SIMPLE_WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
+_NOT_SIMPLE_NGC = re.compile(r"[(;#\[/%<=]")
 
 
-def _simple(lineno: int, raw: str) -> Stmt | None:
-    """Fast path for plain word lines; None when the line needs the full grammar."""
+def _fast_stmt(lineno: int, raw: str, label: str | None, comment: str | None,
+               pairs: list, dialect: str) -> Stmt:
+    """A fast-lane :class:`Stmt` (class-level defaults for everything else)."""
+    st = _NEW(Stmt)
+    st.line = lineno
+    st.text = raw
+    st._words = None
+    st.fast = pairs
+    if label:
+        st.label = label
+    if comment:
+        st.comment = comment.strip()
+    if dialect == "ngc":
+        st.dialect = "ngc"
+    return st
+
+
+def _fast_words(st: Stmt) -> list:
+    """:class:`Word` objects (with 1-based columns) of a fast-lane line."""
+    raw = st.text
+    if st.dialect == "ngc":
+        cols = [i for i, ch in enumerate(raw) if ch not in " \t"]
+        up = raw.replace(" ", "").replace("\t", "").upper()
+        m = _SIMPLE_NGC.match(up)
+        span = m.span(2)
+    else:
+        cols = None
+        up = raw.upper()
+        span = _SIMPLE_SIN.match(up).span(3)
+    return [Word(w.group(1), ("num", float(w.group(2))),
+                 (cols[w.start()] if cols is not None else w.start()) + 1)
+            for w in _SIMPLE_WORD.finditer(up, *span)]
+
+
+def _simple_sin(lineno: int, raw: str) -> Stmt | None:
+    """Fast lane for plain SINUMERIK word lines; None when the line needs the grammar."""
     up = raw.upper()
-    m = _SIMPLE_LINE.match(up)
+    m = _SIMPLE_SIN.match(up)
     if m is None:
         return None
-    st = Stmt(line=lineno, text=raw, comment=(m.group(3) or "").strip())
-    if m.group(1):
-        st.label = m.group(1).strip()
-    st.words = [Word(w.group(1), ("num", float(w.group(2))), w.start() + 1)
-                for w in _SIMPLE_WORD.finditer(up, m.start(2), m.end(2))]
-    return st
+    comment = None
+    if m.group(4) is not None:
+        if len(up) != len(raw):          # upper-casing changed the length (rare letters)
+            return None
+        comment = raw[m.start(4):]
+    return _fast_stmt(lineno, raw, m.group(2) or m.group(1), comment,
+                      _SIMPLE_WORD.findall(up, m.start(3), m.end(3)), "sinumerik")
+
+
+def _simple_ngc(lineno: int, raw: str) -> Stmt | None:
+    """Fast lane for plain NGC word lines (no comments, parameters or expressions)."""
+    if _NOT_SIMPLE_NGC.search(raw) is not None:
+        return None
+    up = raw.replace(" ", "").replace("\t", "").upper()
+    m = _SIMPLE_NGC.match(up)
+    if m is None:
+        return None
+    return _fast_stmt(lineno, raw, m.group(1), None,
+                      _SIMPLE_WORD.findall(up, m.start(2), m.end(2)), "ngc")
 
 
 def parse_sinumerik(lineno: int, raw: str) -> Stmt:
     """Parse one SINUMERIK line."""
-    st = _simple(lineno, raw)
+    st = _simple_sin(lineno, raw)
     if st is not None:
         return st
+    return parse_sinumerik_full(lineno, raw)
+
+
+_SKIP_LEVEL = re.compile(r"/[0-9]?")
+
+
+def parse_sinumerik_full(lineno: int, raw: str) -> Stmt:
+    """Parse one SINUMERIK line with the full grammar."""
     code, comment = _split_comment_sin(raw)
     st = Stmt(line=lineno, text=raw, comment=comment)
     up = code.upper()
     cur = Cursor(up)
     cur.ws()
-    if cur.peek() == "/":            # block delete: the skip switch is off
-        cur.pos += 1
-    if not cur.peek():
+    if cur.peek() == "/":            # block delete (skip levels /0../9): the switch is off
+        cur.match(_SKIP_LEVEL)
+    if not cur.peek() or cur.peek() == "%":   # blank, or a %_N_NAME_MPF file header
         st.empty = True
         return st
     m = cur.match(_BLOCKNO)
@@ -229,7 +324,7 @@ def _control_sin(st: Stmt, cur: Cursor, m: re.Match, code: str) -> None:
             if cur.peek() == ",":
                 cur.pos += 1
     elif cur.peek():
-        if kw in ("ELSE", "ENDIF", "ENDWHILE", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT"):
+        if kw in ("ELSE", "ENDIF", "ENDWHILE", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT", "GOTOS"):
             raise LineError(f"unexpected text after {kw}", cur.pos)
 
 
@@ -243,7 +338,7 @@ def _call_args_bracket(cur: Cursor) -> str:
 
 
 def _goto_target(cur: Cursor, kw: str) -> str:
-    m = cur.match(re.compile(r"[A-Z_][A-Z0-9_]*|:\d+"))
+    m = cur.match(_GOTO_TARGET)
     if not m:
         raise LineError(f"{kw} needs a label", cur.pos)
     return m.group()
@@ -263,7 +358,6 @@ def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
             raise LineError(f"unexpected '{ch}'", start)
         name = m.group()
         cur.pos = m.end()
-        nxt = t[cur.pos] if cur.pos < len(t) else ""
         after = cur.peek()
         if name.startswith("$"):
             # system variables need a real control: keep the statement, evaluate nothing
@@ -272,7 +366,7 @@ def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
             return
         if after == "(" and not (name in ("AC", "IC")):
             cur.pos = t.index("(", cur.pos)
-            args = _call_args(cur)
+            _call_args(cur)                      # moves past the matching ')'
             raw_args = code[start + (t.index("(", start) - start) + 1:cur.pos - 1]
             st.calls.append((name, raw_args, start))
             continue
@@ -282,12 +376,13 @@ def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
             if cur.peek() != "=":
                 raise LineError(f"'=' expected after {name}[{idx}]", cur.pos)
             cur.pos += 1
-            st.assigns.append((f"{name}[{idx.strip()}]", _expr(cur), start))
+            # in source order with the other words: R1=10 R[2]=R1/4 uses the new R1
+            st.words.append(Word(f"{name}[{idx.strip()}]", _expr(cur), start + 1))
             continue
         if after == "=" and not t.startswith("==", cur.pos):
             cur.pos = t.index("=", cur.pos) + 1
             mode = ""
-            mm = re.compile(r"(AC|IC|ACP|ACN|DC)\s*\(").match(t, (cur.ws(), cur.pos)[1])
+            mm = _MODE_CALL.match(t, (cur.ws(), cur.pos)[1])
             if mm:
                 mode = mm.group(1)
                 cur.pos = mm.end() - 1
@@ -326,7 +421,7 @@ def _address_word(st: Stmt, cur: Cursor) -> None:
         nm = NAME.match(t, end)
         if not (t[end].isalpha() and _NEXT_WORD.match(t, end)) and not (
                 nm and nm.group() in FLAGS):
-            bad = re.compile(r"[^ \t]+").match(t, m.start(2)).group()
+            bad = _NON_BLANK.match(t, m.start(2)).group()
             raise LineError(f"invalid number '{bad}' after address {m.group(1)}", m.start(2))
     st.words.append(Word(m.group(1), ("num", float(m.group(2))), m.start() + 1))
     cur.pos = end
@@ -366,13 +461,21 @@ _NGC_WORD = re.compile(r"([A-Z])")
 
 def parse_ngc(lineno: int, raw: str) -> Stmt:
     """Parse one RS274/NGC (LinuxCNC) line."""
-    st = _simple(lineno, raw)
+    st = _simple_ngc(lineno, raw)
     if st is not None:
         return st
+    return parse_ngc_full(lineno, raw)
+
+
+def parse_ngc_full(lineno: int, raw: str) -> Stmt:
+    """Parse one RS274/NGC line with the full grammar."""
     code, cols, comment, msg = _strip_ngc(raw)
     st = Stmt(line=lineno, text=raw, comment=comment, message=msg)
+    st.dialect = "ngc"
     if code.startswith("/"):
         code, cols = code[1:], cols[1:]
+        if code[:1].isdigit():           # skip level /1../9
+            code, cols = code[1:], cols[1:]
     if not code or code == "%":
         st.empty = msg is None
         return st
@@ -430,7 +533,7 @@ def _parse_ngc_code(st: Stmt, cur: Cursor) -> None:
             raise LineError(f"unexpected '{ch}'", start)
         cur.pos += 1
         nxt = t[cur.pos] if cur.pos < len(t) else ""
-        if nxt in "[#":
+        if nxt and nxt in "[#":
             val = parse_expr(cur)
         elif nxt in "+-" and cur.pos + 1 < len(t) and t[cur.pos + 1] in "[#":
             cur.pos += 1
@@ -439,7 +542,7 @@ def _parse_ngc_code(st: Stmt, cur: Cursor) -> None:
         else:
             m = _NUM_SIGNED.match(t, cur.pos)
             if not m:
-                bad = re.compile(r"[^A-Z]*").match(t, cur.pos).group() or nxt or "end of line"
+                bad = _NON_LETTERS.match(t, cur.pos).group() or nxt or "end of line"
                 raise LineError(f"number expected after address {ch}, found '{bad}'", cur.pos)
             cur.pos = m.end()
             # a letter glued to a number is the next word; anything else is a typo (Y1O)
