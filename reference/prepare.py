@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .core.errors import MachineDataError, PathError
-from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segment, line_segments
+from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segments, line_segments
 from .core.limits import MachineLimits
 from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM,
                               TANGENT_TOL_RAD)
@@ -110,28 +110,37 @@ def prepare(program: Program) -> Path:
     rows = np.flatnonzero(moving)
     lines = line_segments(starts[rows], ends[rows], geometry, rows)
     packed = {k: v.copy() for k, v in lines.items()}
-    keep = np.ones(rows.size, dtype=bool)
-    for r_i in np.flatnonzero(is_arc[rows]):
-        b = blocks[rows[r_i]]
-        u, v = (index[a] for a in _PLANES[b.plane])
-        plane = (u, v)
-        if b.plane_basis is not None:       # a rotated frame tilts the plane
-            e = np.zeros((2, n))
-            e[:, :3] = np.asarray(b.plane_basis)
-            plane = (e[0], e[1])
-        center = np.asarray(b.center, dtype=np.float64)
-        r0 = float(np.hypot(starts[rows[r_i], u] - center[u], starts[rows[r_i], v] - center[v]))
-        tol = max(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * r0)
+    arc_i = np.flatnonzero(is_arc[rows])           # positions among the moving rows
+    if arc_i.size:
+        arc_rows = rows[arc_i]
+        e1 = np.zeros((arc_i.size, n))
+        e2 = np.zeros((arc_i.size, n))
+        centers = np.empty((arc_i.size, n))
+        cw = np.empty(arc_i.size, dtype=bool)
+        turns = np.empty(arc_i.size, dtype=np.int64)
+        for j, r in enumerate(arc_rows):
+            b = blocks[r]
+            if b.plane_basis is not None:       # a rotated frame tilts the plane
+                e1[j, :3], e2[j, :3] = b.plane_basis
+            else:
+                u, v = _PLANES[b.plane]
+                e1[j, index[u]] = 1.0
+                e2[j, index[v]] = 1.0
+            centers[j] = b.center
+            cw[j] = b.motion == "G2"
+            turns[j] = b.turns
+        ps = starts[arc_rows] - centers
+        r0 = np.hypot(np.sum(ps * e1, axis=1), np.sum(ps * e2, axis=1))
+        tol = np.maximum(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * r0)
         try:
-            arc = arc_segment(starts[rows[r_i]], ends[rows[r_i]], center, plane,
-                              b.motion == "G2", b.turns, geometry, int(rows[r_i]), tol)
+            arcs = arc_segments(starts[arc_rows], ends[arc_rows], centers, e1, e2, cw, turns,
+                                geometry, arc_rows, tol)
         except PathError as exc:
+            b = blocks[exc.block]
             raise PathError(f"{program.file}:{b.line}: {exc}", b.index) from None
-        if arc["length"][0] <= POS_TOL_MM:
-            keep[r_i] = False
-            continue
         for k in packed:
-            packed[k][r_i] = arc[k][0]
+            packed[k][arc_i] = arcs[k]
+    keep = packed["length"] > POS_TOL_MM
     if not np.all(keep):
         rows = rows[keep]
         packed = {k: v[keep] for k, v in packed.items()}

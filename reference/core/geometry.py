@@ -181,20 +181,89 @@ def line_segments(starts: np.ndarray, ends: np.ndarray, geometry: np.ndarray,
                 kind=np.zeros(m, dtype=np.int8))
 
 
+def arc_segments(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray,
+                 e1: np.ndarray, e2: np.ndarray, clockwise: np.ndarray, turns: np.ndarray,
+                 geometry: np.ndarray, blocks: np.ndarray, radius_tol: np.ndarray
+                 ) -> dict[str, np.ndarray]:
+    """Packed parameters of many circular arcs or helices at once (vectorised).
+
+    Parameters
+    ----------
+    starts, ends, centers : numpy.ndarray, shape (m, n)
+        Start and end points and arc centres (absolute; only the in-plane part of the
+        centre is used), mm / degrees.
+    e1, e2 : numpy.ndarray, shape (m, n)
+        Orthonormal plane vectors; counter-clockwise turns from ``e1`` to ``e2``
+        (G17: X->Y, G18: Z->X, G19: Y->Z).
+    clockwise : numpy.ndarray of bool, shape (m,)
+        True for G2.
+    turns : numpy.ndarray of int, shape (m,)
+        Additional full turns (>= 0).
+    geometry : numpy.ndarray of bool, shape (n,)
+        True for the geometry axes.
+    blocks : numpy.ndarray of int, shape (m,)
+        Source NC block of each arc.
+    radius_tol : numpy.ndarray, shape (m,)
+        Largest accepted difference between start and end radius, mm.
+
+    Returns
+    -------
+    dict
+        Packed arrays for the ``m`` arcs.
+
+    Raises
+    ------
+    PathError
+        The first arc (in order) with zero radius or with start and end radius
+        differing by more than its ``radius_tol``; ``PathError.block`` names its block.
+    """
+    starts = np.asarray(starts, dtype=np.float64)
+    ends = np.asarray(ends, dtype=np.float64)
+    ps, pe = starts - centers, ends - centers
+    su, sv = np.sum(ps * e1, axis=1), np.sum(ps * e2, axis=1)
+    eu, ev = np.sum(pe * e1, axis=1), np.sum(pe * e2, axis=1)
+    r0, r1 = np.hypot(su, sv), np.hypot(eu, ev)
+    bad = (r0 <= POS_TOL_MM) | (np.abs(r1 - r0) > radius_tol)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        if r0[i] <= POS_TOL_MM:
+            raise PathError("arc with zero radius (centre on the start point)", int(blocks[i]))
+        raise PathError(
+            f"arc start radius {r0[i]:.6g} mm and end radius {r1[i]:.6g} mm differ by "
+            f"{abs(r1[i] - r0[i]):.3g} mm (> {radius_tol[i]:.3g} mm)", int(blocks[i]))
+    th0, th1 = np.arctan2(sv, su), np.arctan2(ev, eu)
+    # Direction decides the sweep; an arc ending where it started (in the plane) is a
+    # full turn, as both dialects define it.
+    closed = np.hypot(eu - su, ev - sv) <= POS_TOL_MM
+    two_pi = 2 * np.pi
+    sweep = np.where(clockwise, np.where(closed, -two_pi, -((th0 - th1) % two_pi)),
+                     np.where(closed, two_pi, (th1 - th0) % two_pi))
+    sweep = sweep + np.where(clockwise, -1.0, 1.0) * two_pi * turns
+    delta = ends - starts
+    lin = (delta - np.sum(delta * e1, axis=1)[:, None] * e1
+           - np.sum(delta * e2, axis=1)[:, None] * e2)
+    geo_lin = np.sqrt(np.sum(lin[:, geometry] ** 2, axis=1))
+    length = np.hypot(r0 * sweep, geo_lin)
+    origin = starts - r0[:, None] * (np.cos(th0)[:, None] * e1 + np.sin(th0)[:, None] * e2)
+    return dict(origin=origin, e1=np.array(e1, dtype=np.float64),
+                e2=np.array(e2, dtype=np.float64), d=lin / length[:, None], radius=r0,
+                omega=sweep / length, theta0=th0, length=length,
+                block=np.asarray(blocks, dtype=np.int64),
+                kind=np.full(r0.size, KIND_CODES.index("arc"), dtype=np.int8))
+
+
 def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
                 plane, clockwise: bool, turns: int,
                 geometry: np.ndarray, block: int, radius_tol: float) -> dict[str, np.ndarray]:
-    """Packed parameters of one circular arc or helix.
+    """Packed parameters of one circular arc or helix (see :func:`arc_segments`).
 
     Parameters
     ----------
     start, end, center : numpy.ndarray, shape (n,)
-        Start and end points and the arc centre (absolute; only the in-plane part of
-        ``center`` is used), mm / degrees.
+        Start and end points and the arc centre, mm / degrees.
     plane : tuple of two int, or tuple of two numpy.ndarray of shape (n,)
-        The plane as axis indices ``(u, v)`` (G17: X->Y, G18: Z->X, G19: Y->Z) or as
-        orthonormal vectors ``(e1, e2)``; counter-clockwise means from the first to the
-        second.
+        The plane as axis indices ``(u, v)`` or as orthonormal vectors ``(e1, e2)``;
+        counter-clockwise means from the first to the second.
     clockwise : bool
         True for G2.
     turns : int
@@ -217,8 +286,6 @@ def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
         Zero radius, or start and end radius differing by more than ``radius_tol``.
     """
     start = np.asarray(start, dtype=np.float64)
-    end = np.asarray(end, dtype=np.float64)
-    center = np.asarray(center, dtype=np.float64)
     n = start.size
     if isinstance(plane[0], (int, np.integer)):
         e1 = np.zeros(n)
@@ -228,37 +295,10 @@ def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
     else:
         e1 = np.asarray(plane[0], dtype=np.float64)
         e2 = np.asarray(plane[1], dtype=np.float64)
-    ps, pe = start - center, end - center
-    su, sv = float(ps @ e1), float(ps @ e2)
-    eu, ev = float(pe @ e1), float(pe @ e2)
-    r0 = float(np.hypot(su, sv))
-    r1 = float(np.hypot(eu, ev))
-    if r0 <= POS_TOL_MM:
-        raise PathError("arc with zero radius (centre on the start point)", block)
-    if abs(r1 - r0) > radius_tol:
-        raise PathError(
-            f"arc start radius {r0:.6g} mm and end radius {r1:.6g} mm differ by "
-            f"{abs(r1 - r0):.3g} mm (> {radius_tol:.3g} mm)", block)
-    th0 = float(np.arctan2(sv, su))
-    th1 = float(np.arctan2(ev, eu))
-    # Direction decides the sweep; an arc ending where it started (in the plane) is a
-    # full turn, as both dialects define it.
-    closed = float(np.hypot(eu - su, ev - sv)) <= POS_TOL_MM
-    if clockwise:
-        sweep = -2 * np.pi if closed else -((th0 - th1) % (2 * np.pi))
-    else:
-        sweep = 2 * np.pi if closed else (th1 - th0) % (2 * np.pi)
-    sweep += (-1 if clockwise else 1) * 2 * np.pi * turns
-    delta = end - start
-    lin = delta - (delta @ e1) * e1 - (delta @ e2) * e2
-    geo_lin = float(np.sqrt(np.sum(lin[geometry] ** 2)))
-    length = float(np.hypot(r0 * sweep, geo_lin))
-    origin = start - r0 * (np.cos(th0) * e1 + np.sin(th0) * e2)
-    return dict(origin=origin[None], e1=e1[None], e2=e2[None], d=(lin / length)[None],
-                radius=np.array([r0]), omega=np.array([sweep / length]),
-                theta0=np.array([th0]), length=np.array([length]),
-                block=np.array([block], dtype=np.int64),
-                kind=np.array([KIND_CODES.index("arc")], dtype=np.int8))
+    return arc_segments(start[None], np.asarray(end, dtype=np.float64)[None],
+                        np.asarray(center, dtype=np.float64)[None], e1[None], e2[None],
+                        np.array([clockwise]), np.array([turns]), geometry,
+                        np.array([block]), np.array([radius_tol]))
 
 
 @dataclass(frozen=True, slots=True)
