@@ -1,0 +1,602 @@
+"""The reference planner: composition of the stages and the :class:`ReferencePlan`.
+
+Stage order (spec/sinumerik-model.md 12.3; TRC, tangential control and rounding come
+in a later issue, G641..G645 behave as G64 and the stage trace says so):
+
+``prepare`` (program -> path) -> ``stops`` (acceleration modes, forced stops) ->
+``limit curves`` (segment caps, tangential limits) -> ``corners`` (junction limits) ->
+``lookahead`` (horizon caps, planning units, passes) -> ``profiles`` (unit profiles) ->
+``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation`` (ADAPT_PATH_DYNAMIC) ->
+``settle`` (exact-stop holds) -> assembly of the :class:`~reference.core.profile.Profile`
+-> ``check`` (the planner's own profile against its declared bound set).
+
+Each stage is a pure function of data to data; this module only composes them, records
+the stage trace and derives the per-block and per-corner rows.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from ..core.constraints import BOUND_SETS, ConstraintReport, check_profile
+from ..core.geometry import Path
+from ..core.limits import MachineLimits
+from ..core.profile import Profile
+from ..machine import Machine
+from ..nc.program import Program
+from ..prepare import prepare, restrict_to_machine
+from . import causes as C
+from .adaptation import adaptation_factors, adapted_units
+from .corners import junction_limits
+from .limit_curves import SegmentLimits, segment_limits
+from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planning_units
+from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
+from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, N_PHASES, UnitProfiles, case_name,
+                       unit_profiles)
+from .smoothing import smooth_velocity
+from .stops import ACCEL_MODES, SegmentModes, segment_modes, settle_times
+
+Progress = Callable[[str, float], None]
+
+_ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
+
+
+# ----------------------------------------------------------------- result types
+class BlockRow(NamedTuple):
+    """One NC block of the plan (an immutable named tuple: cheap for 10^5 blocks).
+
+    Attributes
+    ----------
+    block, line : int
+        Block index and 1-based source line.
+    label, kind : str
+        Block number/label and ``"G0"``/``"G1"``/``"G2"``/``"G3"``/``"none"``.
+    length_mm : float
+        Path length, mm.
+    v_entry, v_exit, v_peak : float
+        Speed at the block start and end and the largest speed inside, mm/s.
+    time_s : float
+        Time spent in the block (holds included), s.
+    cause : str
+        Limiting cause (:data:`reference.planner.causes.CAUSES`); ``""`` for blocks
+        that neither move nor wait.
+    mode : str
+        Acceleration mode (``"BRISK"``, ``"SOFT"``, ``"DRIVE"``; ``""`` without motion).
+    case : str
+        Profile case of the planning unit the block lies in (``RISE_ACC+CRUISE+...``).
+    """
+
+    block: int
+    line: int
+    label: str
+    kind: str
+    length_mm: float
+    v_entry: float
+    v_exit: float
+    v_peak: float
+    time_s: float
+    cause: str
+    mode: str
+    case: str
+
+
+class CornerRow(NamedTuple):
+    """One interior segment break (a block transition with motion on both sides); an
+    immutable named tuple.
+
+    Attributes
+    ----------
+    index : int
+        Break index ``k`` (between segments ``k-1`` and ``k``).
+    s : float
+        Path position, mm.
+    block_before, block_after : int
+        NC blocks on both sides.
+    v : float
+        Planned speed at the break, mm/s.
+    v_limit : float
+        The break's own limit (junction rules, horizon, neighbouring caps), mm/s.
+    v_g64 : float
+        The G64 corner speed alone (``inf`` when tangential), mm/s.
+    tangential : bool
+        True for tangential transitions.
+    cause : str
+        Limiting cause of ``v``.
+    """
+
+    index: int
+    s: float
+    block_before: int
+    block_after: int
+    v: float
+    v_limit: float
+    v_g64: float
+    tangential: bool
+    cause: str
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a
+
+
+class _Table(Sequence):
+    """Immutable columnar table of rows: read-only arrays per field, rows made on demand
+    (10^5 blocks cost arrays, not 10^5 objects, until someone iterates)."""
+
+    __slots__ = ("_cols", "_n")
+    _row: type = tuple
+    _fields: tuple[str, ...] = ()
+
+    def __init__(self, **cols) -> None:
+        for k, v in cols.items():
+            if isinstance(v, np.ndarray):
+                cols[k] = _ro(v)
+        object.__setattr__(self, "_cols", cols)
+        object.__setattr__(self, "_n", len(next(iter(cols.values()))) if cols else 0)
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{type(self).__name__} is immutable")
+
+    def __len__(self) -> int:
+        return self._n
+
+    def column(self, name: str):
+        """One column (read-only array or tuple of str), e.g. ``table.column("v_exit")``."""
+        if name in self._cols:
+            return self._cols[name]
+        return tuple(getattr(r, name) for r in self)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return tuple(self[j] for j in range(*i.indices(self._n)))
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError(i)
+        return self._make(i)
+
+    def __iter__(self):
+        for i in range(self._n):
+            yield self._make(i)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._n} rows)"
+
+
+class BlockTable(_Table):
+    """The per-block rows of a plan (a read-only sequence of :class:`BlockRow`)."""
+
+    __slots__ = ()
+
+    def _make(self, i: int) -> BlockRow:
+        c = self._cols
+        cause = int(c["cause_code"][i])
+        mode = int(c["mode_code"][i])
+        case = int(c["case_code"][i])
+        return BlockRow(block=int(c["block"][i]), line=int(c["line"][i]), label=c["label"][i],
+                        kind=c["kind"][i], length_mm=float(c["length_mm"][i]),
+                        v_entry=float(c["v_entry"][i]), v_exit=float(c["v_exit"][i]),
+                        v_peak=float(c["v_peak"][i]), time_s=float(c["time_s"][i]),
+                        cause=C.CAUSES[cause] if cause >= 0 else "",
+                        mode=ACCEL_MODES[mode].name if mode >= 0 else "",
+                        case=case_name(case) if case >= 0 else "")
+
+
+class CornerTable(_Table):
+    """The per-corner rows of a plan (a read-only sequence of :class:`CornerRow`)."""
+
+    __slots__ = ()
+
+    def _make(self, i: int) -> CornerRow:
+        c = self._cols
+        return CornerRow(index=int(c["index"][i]), s=float(c["s"][i]),
+                         block_before=int(c["block_before"][i]),
+                         block_after=int(c["block_after"][i]), v=float(c["v"][i]),
+                         v_limit=float(c["v_limit"][i]), v_g64=float(c["v_g64"][i]),
+                         tangential=bool(c["tangential"][i]),
+                         cause=C.CAUSES[int(c["cause_code"][i])])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReferencePlan:
+    """Result of :func:`plan`.
+
+    Attributes
+    ----------
+    program : str
+        Program file.
+    machine : str
+        Machine name.
+    path : Path
+        The path the profile runs on.
+    profile : Profile
+        The planned motion.
+    blocks : BlockTable
+        One :class:`BlockRow` per NC block (in ``path.blocks`` order); a read-only
+        sequence, columns via ``blocks.column(name)``.
+    corners : CornerTable
+        One :class:`CornerRow` per interior segment break.
+    trace : tuple[tuple[str, str], ...]
+        ``(stage, note)`` pairs in stage order.
+    bound_set : str
+        ``"jerk"`` if every segment is SOFT, else ``"acc"`` (key of ``BOUND_SETS``).
+    report : ConstraintReport or None
+        ``check_profile`` of the own profile (``None`` when planned with
+        ``check=False``).
+    limits : MachineLimits
+        The machine limits used.
+    parameters : PlannerParameters
+        The model parameters used.
+    """
+
+    program: str
+    machine: str
+    path: Path
+    profile: Profile
+    blocks: BlockTable
+    corners: CornerTable
+    trace: tuple[tuple[str, str], ...]
+    bound_set: str
+    report: ConstraintReport | None
+    limits: MachineLimits
+    parameters: PlannerParameters
+
+    @property
+    def time_s(self) -> float:
+        """Total planned time, s."""
+        return self.profile.duration
+
+    @property
+    def ok(self) -> bool:
+        """True when the own profile keeps the declared bound set (False if unchecked)."""
+        return self.report is not None and self.report.ok(BOUND_SETS[self.bound_set])
+
+
+# ----------------------------------------------------------------- composition
+def _noop(stage: str, fraction: float) -> None:
+    return None
+
+
+def _replan(units: Units, idx: np.ndarray, v_nodes: np.ndarray) -> UnitProfiles:
+    """Unit profiles of units ``idx`` between the node speeds ``v_nodes``."""
+    return unit_profiles(v_nodes[idx], v_nodes[idx + 1], units.length[idx], units.cap[idx],
+                         units.acc_up[idx], units.jerk_up[idx], units.acc_dn[idx],
+                         units.jerk_dn[idx])
+
+
+def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | None = None,
+         progress: Progress | None = None, check: bool = True) -> ReferencePlan:
+    """Plan a program with the SINUMERIK-style heuristic.
+
+    Parameters
+    ----------
+    program : Program
+        The parsed NC program.
+    machine : Machine
+        Machine data (limits, channel and axis settings).
+    parameters : PlannerParameters, optional
+        Model parameters where the manuals are silent (defaults documented there).
+    progress : callable, optional
+        ``progress(stage, fraction)`` is called as the stages run (fraction in [0, 1]).
+    check : bool
+        Judge the own profile with ``check_profile`` (default True).
+
+    Returns
+    -------
+    ReferencePlan
+
+    Raises
+    ------
+    FeedOracleError
+        Bad input (path geometry, axes without machine data).
+    """
+    params = DEFAULT_PARAMETERS if parameters is None else parameters
+    report_progress = progress or _noop
+    trace: list[tuple[str, str]] = []
+    t_start = time.perf_counter()
+    ch = machine.channel
+    limits = machine.limits
+
+    report_progress("prepare", 0.0)
+    path = restrict_to_machine(prepare(program), limits)
+    m = path.n_segments
+    trace.append(("prepare", f"{len(path.blocks)} blocks, {m} segments, "
+                             f"{path.total_length:.6g} mm"))
+    n_round = sum(1 for b in program.blocks if b.continuous_mode in _ROUNDING_MODES
+                  and b.motion is not None)
+    trace.append(("rounding", "not modelled yet: G641..G645 behave as G64 "
+                              f"({n_round} blocks in G641..G645; corners passed by the G64 "
+                              "rule or exact stop)"))
+
+    report_progress("stops", 0.1)
+    modes = segment_modes(program, path, machine)
+    notes = sorted({ACCEL_MODES[i].note for i in np.unique(modes.mode) if ACCEL_MODES[i].note})
+    counts = {ACCEL_MODES[i].name: int(np.sum(modes.mode == i)) for i in np.unique(modes.mode)}
+    trace.append(("stops", f"modes {counts or {ACCEL_MODES[modes.default_mode].name: 0}}; "
+                           f"{int(modes.mode_change.sum())} forced stops at BRISK/SOFT "
+                           f"changes; {int(np.sum(modes.stop[1:-1]))} interior stops"
+                  + ("; " + "; ".join(notes) if notes else "")))
+
+    report_progress("limit curves", 0.2)
+    seg = segment_limits(path, machine, modes, params)
+    trace.append(("limit curves", _cause_counts("segment caps", seg.cap_cause)))
+
+    report_progress("corners", 0.3)
+    lim = limits.for_axes(path.axes)
+    junc = junction_limits(path, lim, limits.t_ipo_s, modes, seg)
+    trace.append(("corners", _cause_counts("junction limits", junc.cause[1:-1])))
+
+    report_progress("lookahead", 0.4)
+    horizon = horizon_caps(path, seg, modes, ch.lookahead_blocks)
+    base_units = planning_units(path, seg, junc, modes, horizon, params.soft_merge_cap_ratio,
+                                params.soft_merge_accel_ratio)
+    units = base_units
+    speeds = lookahead_passes(units)
+    prof = _replan(units, np.arange(units.n_units), speeds.v)
+    n_h = int(np.sum(units.node_cause == C.HORIZON))
+    trace.append(("lookahead", f"horizon {ch.lookahead_blocks} blocks (v = 0 assumed at its "
+                               f"end; binding at {n_h} nodes); {units.n_units} planning units "
+                               f"for {m} segments"))
+    trace.append(("profiles", _case_counts(prof, units)))
+
+    report_progress("smoothing", 0.6)
+    if ch.lookahead_smooth_factor_pct > 0:
+        sm = smooth_velocity(units, speeds, prof, ch.lookahead_smooth_factor_pct,
+                             params.smoothing_rounds, _replan)
+        units, speeds, prof = sm.units, sm.speeds, sm.profiles
+        trace.append(("smoothing", f"LOOKAH_SMOOTH_FACTOR {ch.lookahead_smooth_factor_pct:g} "
+                                   f"%: {sm.n_bumps} bumps removed, moving time "
+                                   f"{sm.time_before:.6g} s -> {sm.time_after:.6g} s"))
+    else:
+        trace.append(("smoothing", "off (LOOKAH_SMOOTH_FACTOR = 0)"))
+
+    report_progress("adaptation", 0.7)
+    adapt = tuple(ch.adapt_path_dynamic)
+    if max(adapt) > 1.0 and units.n_units:
+        n_ad = 0
+        for _ in range(params.adaptation_rounds):
+            fac = adaptation_factors(units, prof, base_units, adapt)
+            if fac.n_adapted == 0:
+                break
+            new_units = adapted_units(base_units, units, fac)
+            if (np.array_equal(new_units.acc_up, units.acc_up)
+                    and np.array_equal(new_units.acc_dn, units.acc_dn)
+                    and np.array_equal(new_units.jerk_up, units.jerk_up)
+                    and np.array_equal(new_units.jerk_dn, units.jerk_dn)):
+                break
+            units = new_units
+            speeds = lookahead_passes(units)
+            prof = _replan(units, np.arange(units.n_units), speeds.v)
+            n_ad = int(np.sum(units.adapted_up) + np.sum(units.adapted_dn))
+        trace.append(("adaptation", f"ADAPT_PATH_DYNAMIC {list(adapt)}: {n_ad} velocity-change "
+                                    "processes stretched towards 1/LOOKAH_FREQUENCY"))
+    else:
+        trace.append(("adaptation", "off (ADAPT_PATH_DYNAMIC = 1)"))
+
+    report_progress("settle", 0.8)
+    v_brake = np.zeros(m + 1)
+    if units.n_units:
+        v_brake[units.node_break[1:]] = prof.v_peak
+    settle = settle_times(program, path, machine, modes, v_brake, params)
+    n_settle = int(np.sum(settle > 0))
+    trace.append(("settle", f"{int(np.sum(modes.exact_stop_block >= 0))} exact stops; "
+                            f"{n_settle} settle holds, {settle.sum():.6g} s "
+                            f"(e0 = {params.settle_lag_factor:g} * v/Kv)"))
+
+    report_progress("assemble", 0.85)
+    profile = _assemble(path, units, prof, settle, modes)
+    rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
+                          horizon)
+    bound_set = modes.bound_set
+    report = None
+    if check:
+        report_progress("check", 0.9)
+        report = check_profile(path, limits, profile)
+        viol = report.violations(BOUND_SETS[bound_set])
+        trace.append(("check", f"bound set {bound_set!r}: " + (
+            "no violations" if not viol else
+            "; ".join(f"{v.constraint} ratio {v.ratio:.6g}" for v in viol))))
+    trace.append(("time", f"planned {profile.duration:.6g} s in "
+                          f"{time.perf_counter() - t_start:.3g} s wall time"))
+    report_progress("done", 1.0)
+    return ReferencePlan(program=program.file, machine=machine.name, path=path,
+                         profile=profile, blocks=rows, corners=corners, trace=tuple(trace),
+                         bound_set=bound_set, report=report, limits=limits,
+                         parameters=params)
+
+
+def _cause_counts(what: str, codes: np.ndarray) -> str:
+    if codes.size == 0:
+        return f"{what}: none"
+    cnt = np.bincount(np.asarray(codes, dtype=np.int64), minlength=len(C.CAUSES))
+    parts = [f"{C.CAUSES[i]} {int(c)}" for i, c in enumerate(cnt) if c]
+    return f"{what} by cause: " + ", ".join(parts)
+
+
+def _case_counts(prof: UnitProfiles, units: Units) -> str:
+    if prof.case.size == 0:
+        return "no motion"
+    vals, cnt = np.unique(prof.case, return_counts=True)
+    kinds = "SOFT 7-phase S-curves" if units.jerk_limited.all() else (
+        "BRISK trapezoids" if not units.jerk_limited.any() else
+        "BRISK trapezoids and SOFT S-curves")
+    return f"{kinds}; cases " + ", ".join(f"{case_name(int(v))} {int(c)}"
+                                          for v, c in zip(vals, cnt))
+
+
+# ----------------------------------------------------------------- assembly
+def _exclusive_cumsum(x: np.ndarray) -> np.ndarray:
+    """Row-wise sums of the preceding columns (exactly 0 in the first column)."""
+    out = np.zeros_like(x)
+    np.cumsum(x[:, :-1], axis=1, out=out[:, 1:])
+    return out
+
+
+def _assemble(path: Path, units: Units, prof: UnitProfiles, settle: np.ndarray,
+              modes: SegmentModes) -> Profile:
+    """One Profile: unit phases in order, holds (settle, dwell) at their breaks."""
+    u = units.n_units
+    h = prof.duration
+    a0 = prof.a0
+    jj = prof.jerk
+    dv = a0 * h + jj * h * h / 2
+    v_start = prof.v_in[:, None] + _exclusive_cumsum(dv)
+    ds = v_start * h + a0 * h * h / 2 + jj * h ** 3 / 6
+    s_start = units.s_start[:, None] + _exclusive_cumsum(ds)
+    keep = h > 0
+    major = np.repeat(np.arange(u, dtype=np.float64), N_PHASES).reshape(u, N_PHASES)
+    minor = np.tile(np.arange(N_PHASES, dtype=np.float64), (u, 1))
+    cols = dict(h=h[keep], a=a0[keep], j=jj[keep], s=s_start[keep],
+                v=np.maximum(v_start[keep], 0.0), blk=np.full(int(keep.sum()), -1),
+                major=major[keep], minor=minor[keep])
+    # holds: settle of the exact-stop block, then the dwell blocks at the same break
+    node_of_break = np.full(path.n_segments + 1, -1)
+    node_of_break[units.node_break] = np.arange(u + 1)
+    hold = []
+    for k in np.flatnonzero(settle > 0):
+        hold.append((k, 0, float(settle[k]), int(modes.exact_stop_block[k])))
+    for order, span in enumerate(path.blocks):
+        if span.dwell_s > 0:
+            hold.append((span.first_segment, 1 + order, float(span.dwell_s), span.block))
+    if hold:
+        hk = np.array([x[0] for x in hold])
+        node = node_of_break[hk] if u else np.zeros(hk.size, dtype=np.int64)
+        cols = {k: np.concatenate((cols[k], extra)) for k, extra in (
+            ("h", np.array([x[2] for x in hold])), ("a", np.zeros(len(hold))),
+            ("j", np.zeros(len(hold))), ("s", path.s_breaks[hk]),
+            ("v", np.zeros(len(hold))), ("blk", np.array([x[3] for x in hold])),
+            ("major", node - 0.5), ("minor", np.array([float(x[1]) for x in hold])))}
+    order = np.lexsort((cols["minor"], cols["major"]))
+    hh = cols["h"][order]
+    t = np.concatenate(([0.0], np.cumsum(hh)))
+    s = np.concatenate((cols["s"][order], [path.total_length]))
+    v = np.concatenate((cols["v"][order], [0.0]))
+    return Profile(t=t, s=s, v=v, a=cols["a"][order], j=cols["j"][order],
+                   block=cols["blk"][order])
+
+
+# ----------------------------------------------------------------- rows
+def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits, junc,
+          units: Units, speeds: NodeSpeeds, prof: UnitProfiles, profile: Profile,
+          horizon: np.ndarray) -> tuple["BlockTable", "CornerTable"]:
+    """Per-block and per-corner rows with speeds and limiting causes."""
+    m = path.n_segments
+    tol = CAUSE_REL_TOL
+    u = units.n_units
+    if u:
+        unit_of_seg = np.repeat(np.arange(u), units.n_segments)
+        # speed at every break: nodes exact, interior breaks from the profile
+        v_break = np.zeros(m + 1)
+        inner = np.ones(m + 1, dtype=bool)
+        inner[units.node_break] = False
+        if inner.any():
+            tb = profile.time_at(path.s_breaks[inner])
+            v_break[inner] = np.maximum(profile.state(tb)[1], 0.0)
+        v_break[units.node_break] = speeds.v
+        p1 = units.s_start + prof.dist_rise
+        p2 = p1 + prof.dist_cruise
+        sa, sb = path.s_breaks[:-1], path.s_breaks[1:]
+        us = unit_of_seg
+        holds_peak = (sb >= p1[us]) & (sa <= p2[us])
+        v_peak_seg = np.where(holds_peak, prof.v_peak[us], np.maximum(v_break[:-1],
+                                                                       v_break[1:]))
+        at_cap = prof.v_peak >= units.cap * (1 - tol)
+        rising = sb <= p1[us] * (1 + 1e-12)
+        rise_cause = _accel_cause(units, prof, up=True)
+        exit_cause = _node_cause(units, speeds, prof)[1:]
+        # at the cap: the cap's cause; only rising (the ramp from behind limits it):
+        # acceleration, jerk or frequency; holding a peak below the cap or braking: what
+        # the unit brakes for (a corner, a stop, the horizon end, ...)
+        seg_cause = np.where(at_cap[us] & holds_peak, units.cap_cause[us],
+                             np.where(rising, rise_cause[us], exit_cause[us]))
+        # breaks: node causes; interior breaks like segment positions
+        node_c = _node_cause(units, speeds, prof)
+        brk_cause = np.empty(m + 1, dtype=np.int64)
+        us_b = np.clip(np.searchsorted(units.node_break, np.arange(m + 1), side="right") - 1,
+                       0, u - 1)
+        at_cap_b = v_break >= units.cap[us_b] * (1 - tol)
+        rising_b = path.s_breaks <= p1[us_b] * (1 + 1e-12)
+        brk_cause[:] = np.where(at_cap_b, units.cap_cause[us_b],
+                                np.where(rising_b, rise_cause[us_b], exit_cause[us_b]))
+        brk_cause[units.node_break] = node_c
+        case_seg = prof.case[us]
+    else:
+        v_break = np.zeros(m + 1)
+        v_peak_seg = np.zeros(m)
+        seg_cause = np.zeros(m, dtype=np.int64)
+        brk_cause = np.full(m + 1, C.FORCED_STOP)
+        case_seg = np.zeros(m, dtype=np.int64)
+
+    times = profile.block_times(path) if path.blocks else np.zeros(0)
+    spans = path.blocks
+    nb = len(spans)
+    first = np.array([sp.first_segment for sp in spans], dtype=np.int64)
+    nseg = np.array([sp.n_segments for sp in spans], dtype=np.int64)
+    ids = np.array([sp.block for sp in spans], dtype=np.int64)
+    moving = nseg > 0
+    # per block: the segment where it spends most time decides cause, mode and case
+    main = first.copy()
+    multi = np.flatnonzero(nseg > 1)
+    if multi.size:
+        seg_time = profile.segment_times(path)
+        for i in multi:
+            lo, hi = first[i], first[i] + nseg[i]
+            main[i] = lo + int(np.argmax(seg_time[lo:hi]))
+    mainc = np.clip(main, 0, max(m - 1, 0))
+    t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
+    kb = np.clip(first, 0, m)
+    v_entry = v_break[kb]
+    v_exit = v_break[np.clip(first + nseg, 0, m)]
+    v_pk = v_entry.copy()
+    if m:
+        v_pk[moving] = v_peak_seg[mainc[moving]]
+        for i in multi:
+            v_pk[i] = float(np.max(v_peak_seg[first[i]:first[i] + nseg[i]]))
+    stop_here = modes.stop[kb] & (t_blk > 0)
+    cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
+    cause_code = np.where(moving | stop_here, cause_code, -1)
+    mode_code = np.where(moving, modes.mode[mainc] if m else 0, -1)
+    case_code = np.where(moving, case_seg[mainc] if m else 0, -1)
+    rows = BlockTable(
+        block=ids, line=np.array([sp.line for sp in spans], dtype=np.int64),
+        label=tuple(sp.label for sp in spans), kind=tuple(sp.kind for sp in spans),
+        length_mm=np.array([sp.s_end - sp.s_start for sp in spans], dtype=np.float64),
+        v_entry=v_entry, v_exit=v_exit, v_peak=v_pk, time_s=t_blk, cause_code=cause_code,
+        mode_code=mode_code, case_code=case_code)
+    k = np.arange(1, m) if m >= 2 else np.zeros(0, dtype=np.int64)
+    own = np.minimum(junc.cap, horizon)
+    corners = CornerTable(
+        index=k, s=path.s_breaks[k], block_before=path.block[k - 1] if k.size else k,
+        block_after=path.block[k] if k.size else k, v=v_break[k], v_limit=own[k],
+        v_g64=junc.g64[k], tangential=junc.tangential[k], cause_code=brk_cause[k])
+    return rows, corners
+
+
+def _accel_cause(units: Units, prof: UnitProfiles, up: bool) -> np.ndarray:
+    """Cause of a ramp that stays below the cap: frequency (adapted), jerk (SOFT ramp that
+    never reaches a_max), else axis acceleration."""
+    adapted = units.adapted_up if up else units.adapted_dn
+    acc_bit = CASE_RISE_ACC if up else CASE_FALL_ACC
+    jerk_lim = units.jerk_limited & ((prof.case & acc_bit) == 0)
+    return np.where(adapted, C.FREQUENCY, np.where(jerk_lim, C.JERK, C.AXIS_ACCELERATION))
+
+
+def _node_cause(units: Units, speeds: NodeSpeeds, prof: UnitProfiles) -> np.ndarray:
+    """Cause of every node speed: its own limit, the propagated braking limit, or the
+    acceleration from behind."""
+    tol = CAUSE_REL_TOL
+    own = speeds.v >= units.node_cap * (1 - tol)
+    rise = _accel_cause(units, prof, up=True)
+    behind = np.concatenate(([C.AXIS_ACCELERATION], rise))
+    return np.where(own, units.node_cause,
+                    np.where(speeds.accel_limited, behind, speeds.origin_cause))
+
+
+__all__ = ["BlockRow", "BlockTable", "CornerRow", "CornerTable", "ReferencePlan", "plan"]

@@ -1,0 +1,49 @@
+"""Stage: the plan as the JSON contract of DESIGN section 7 (the ``reference`` part)."""
+
+from __future__ import annotations
+
+import math
+
+from ..core.constraints import BOUND_SETS
+from .engine import ReferencePlan
+
+
+def _num(x: float) -> float:
+    """JSON has no inf/NaN: infinite values become a large finite number, NaN 0."""
+    if math.isnan(x):
+        return 0.0
+    if math.isinf(x):
+        return 1e300 if x > 0 else -1e300
+    return float(x)
+
+
+def to_json_dict(plan: ReferencePlan) -> dict:
+    """The plan as a JSON-ready dict (schema ``result.schema.json``).
+
+    Parameters
+    ----------
+    plan : ReferencePlan
+
+    Returns
+    -------
+    dict
+        ``{"program", "machine", "bounds", "reference": {"time_s", "violations"},
+        "blocks": [...]}``; ``bounds`` is the planner's own bound set, ``violations``
+        lists the constraints of that set the own profile breaks
+        (``{"constraint", "axis", "ratio", "s", "block"}``), and every block row has
+        ``block, line, label, kind, length_mm, t_reference_s, v_exit_reference,
+        limit_reference``.
+    """
+    viol = []
+    if plan.report is not None:
+        for r in plan.report.violations(BOUND_SETS[plan.bound_set]):
+            viol.append({"constraint": r.constraint, "axis": r.axis, "ratio": _num(r.ratio),
+                         "s": _num(r.s), "block": int(r.block)})
+    blocks = [{"block": int(b.block), "line": max(1, int(b.line)), "label": b.label,
+               "kind": b.kind, "length_mm": max(0.0, _num(b.length_mm)),
+               "t_reference_s": max(0.0, _num(b.time_s)),
+               "v_exit_reference": max(0.0, _num(b.v_exit)),
+               "limit_reference": b.cause} for b in plan.blocks]
+    return {"program": plan.program, "machine": plan.machine, "bounds": plan.bound_set,
+            "reference": {"time_s": _num(plan.time_s), "violations": viol},
+            "blocks": blocks}

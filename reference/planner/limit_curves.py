@@ -1,0 +1,180 @@
+"""Stage: speed caps and tangential limits of every segment (model note 6.4).
+
+Every segment is a helical piece (line, arc, helix) whose curvature is constant, so its
+limit curve is one number per segment. Per axis ``i`` the tangent ``q'_i``, curvature
+``q''_i`` and ``q'''_i`` are a constant part ``d_i`` plus a part rotating with amplitude
+
+``P_i = rho_i |r w|``,  ``Q_i = rho_i r w^2``,  ``R_i = rho_i |r w^3|``
+(``rho_i = sqrt(e1_i^2 + e2_i^2)``, the axis' share of the arc plane).
+
+The bounds below take the worst phase of the rotation (a safe model: the checker's
+per-axis constraints hold wherever the arc is):
+
+``|q'_i v| <= v_max_i``            -> ``v <= v_max_i / (P_i + |d_i|)``   (axis velocity)
+``|q'_i a + q''_i v^2| <= A_i``    -> ``|d_i||a| + sqrt((P_i a)^2 + (Q_i v^2)^2) <= A_i``
+``|q'_i j + 3 q''_i v a + q'''_i v^3| <= J_i``
+                                   -> ``|d_i||j| + sqrt((P_i|j| + R_i v^3)^2 + (3 Q_i v a)^2) <= J_i``
+
+Caps, each with its cause (:mod:`reference.planner.causes`):
+
+* programmed feed F (none for G0): ``feed``;
+* axis velocity: ``axis velocity``;
+* centripetal: ``Q_i v^2 <= share * A_i`` (``arc_centripetal_share``): ``axis acceleration``;
+* SOFT, path jerk on arcs: ``R_i v^3 <= share * J_i`` (``arc_jerk_velocity_share``): ``jerk``;
+* at least one IPO cycle per block: ``v <= L / T_ipo``: ``IPO-cycle cap``.
+
+Then, at the cap speed ``C`` (the worst case, as speeds never exceed it), the tangential
+acceleration ``a_t`` is the largest that satisfies the acceleration inequality for all
+axes, and under SOFT (after keeping ``3 Q_i C a_t <= share * J_i``,
+``arc_jerk_accel_share``) the tangential jerk ``j_t`` the largest that satisfies the jerk
+inequality. On lines these are exactly ``min_i A_i/|d_i|`` and ``min_i J_i/|d_i|``.
+
+Axis limits: MAX_AX_ACCEL times SOFT_ACCEL_FACTOR (SOFT) and G00_ACCEL_FACTOR (G0),
+MAX_AX_JERK times G00_JERK_FACTOR (G0); factors above 1 are clipped to 1 so that the
+plan never exceeds the limits the checker judges against.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.geometry import Path
+from ..machine import Machine
+from . import causes as C
+from .parameters import AXIS_MOVING_TOL, PlannerParameters
+from .stops import ACCEL_MODES, SegmentModes
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SegmentLimits:
+    """Per-segment speed cap and tangential limits, arrays of shape (m,).
+
+    Attributes
+    ----------
+    cap : numpy.ndarray
+        Largest path speed anywhere in the segment, mm/s.
+    cap_cause : numpy.ndarray of int
+        Cause code of the cap.
+    accel : numpy.ndarray
+        Tangential acceleration available at every speed up to ``cap``, mm/s^2.
+    jerk : numpy.ndarray
+        Tangential jerk (``inf`` for BRISK segments), mm/s^3.
+    frequency : numpy.ndarray
+        Smallest LOOKAH_FREQUENCY of the axes moving in the segment, Hz.
+    moving : numpy.ndarray of bool, shape (m, n)
+        Axes that move in the segment.
+    """
+
+    cap: np.ndarray
+    cap_cause: np.ndarray
+    accel: np.ndarray
+    jerk: np.ndarray
+    frequency: np.ndarray
+    moving: np.ndarray
+
+
+def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
+    """(D, P, Q, R), each shape (m, n): constant tangent part and rotating amplitudes."""
+    rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
+    rw = np.abs(path.radius * path.omega)[:, None]
+    w = np.abs(path.omega)[:, None]
+    D = np.abs(path.d)
+    P = rho * rw
+    Q = P * w
+    R = Q * w
+    return D, P, Q, R
+
+
+def _axis_factors(path: Path, machine: Machine, modes: SegmentModes):
+    """Per segment and axis: acceleration and jerk limits after the mode factors."""
+    lim = machine.limits.for_axes(path.axes)
+    st = [machine.settings_of(a) for a in path.axes]
+    soft_f = np.minimum(1.0, np.array([s.soft_accel_factor for s in st]))
+    g0a = np.minimum(1.0, np.array([s.g00_accel_factor for s in st]))
+    g0j = np.minimum(1.0, np.array([s.g00_jerk_factor for s in st]))
+    uses_soft = np.array([m.uses_soft_accel_factor for m in ACCEL_MODES])[modes.mode]
+    acc = lim.a_max[None, :] * np.where(uses_soft[:, None], soft_f[None, :], 1.0)
+    acc = acc * np.where(path.rapid[:, None], g0a[None, :], 1.0)
+    jerk = lim.j_max[None, :] * np.where(path.rapid[:, None], g0j[None, :], 1.0)
+    return lim, acc, jerk
+
+
+def _min_with_cause(candidates: list[tuple[np.ndarray, int]]) -> tuple[np.ndarray, np.ndarray]:
+    vals = np.stack([c[0] for c in candidates], axis=1)
+    arg = np.argmin(vals, axis=1)
+    codes = np.array([c[1] for c in candidates])
+    return vals[np.arange(vals.shape[0]), arg], codes[arg]
+
+
+def _accel_at(cap, A, D, P, Q, moving):
+    """Largest a with D a + sqrt((P a)^2 + (Q cap^2)^2) <= A for every moving axis."""
+    K = Q * (cap * cap)[:, None]
+    A2K2 = np.maximum(A * A - K * K, 0.0)
+    den = A * D + np.sqrt(P * P * A2K2 + D * D * K * K)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.where(den > 0, A2K2 / np.where(den > 0, den, 1.0), np.inf)
+    a = np.where(moving, a, np.inf)
+    return a.min(axis=1)
+
+
+def _jerk_at(cap, acc, J, D, P, Q, R, moving):
+    """Largest j with D j + sqrt((P j + M)^2 + N^2) <= J, M = R cap^3, N = 3 Q cap acc."""
+    M = R * (cap ** 3)[:, None]
+    N = 3.0 * Q * (cap * acc)[:, None]
+    rest = np.maximum(J * J - M * M - N * N, 0.0)
+    b = P * M + J * D
+    disc = np.maximum(b * b + (P * P - D * D) * rest, 0.0)
+    den = b + np.sqrt(disc)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        j = np.where(den > 0, rest / np.where(den > 0, den, 1.0), np.inf)
+    j = np.where(moving, j, np.inf)
+    return j.min(axis=1)
+
+
+def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
+                   params: PlannerParameters) -> SegmentLimits:
+    """Speed cap, tangential acceleration and jerk of every segment.
+
+    Parameters
+    ----------
+    path : Path
+    machine : Machine
+    modes : SegmentModes
+        Acceleration mode per segment (BRISK or SOFT).
+    params : PlannerParameters
+        The arc budget shares.
+
+    Returns
+    -------
+    SegmentLimits
+    """
+    m = path.n_segments
+    lim, A, J = _axis_factors(path, machine, modes)
+    D, P, Q, R = axis_amplitudes(path)
+    moving = (D + P) > AXIS_MOVING_TOL
+    inf = np.full(m, np.inf)
+    soft = modes.jerk_limited
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_axis = np.where(moving, lim.v_max[None, :] / (D + P), np.inf).min(axis=1)
+        v_cent = np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A / np.where(
+            Q > 0, Q, 1.0)), np.inf).min(axis=1)
+        v_jerk = np.where(R > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
+            R > 0, R, 1.0)), np.inf).min(axis=1)
+    v_jerk = np.where(soft, v_jerk, inf)
+    v_ipo = path.length / machine.limits.t_ipo_s
+    cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
+                                  (v_cent, C.AXIS_ACCELERATION), (v_jerk, C.JERK),
+                                  (v_ipo, C.IPO_CAP)])
+    acc = _accel_at(cap, A, D, P, Q, moving)
+    # SOFT: leave the jerk budget share for 3 |q''| v a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a_j = np.where(moving & (Q > 0), params.arc_jerk_accel_share * J / (
+            3.0 * np.where(Q > 0, Q, 1.0) * np.maximum(cap, 1e-300)[:, None]), np.inf
+        ).min(axis=1)
+    acc = np.where(soft, np.minimum(acc, a_j), acc)
+    jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, moving), inf)
+    freq = np.where(moving, lim.frequency_hz[None, :], np.inf).min(axis=1)
+    return SegmentLimits(cap=cap, cap_cause=cause, accel=acc, jerk=jerk, frequency=freq,
+                         moving=moving)

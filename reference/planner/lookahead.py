@@ -1,0 +1,391 @@
+"""Stage: LookAhead, the path velocity preview over a receding horizon (model note 7).
+
+Three steps, all O(n) in the number of segments:
+
+1. **Horizon** (:func:`horizon_caps`). The control prepares ``N = lookahead_blocks``
+   blocks ahead and assumes ``v = 0`` at the end of the last one, because the next block
+   could be tiny or an exact stop [S6]. It re-plans whenever a block arrives and executes
+   only the current block. While segment ``k-1`` runs, the horizon holds segments
+   ``k .. k+N-1``, so its exit speed (the speed at break ``k``) can be at most the speed
+   from which the motion still stops at break ``k+N``. In a receding-horizon plan the
+   horizon end acts on the executed motion *only* through this exit cap (any constraint
+   beyond the horizon is weaker than the zero at its end), so instead of re-running a
+   backward pass per block the stage computes one cap per break:
+
+   - BRISK: ``z_k^2 = 2 sum_{i=k}^{k+N-1} A_i L_i`` (exact, a cumulative sum);
+   - SOFT: one jerk-limited braking ramp from ``z_k`` to rest over the horizon distance
+     with the weakest ``A``, ``J`` of the horizon (a sliding-window minimum).
+
+   Breaks whose horizon reaches the path end get no cap (the end is a real stop).
+   With short blocks and a small ``N`` this cap binds at every break: the speed rises in
+   each block and falls again (the documented saw-tooth); a long horizon removes it.
+
+2. **Planning units** (:func:`planning_units`). BRISK plans each segment on its own (its
+   trapezoids are optimal between the junction speeds). SOFT plans with zero acceleration
+   at the ends of a unit, so consecutive SOFT segments are merged into one unit, through
+   which the jerk-limited ramps continue, when the break between them does not bind (its
+   own limit is at least the unit's cap) and the caps stay within
+   ``soft_merge_cap_ratio``; the unit runs at the smallest cap of its segments with the
+   smallest acceleration and jerk (a safe model).
+
+3. **Passes** (:func:`lookahead_passes`): a backward pass from the end and a forward pass
+   from the start over the units, each step the closed-form reachable speed of
+   :func:`reference.planner.profiles.ramp_reach` (dispatch on the unit's mode). Every pair
+   of consecutive node speeds is then joinable by one unit profile.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.ndimage import minimum_filter1d
+
+from ..core.geometry import Path
+from . import causes as C
+from .corners import JunctionLimits
+from .limit_curves import SegmentLimits
+from .profiles import ramp_reach
+from .stops import SegmentModes
+
+
+# ----------------------------------------------------------------- horizon
+def _forward_window_min(x: np.ndarray, n: int) -> np.ndarray:
+    """``out[k] = min(x[k : k + n])`` (shorter windows at the end)."""
+    if x.size == 0:
+        return x.copy()
+    if n >= x.size:
+        return np.minimum.accumulate(x[::-1])[::-1]
+    return minimum_filter1d(x, size=n, mode="nearest", origin=-(n // 2))
+
+
+def horizon_caps(path: Path, seg: SegmentLimits, modes: SegmentModes, n_blocks: int
+                 ) -> np.ndarray:
+    """Exit-speed cap of every break from the LookAhead horizon (``inf`` where none).
+
+    Parameters
+    ----------
+    path : Path
+    seg : SegmentLimits
+        Tangential acceleration and jerk per segment.
+    modes : SegmentModes
+    n_blocks : int
+        LookAhead horizon, in prepared (moving) blocks after the current one (>= 1).
+
+    Returns
+    -------
+    numpy.ndarray, shape (m + 1,)
+        mm/s.
+    """
+    m = path.n_segments
+    z = np.full(m + 1, np.inf)
+    n = max(int(n_blocks), 1)
+    k = np.arange(1, m)
+    e = k + n
+    inside = e < m
+    if not inside.any():
+        return z
+    k, e = k[inside], e[inside]
+    cal = np.concatenate(([0.0], np.cumsum(seg.accel * path.length)))
+    z_brisk = np.sqrt(2.0 * np.maximum(cal[e] - cal[k], 0.0))
+    a_min = _forward_window_min(seg.accel, n)[k]
+    j_min = _forward_window_min(seg.jerk, n)[k]
+    dist = path.s_breaks[e] - path.s_breaks[k]
+    z_soft = ramp_reach(np.zeros(k.size), dist, a_min, j_min)
+    soft = _forward_window_min(np.where(modes.jerk_limited, 0.0, 1.0), n)[k] == 0.0
+    z[k] = np.where(soft, z_soft, z_brisk)
+    return z
+
+
+# ----------------------------------------------------------------- planning units
+@dataclass(frozen=True, slots=True, eq=False)
+class Units:
+    """Planning units: runs of segments planned as one profile (arrays over units).
+
+    Attributes
+    ----------
+    first_segment, n_segments : numpy.ndarray of int, shape (u,)
+        Segment range of each unit.
+    node_break : numpy.ndarray of int, shape (u + 1,)
+        Break index of each unit boundary (node).
+    s_start, length : numpy.ndarray, shape (u,)
+        Start position and length, mm.
+    cap : numpy.ndarray, shape (u,)
+        Speed cap, mm/s.
+    cap_cause : numpy.ndarray of int, shape (u,)
+        Its cause.
+    acc_up, jerk_up, acc_dn, jerk_dn : numpy.ndarray, shape (u,)
+        Limits of rising and falling ramps (jerk ``inf`` for BRISK).
+    frequency : numpy.ndarray, shape (u,)
+        Smallest LOOKAH_FREQUENCY of the axes moving in the unit, Hz.
+    jerk_limited : numpy.ndarray of bool, shape (u,)
+        SOFT units.
+    node_cap : numpy.ndarray, shape (u + 1,)
+        Speed limit at each node (junction rules, horizon, neighbouring unit caps).
+    node_cause : numpy.ndarray of int, shape (u + 1,)
+        Its cause.
+    adapted_up, adapted_dn : numpy.ndarray of bool, shape (u,)
+        Ramps whose dynamics the dynamic adaptation lowered.
+    """
+
+    first_segment: np.ndarray
+    n_segments: np.ndarray
+    node_break: np.ndarray
+    s_start: np.ndarray
+    length: np.ndarray
+    cap: np.ndarray
+    cap_cause: np.ndarray
+    acc_up: np.ndarray
+    jerk_up: np.ndarray
+    acc_dn: np.ndarray
+    jerk_dn: np.ndarray
+    frequency: np.ndarray
+    jerk_limited: np.ndarray
+    node_cap: np.ndarray
+    node_cause: np.ndarray
+    adapted_up: np.ndarray
+    adapted_dn: np.ndarray
+
+    @property
+    def n_units(self) -> int:
+        """Number of units."""
+        return int(self.length.size)
+
+    def with_caps(self, cap: np.ndarray, cap_cause: np.ndarray) -> "Units":
+        """Same units with new caps; node caps are re-limited by the neighbouring caps."""
+        node_cap, node_cause = _limit_nodes(self.node_cap, self.node_cause, cap, cap_cause)
+        return replace(self, cap=cap, cap_cause=cap_cause, node_cap=node_cap,
+                       node_cause=node_cause)
+
+
+def _limit_nodes(node_cap, node_cause, cap, cap_cause):
+    """Node caps limited by the caps of the units on both sides."""
+    left = np.concatenate(([np.inf], cap))
+    right = np.concatenate((cap, [np.inf]))
+    lc = np.concatenate(([C.FEED], cap_cause))
+    rc = np.concatenate((cap_cause, [C.FEED]))
+    nb = np.minimum(left, right)
+    nbc = np.where(left <= right, lc, rc)
+    use = nb < node_cap
+    return np.where(use, nb, node_cap), np.where(use, nbc, node_cause)
+
+
+def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
+                 own_cap: np.ndarray, through: np.ndarray, ratio: float,
+                 accel_ratio: float) -> np.ndarray:
+    """True at interior breaks where two SOFT segments become one unit (greedy runs)."""
+    m = path.n_segments
+    merge = np.zeros(m + 1, dtype=bool)
+    if m < 2:
+        return merge
+    jl = modes.jerk_limited
+    cand = np.zeros(m + 1, dtype=bool)
+    cand[1:m] = (jl[:-1] & jl[1:] & ~modes.stop[1:m]
+                 & (through[1:m] >= accel_ratio * np.minimum(seg.accel[:-1], seg.accel[1:])))
+    idx = np.flatnonzero(cand)
+    if idx.size == 0:
+        return merge
+    # effective cap: the speed a segment could reach on its own between neighbours that
+    # run at their caps (rise over half of it, fall over the other half); merging gives
+    # away at most the difference between effective caps, so short blocks merge freely
+    c = seg.cap
+    low = np.minimum(c, np.minimum(np.concatenate(([np.inf], c[:-1])),
+                                   np.concatenate((c[1:], [np.inf]))))
+    reach = ramp_reach(low, 0.5 * path.length, seg.accel, seg.jerk)
+    eff = np.minimum(c, reach).tolist()
+    cap = c.tolist()
+    own = own_cap.tolist()
+    lo = elo = ehi = 0.0
+    prev = -2
+    for k in idx.tolist():
+        if k != prev + 1:
+            lo, elo, ehi = cap[k - 1], eff[k - 1], eff[k - 1]
+        new_lo = min(lo, cap[k])
+        new_elo, new_ehi = min(elo, eff[k]), max(ehi, eff[k])
+        if own[k] >= new_lo and new_elo >= ratio * new_ehi:
+            merge[k] = True
+            lo, elo, ehi = new_lo, new_elo, new_ehi
+        else:
+            lo, elo, ehi = cap[k], eff[k], eff[k]
+        prev = k
+    return merge
+
+
+def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
+                   modes: SegmentModes, horizon: np.ndarray, merge_ratio: float,
+                   merge_accel_ratio: float) -> Units:
+    """Group segments into planning units and set their node limits.
+
+    Parameters
+    ----------
+    path : Path
+    seg : SegmentLimits
+    junc : JunctionLimits
+    modes : SegmentModes
+    horizon : numpy.ndarray, shape (m + 1,)
+        Horizon caps (:func:`horizon_caps`).
+    merge_ratio : float
+        ``soft_merge_cap_ratio``.
+    merge_accel_ratio : float
+        ``soft_merge_accel_ratio``.
+
+    Returns
+    -------
+    Units
+    """
+    m = path.n_segments
+    # a break's own limit (without the neighbouring caps): rules other than "caps"
+    own = np.minimum(np.minimum(junc.g64, junc.curvature), horizon)
+    own = np.where(modes.stop, 0.0, own)
+    merge = _merge_flags(path, seg, modes, own, junc.through_accel, merge_ratio,
+                         merge_accel_ratio)
+    nodes = np.flatnonzero(~merge)          # includes 0 and m
+    first = nodes[:-1]
+    count = np.diff(nodes)
+    cap = np.minimum.reduceat(seg.cap, first)
+    unit_of = np.repeat(np.arange(first.size), count)
+    is_min = seg.cap == cap[unit_of]
+    pos = np.where(is_min, np.arange(m), m)
+    arg = np.minimum.reduceat(pos, first)
+    cap_cause = seg.cap_cause[arg]
+    acc = np.minimum.reduceat(seg.accel, first)
+    # merged breaks: the acceleration that may cross them
+    thru = np.where(merge, junc.through_accel, np.inf)[:m] if m else np.zeros(0)
+    if m:
+        acc = np.minimum(acc, np.minimum.reduceat(thru, first))
+    jerk = np.minimum.reduceat(seg.jerk, first)
+    freq = np.minimum.reduceat(seg.frequency, first)
+    node_cap = junc.cap[nodes]
+    node_cause = junc.cause[nodes]
+    hz = horizon[nodes]
+    use_h = hz < node_cap
+    node_cap = np.where(use_h, hz, node_cap)
+    node_cause = np.where(use_h, C.HORIZON, node_cause)
+    node_cap, node_cause = _limit_nodes(node_cap, node_cause, cap, cap_cause)
+    z = np.zeros(first.size, dtype=bool)
+    return Units(first_segment=first, n_segments=count, node_break=nodes,
+                 s_start=path.s_breaks[first], length=path.s_breaks[nodes[1:]] -
+                 path.s_breaks[first], cap=cap, cap_cause=cap_cause, acc_up=acc,
+                 jerk_up=jerk, acc_dn=acc.copy(), jerk_dn=jerk.copy(), frequency=freq,
+                 jerk_limited=np.isfinite(jerk), node_cap=node_cap, node_cause=node_cause,
+                 adapted_up=z, adapted_dn=z.copy())
+
+
+# ----------------------------------------------------------------- passes
+def _reach_brisk(v: float, dist: float, acc: float, jerk: float) -> float:
+    return math.sqrt(v * v + 2.0 * acc * dist)
+
+
+def _reach_soft(v: float, dist: float, acc: float, jerk: float) -> float:
+    thr = acc * acc / jerk
+    # jerk-limited: x^3 + p x + q = 0, dv = x^2
+    p = 2.0 * v
+    q = -dist * math.sqrt(jerk)
+    q2 = 0.25 * q * q
+    p3 = p * p * p / 27.0
+    if q2 >= p3:
+        u = (-0.5 * q + math.sqrt(q2 + p3)) ** (1.0 / 3.0)
+        x = u - p / (3.0 * u) if u > 0 else 0.0
+    else:
+        x = 2.0 * math.sqrt(p / 3.0) * math.sinh(math.asinh(math.sqrt(q2 / p3)) / 3.0)
+    df = 3.0 * x * x + p
+    if df > 0:
+        x -= (x * x * x + p * x + q) / df
+    dv = x * x
+    if dv <= thr:
+        return v + max(dv, 0.0)
+    b = 2.0 * v + thr
+    c = 2.0 * v * thr - 2.0 * acc * dist
+    dv = -2.0 * c / (b + math.sqrt(max(b * b - 4.0 * c, 0.0)))
+    return v + max(dv, 0.0)
+
+
+#: Reachable speed over a distance, by mode (index: jerk-limited).
+_REACH = (_reach_brisk, _reach_soft)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class NodeSpeeds:
+    """Speeds at the unit nodes after the LookAhead passes.
+
+    Attributes
+    ----------
+    v : numpy.ndarray, shape (u + 1,)
+        Node speeds, mm/s.
+    backward : numpy.ndarray, shape (u + 1,)
+        Result of the backward pass alone (largest speed that can still brake), mm/s.
+    origin_cause : numpy.ndarray of int, shape (u + 1,)
+        Cause of the limit the backward pass propagated to each node.
+    accel_limited : numpy.ndarray of bool, shape (u + 1,)
+        Nodes below their backward speed because the forward ramp could not go faster.
+    """
+
+    v: np.ndarray
+    backward: np.ndarray
+    origin_cause: np.ndarray
+    accel_limited: np.ndarray
+
+
+def _fits(v_lo: float, v_hi: float, dist: float, acc: float, jerk: float) -> bool:
+    """Cheap sufficient test: a ramp between the speeds fits into ``dist``.
+
+    Uses ``ramp_distance <= (v_hi^2 - v_lo^2)/(2A) + (v_hi + v_lo) A/(2J)`` (the
+    jerk-limited ramp time ``2 sqrt(dv/J)`` never exceeds ``dv/A + A/J``).
+    """
+    return (v_hi * v_hi - v_lo * v_lo) / (2.0 * acc) + (v_hi + v_lo) * acc / (2.0 * jerk) \
+        <= dist
+
+
+def lookahead_passes(units: Units) -> NodeSpeeds:
+    """Backward and forward passes over the units (closed-form steps).
+
+    Each step first tries the cheap sufficient test :func:`_fits` (most nodes are bound
+    by their own limit) and computes the exact reachable speed only when it fails.
+
+    Parameters
+    ----------
+    units : Units
+
+    Returns
+    -------
+    NodeSpeeds
+    """
+    n = units.n_units
+    cap = units.node_cap.tolist()
+    cause = units.node_cause.tolist()
+    L = units.length.tolist()
+    jl = units.jerk_limited.astype(int).tolist()
+    ad, jd = units.acc_dn.tolist(), units.jerk_dn.tolist()
+    au, ju = units.acc_up.tolist(), units.jerk_up.tolist()
+    b = [0.0] * (n + 1)
+    origin = [0] * (n + 1)
+    b[n], origin[n] = cap[n], cause[n]
+    reach = _REACH
+    fits = _fits
+    for k in range(n - 1, -1, -1):
+        be, c = b[k + 1], cap[k]
+        if c <= be or fits(be, c, L[k], ad[k], jd[k]):
+            b[k], origin[k] = c, cause[k]
+            continue
+        r = reach[jl[k]](be, L[k], ad[k], jd[k])
+        if c <= r:
+            b[k], origin[k] = c, cause[k]
+        else:
+            b[k], origin[k] = r, origin[k + 1]
+    w = [0.0] * (n + 1)
+    acc_lim = [False] * (n + 1)
+    w[0] = b[0]
+    for k in range(n):
+        ws, bn = w[k], b[k + 1]
+        if bn <= ws or fits(ws, bn, L[k], au[k], ju[k]):
+            w[k + 1] = bn
+            continue
+        f = reach[jl[k]](ws, L[k], au[k], ju[k])
+        if bn <= f:
+            w[k + 1] = bn
+        else:
+            w[k + 1] = f
+            acc_lim[k + 1] = True
+    return NodeSpeeds(v=np.array(w), backward=np.array(b), origin_cause=np.array(origin),
+                      accel_limited=np.array(acc_lim))

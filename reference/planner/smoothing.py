@@ -1,0 +1,194 @@
+"""Stage: smoothing of the path velocity (MD20460 LOOKAH_SMOOTH_FACTOR, model note 7.3).
+
+Short acceleration "bumps" (the speed rises and falls again) save little time but excite
+the machine. The smoothing factor is the productivity loss (in %) the control may spend
+to avoid them; only bumps whose duration is below ``1/f`` count, ``f`` the smallest
+LOOKAH_FREQUENCY (MD32440) of the axes moving in the bump (AX2 at 10 Hz dominates as soon
+as AX2 moves). No contour error results: only the speed changes.
+
+Model [I]:
+
+* A bump is the stretch between two consecutive *valleys* of the planned speed (nodes
+  where the speed stops falling and starts rising; program start and end count).
+* Candidate: cap the bump at ``v_flat = max(v_left_valley, v_right_valley)``; this keeps
+  every pair of node speeds joinable (lower speeds never lengthen a ramp).
+* Accept the candidate when the bump is shorter than ``1/f`` and the time it costs is at
+  most ``factor`` % of the bump's time. Bumps are taken shortest first: each round caps
+  the bumps that qualify, after which neighbouring bumps may merge into larger ones
+  (``smoothing_rounds`` rounds).
+
+Each capped bump costs at most ``factor`` % of its own time, so the whole program slows
+down by at most ``factor`` %: 1 % is "practically off", as the manual's example says.
+
+The value 0: the manual's excerpt suggests that 0 makes the control use an internal
+100 %; this project's machine data (DESIGN section 3) defines 0 as "smoothing off", and
+the model follows the project. Set 100 for full smoothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Callable
+
+import numpy as np
+
+from . import causes as C
+from .lookahead import NodeSpeeds, Units
+from .parameters import CAUSE_REL_TOL
+from .profiles import UnitProfiles
+
+
+@dataclass(frozen=True, slots=True)
+class SmoothingResult:
+    """Output of :func:`smooth_velocity`.
+
+    Attributes
+    ----------
+    units : Units
+        Units with the smoothing caps (cause ``frequency``).
+    speeds : NodeSpeeds
+        Node speeds (capped inside smoothed bumps).
+    profiles : UnitProfiles
+        Re-planned unit profiles.
+    n_bumps : int
+        Bumps removed.
+    time_before, time_after : float
+        Moving time before and after smoothing, s.
+    """
+
+    units: Units
+    speeds: NodeSpeeds
+    profiles: UnitProfiles
+    n_bumps: int
+    time_before: float
+    time_after: float
+
+
+def _moves(prof: UnitProfiles):
+    tol = CAUSE_REL_TOL
+    rise = prof.v_peak > prof.v_in * (1 + tol) + 1e-9
+    fall = prof.v_peak > prof.v_out * (1 + tol) + 1e-9
+    return rise, fall
+
+
+def find_valleys(prof: UnitProfiles) -> np.ndarray:
+    """Node indices where the speed stops falling and starts rising (ends included).
+
+    Parameters
+    ----------
+    prof : UnitProfiles
+        Profiles of ``u`` units.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Sorted node indices in ``[0, u]``.
+    """
+    u = prof.v_peak.size
+    rise, fall = _moves(prof)
+    last = np.where(fall, -1, np.where(rise, 1, 0))     # last move inside unit
+    first = np.where(rise, 1, np.where(fall, -1, 0))    # first move inside unit
+    # last move before node k (units < k), forward-filled over flat units
+    idx = np.where(last != 0, np.arange(u), -1)
+    ff = np.maximum.accumulate(idx) if u else idx
+    before = np.concatenate(([0], np.where(ff >= 0, last[np.maximum(ff, 0)], 0)))
+    # first move after node k (units >= k), backward-filled
+    idx2 = np.where(first != 0, np.arange(u), u)
+    bf = np.minimum.accumulate(idx2[::-1])[::-1] if u else idx2
+    after = np.concatenate((np.where(bf < u, first[np.minimum(bf, max(u - 1, 0))], 0), [0]))
+    return np.flatnonzero((before <= 0) & (after >= 0))
+
+
+def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
+                    factor_pct: float, rounds: int,
+                    replan: Callable[[Units, np.ndarray, np.ndarray], UnitProfiles]
+                    ) -> SmoothingResult:
+    """Remove short bumps whose removal costs at most ``factor_pct`` % of their time.
+
+    Parameters
+    ----------
+    units : Units
+    speeds : NodeSpeeds
+    prof : UnitProfiles
+    factor_pct : float
+        LOOKAH_SMOOTH_FACTOR, % (0 = off).
+    rounds : int
+        Rounds of bump removal.
+    replan : callable
+        ``replan(units_subset_index -> ...)``: given ``(units, idx, v_nodes)`` returns the
+        unit profiles of units ``idx`` with entry ``v_nodes[idx]`` and exit
+        ``v_nodes[idx + 1]``.
+
+    Returns
+    -------
+    SmoothingResult
+    """
+    t0 = float(prof.time.sum())
+    n_bumps = 0
+    if factor_pct <= 0.0 or units.n_units == 0:
+        return SmoothingResult(units, speeds, prof, 0, t0, t0)
+    v = speeds.v.copy()
+    for _ in range(max(rounds, 1)):
+        valleys = find_valleys(prof)
+        if valleys.size < 2:
+            break
+        a, b = valleys[:-1], valleys[1:]
+        rise, _ = _moves(prof)
+        n_rise = np.concatenate(([0], np.cumsum(rise)))
+        has_rise = (n_rise[b] - n_rise[a]) > 0
+        t_cum = np.concatenate(([0.0], np.cumsum(prof.time)))
+        t_bump = t_cum[b] - t_cum[a]
+        f_bump = np.minimum.reduceat(units.frequency[: b[-1]], a)
+        with np.errstate(divide="ignore"):
+            short = t_bump < 1.0 / f_bump
+        # a bump between two standstills cannot be flattened (v_flat = 0)
+        v_flat_all = np.maximum(v[a], v[b])
+        cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0))
+        if cand.size == 0:
+            break
+        v_flat = np.maximum(v[a[cand]], v[b[cand]])
+        # units of the candidate bumps and their flat speed
+        counts = b[cand] - a[cand]
+        uidx = np.concatenate([np.arange(x, y) for x, y in zip(a[cand], b[cand])])
+        vf_u = np.repeat(v_flat, counts)
+        new_cap = np.minimum(units.cap[uidx], vf_u)
+        v_new = v.copy()
+        nidx = uidx[uidx > 0]
+        v_new[nidx] = np.minimum(v_new[nidx], np.repeat(v_flat, counts)[uidx > 0])
+        trial = units.with_caps(_scatter(units.cap, uidx, new_cap), units.cap_cause)
+        p_new = replan(trial, uidx, v_new)
+        starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
+        t_new = np.add.reduceat(p_new.time, starts)
+        ok = t_new - t_bump[cand] <= factor_pct / 100.0 * t_bump[cand]
+        if not ok.any():
+            break
+        keep_u = np.repeat(ok, counts)
+        sel = uidx[keep_u]
+        cap = units.cap.copy()
+        cause = units.cap_cause.copy()
+        lowered = new_cap[keep_u] < cap[sel]
+        cap[sel] = new_cap[keep_u]
+        cause[sel] = np.where(lowered, C.FREQUENCY, cause[sel])
+        units = units.with_caps(cap, cause)
+        # interior nodes of accepted bumps keep the flat speed as their limit
+        nodes = sel[sel > 0]
+        vf_sel = vf_u[keep_u][sel > 0]
+        inner = np.isin(nodes, a[cand][ok], invert=True)
+        nodes, vf_sel = nodes[inner], vf_sel[inner]
+        node_cap = units.node_cap.copy()
+        node_cause = units.node_cause.copy()
+        low = vf_sel < node_cap[nodes]
+        node_cap[nodes[low]] = vf_sel[low]
+        node_cause[nodes[low]] = C.FREQUENCY
+        units = replace(units, node_cap=node_cap, node_cause=node_cause)
+        v[nodes] = np.minimum(v[nodes], vf_sel)
+        n_bumps += int(ok.sum())
+        prof = replan(units, np.arange(units.n_units), v)
+    speeds = replace(speeds, v=v)
+    return SmoothingResult(units, speeds, prof, n_bumps, t0, float(prof.time.sum()))
+
+
+def _scatter(base: np.ndarray, idx: np.ndarray, values: np.ndarray) -> np.ndarray:
+    out = base.copy()
+    out[idx] = values
+    return out
