@@ -6,7 +6,9 @@ STAMP  := $(VENV)/.installed-stamp
 
 .PHONY: demo test bench install clean
 
-$(STAMP): pyproject.toml
+# Re-install when the project file or the package list changes (an editable install maps
+# the packages that existed when it ran).
+$(STAMP): pyproject.toml $(wildcard */__init__.py)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[test]"
@@ -15,7 +17,7 @@ $(STAMP): pyproject.toml
 install: $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/feedoracle inspect examples/demo.mpf
+	$(VENV)/bin/feedoracle compare examples/demo.mpf --report reports --json reports/demo.json
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2 --dist loadgroup

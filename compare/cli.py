@@ -93,6 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("program")
     common(sp)
     sp.set_defaults(func=cmd_inspect)
+
+    from . import commands  # plan, optimize, compare, check live beside the report code
+    commands.register(sub, common)
     return p
 
 

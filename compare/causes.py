@@ -1,0 +1,162 @@
+"""What limits the speed of a profile in each NC block, derived from the motion itself.
+
+Planners that report their own limiting cause per block (the heuristic, the oracle) are
+shown with theirs; this module derives one for profiles that do not (recorded
+trajectories, or an oracle that reports none), with the same vocabulary
+(:data:`CAUSES`).
+
+Rule, per block: sample the motion inside every interval and find, for each limit,
+the share of the block's time during which it is *tight* (within :data:`TIGHT_REL` of
+its bound). The block's cause is the limit with the largest share; a block that spends
+most of its time braking into a required stop or into a corner taken at the
+velocity-jump allowance is attributed to that stop or corner instead. A block where no
+limit is tight for :data:`MIN_SHARE` of its time is ``"none"``: nothing forced the
+motion to be that slow there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.core.profile import Profile
+
+#: The cause vocabulary shared with the heuristic and the oracle (plus ``"none"`` for a
+#: block where no limit is tight and ``"-"`` for a block without motion or time).
+CAUSES: tuple[str, ...] = ("feed", "axis velocity", "axis acceleration", "jerk", "frequency",
+                           "corner rule", "look-ahead horizon", "IPO-cycle cap", "exact stop",
+                           "forced stop")
+
+#: A limit is tight where value/limit >= 1 - TIGHT_REL. 2 % covers the oracle's
+#: discretisation (constant path acceleration between grid nodes on arcs) and the
+#: reconstruction error of recorded trajectories, yet separates real slack.
+TIGHT_REL = 0.02
+
+#: A block whose tightest limit is tight for less than this share of its time is "none".
+MIN_SHARE = 0.25
+
+#: Samples per profile interval (at 1/6, 1/2 and 5/6 of it; Simpson-like weights).
+_TAU = np.array([1.0, 3.0, 5.0]) / 6.0
+
+#: Intervals per chunk (bounds memory on long profiles).
+_CHUNK = 50_000
+
+_SHARED = ("feed", "axis velocity", "axis acceleration", "jerk")
+
+
+def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
+                  jerk: bool = True) -> dict[int, str]:
+    """Limiting cause of every block of ``path`` for ``profile``.
+
+    Parameters
+    ----------
+    path : Path
+        The path the profile runs on.
+    limits : MachineLimits
+        Machine limits.
+    profile : Profile
+        The motion.
+    jerk : bool
+        Consider the jerk limit (False for acceleration-bounded planners, whose jerk is
+        unbounded by design).
+
+    Returns
+    -------
+    dict[int, str]
+        Block index -> one of :data:`CAUSES`, ``"none"`` or ``"-"``.
+    """
+    if not path.blocks:
+        return {}
+    n_blocks = max(b.block for b in path.blocks) + 1
+    lim = limits.for_axes(path.axes)
+    cuts = [b.s_end for b in path.blocks if b.s_end > b.s_start]
+    prof = profile.split_at(cuts)
+    blk = prof.interval_blocks(path)
+    h = np.diff(prof.t)
+    moving = np.flatnonzero(np.diff(prof.s) > 0)
+    names = _SHARED if jerk else _SHARED[:3]
+    tight = {c: np.zeros(n_blocks) for c in names}
+    braking = np.zeros(n_blocks)
+    time = np.bincount(blk, weights=h, minlength=n_blocks)
+    for lo in range(0, moving.size, _CHUNK):
+        k = moving[lo:lo + _CHUNK]
+        tau = h[k][:, None] * _TAU[None, :]
+        a0, jj = prof.a[k][:, None], prof.j[k][:, None]
+        s = prof.s[k][:, None] + prof.v[k][:, None] * tau + a0 * tau ** 2 / 2 + jj * tau ** 3 / 6
+        v = np.maximum(prof.v[k][:, None] + a0 * tau + jj * tau ** 2 / 2, 0.0)
+        a = a0 + jj * tau
+        w = np.repeat(h[k] / _TAU.size, _TAU.size)
+        b = np.repeat(blk[k], _TAU.size)
+        s, v, a = s.ravel(), v.ravel(), a.ravel()
+        j = np.repeat(prof.j[k], _TAU.size)
+        seg = path.segment_index(np.clip(s, 0.0, path.total_length))
+        _, dq, ddq, dddq = path.evaluate(np.clip(s, 0.0, path.total_length), segment=seg)
+        feed = path.feed[seg]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = {
+                "feed": np.where(np.isfinite(feed), v / feed, 0.0),
+                "axis velocity": np.max(np.abs(dq) * v[:, None] / lim.v_max, axis=1),
+                "axis acceleration": np.max(np.abs(dq * a[:, None] + ddq * (v * v)[:, None])
+                                            / lim.a_max, axis=1),
+            }
+            if jerk:
+                jr = dq * j[:, None] + 3 * ddq * (v * a)[:, None] + dddq * (v ** 3)[:, None]
+                ratios["jerk"] = np.max(np.abs(jr) / lim.j_max, axis=1)
+        for c in names:
+            tight[c] += np.bincount(b, weights=w * (ratios[c] >= 1.0 - TIGHT_REL),
+                                    minlength=n_blocks)
+        braking += np.bincount(b, weights=w * (a < 0), minlength=n_blocks)
+    end_kind = _block_end_kind(path, profile, lim)
+    out: dict[int, str] = {}
+    for span in path.blocks:
+        i = span.block
+        T = time[i]
+        if T <= 0:
+            out[i] = "-"
+            continue
+        if span.s_end <= span.s_start:          # a hold: dwell or stop without motion
+            out[i] = _stop_cause(span.stop_reason) if span.stop_reason else "-"
+            continue
+        shares = {c: tight[c][i] / T for c in names}
+        best = max(shares, key=shares.get)
+        end = end_kind.get(i, "")
+        if end and braking[i] / T >= 0.5:
+            out[i] = end
+        elif shares[best] >= MIN_SHARE:
+            out[i] = best
+        else:
+            out[i] = end or "none"
+    return out
+
+
+def _stop_cause(reason: str) -> str:
+    return "exact stop" if reason.startswith("exact") else "forced stop"
+
+
+def _block_end_kind(path: Path, profile: Profile, lim) -> dict[int, str]:
+    """Blocks that end in a required stop or in a corner crossed at the jump allowance."""
+    out: dict[int, str] = {}
+    if path.n_segments == 0:
+        return out
+    t_in, t_out = path.junction_tangents()
+    corners: list[tuple[int, int]] = []
+    for span in path.blocks:
+        if span.n_segments == 0:
+            continue
+        k = span.first_segment + span.n_segments          # break at the block end
+        if path.stop[k]:
+            out[span.block] = _stop_cause(path.stop_reason[k]) if k < path.n_segments \
+                else "forced stop"                        # the program end
+        elif np.any(np.abs(t_out[k - 1] - t_in[k - 1]) > 1e-9):
+            corners.append((span.block, k))
+    if corners:
+        ks = np.array([k for _, k in corners])
+        v_end = profile.state(profile.time_at(path.s_breaks[ks]))[1]
+        dt = np.abs(t_out[ks - 1] - t_in[ks - 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            v_allow = np.min(np.where(dt > 1e-9, lim.jump[None, :] / dt, np.inf), axis=1)
+        for (b, _), ve, va in zip(corners, v_end, v_allow):
+            if ve >= (1.0 - TIGHT_REL) * va:
+                out[b] = "corner rule"
+    return out

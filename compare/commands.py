@@ -1,0 +1,423 @@
+"""Sub-commands plan, optimize, compare and check (registered by :mod:`compare.cli`).
+
+Exit codes (DESIGN section 7): 0 all good; 1 a gap above ``--max-gap``, a limit
+violation, or an oracle without certified bounds (nothing certifies the program then);
+2 bad input (one message on stderr naming file and line, never a traceback).
+
+``--max-gap`` takes percent: ``15%`` and ``15`` both mean 15 %; ``0.5`` means 0.5 %
+(not 50 %). The gate compares the *upper* end of the gap interval,
+``t_ref/LB - 1``, with it, so a program passes only when its gap is certified to be
+within the gate.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path as FsPath
+from typing import Callable, Sequence, TextIO
+
+from reference.core.constraints import BOUND_SETS
+from reference.core.errors import FeedOracleError
+from reference.machine import load_machine
+from reference.nc import parse_file
+from reference.prepare import unmodelled_features
+
+from . import engines
+from .comparison import Comparison, compare, describe_violation, format_interval
+from .export import (comparison_dict, blocks_csv, profile_samples, write_json,
+                     write_samples_csv)
+
+EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class UsageError(FeedOracleError, ValueError):
+    """A command-line value that does not parse (exit 2)."""
+
+
+def parse_max_gap(text: str) -> float:
+    """``--max-gap`` as a fraction: ``"15%"`` and ``"15"`` -> 0.15, ``"0.5"`` -> 0.005.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        Not a finite number >= 0.
+    """
+    raw = text.strip()
+    body = raw[:-1].strip() if raw.endswith("%") else raw
+    try:
+        pct = float(body)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--max-gap {text!r}: expected percent, e.g. 15% or 15") from None
+    if not (math.isfinite(pct) and pct >= 0):
+        raise argparse.ArgumentTypeError(f"--max-gap {text!r}: must be a percentage >= 0")
+    return pct / 100.0
+
+
+def _mm(text: str) -> float:
+    """A length >= 0 in mm (``--max-deviation``)."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x >= 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a length >= 0 in mm")
+    return x
+
+
+# --------------------------------------------------------------------- registration
+def register(sub: argparse._SubParsersAction, common: Callable) -> None:
+    """Add plan, optimize, compare and check to the CLI parser."""
+    sp = sub.add_parser("plan", help="heuristic only: per-block times, speeds and causes")
+    sp.add_argument("program")
+    sp.add_argument("--json", metavar="F", help="write the 'reference' part as JSON ('-' = stdout)")
+    sp.add_argument("--csv", metavar="F",
+                    help="write the motion sampled at the IPO cycle: t, s, v and every axis")
+    common(sp)
+    sp.set_defaults(func=cmd_plan)
+
+    sp = sub.add_parser("optimize", help="oracle only: certified bounds on the optimal time")
+    sp.add_argument("program")
+    sp.add_argument("--bounds", choices=engines.BOUND_CHOICES[1:], default="acc",
+                    help="constraint set of the oracle (default acc)")
+    sp.add_argument("--json", metavar="F", help="write the 'oracle' part and block rows as JSON")
+    sp.add_argument("--csv", metavar="F",
+                    help="write the verified optimal motion sampled at the IPO cycle")
+    common(sp)
+    sp.set_defaults(func=cmd_optimize)
+
+    sp = sub.add_parser(
+        "compare", help="heuristic vs oracle, block by block; reports and a CI gate",
+        description="Compare the heuristic with the time-optimal motion, block by block. "
+                    "Exit 0 good, 1 gap above --max-gap or a limit violation, 2 bad input.")
+    sp.add_argument("programs", nargs="+", metavar="PROGRAM")
+    sp.add_argument("--bounds", choices=engines.BOUND_CHOICES, default="auto",
+                    help="oracle constraint set; auto = the heuristic's own where the "
+                         "oracle can solve it, else acc (with a note)")
+    sp.add_argument("--report", metavar="DIR", default="reports",
+                    help="write HTML, JSON and CSV per program here (default: reports)")
+    sp.add_argument("--no-report", action="store_true", help="write no report files")
+    sp.add_argument("--json", metavar="F",
+                    help="write the result as JSON (several programs: a JSON array)")
+    sp.add_argument("--max-gap", metavar="PCT", type=parse_max_gap, default=None,
+                    help="fail (exit 1) when the gap may exceed PCT percent: '15%%' or "
+                         "'15' mean 15 %%, '0.5' means 0.5 %%; compared with the upper "
+                         "end t_ref/LB - 1 of the certified gap interval")
+    common(sp)
+    sp.set_defaults(func=cmd_compare)
+
+    sp = sub.add_parser(
+        "check", help="a recorded trajectory (CSV t,X,Y,Z...) against limits and oracle",
+        description="Read a trajectory recorded from any controller or simulator (CSV "
+                    "with header t,X,Y,Z[,A,...] in s and mm/degrees), project it onto "
+                    "the program's path, check it against the machine limits and compare "
+                    "it block by block with the oracle.")
+    sp.add_argument("trajectory", metavar="TRAJECTORY.csv")
+    sp.add_argument("--program", required=True, metavar="P", help="the NC program it ran")
+    sp.add_argument("--bounds", choices=tuple(BOUND_SETS), default=None,
+                    help="constraints the trajectory must keep (default acc: velocity, "
+                         "acceleration, feed, corner jumps, stops; jerk from samples is "
+                         "shown for information unless --bounds jerk)")
+    sp.add_argument("--path", choices=("reference", "programmed"), default="reference",
+                    dest="path_kind",
+                    help="project onto the heuristic's path (with its corner rounding, "
+                         "default) or onto the programmed contour")
+    sp.add_argument("--max-deviation", metavar="MM", type=_mm, default=None,
+                    help="fail (exit 1) when the trajectory is farther than MM from the "
+                         "path (default: 0.1 mm, or 5 x the noise level)")
+    sp.add_argument("--smoothing", metavar="MM", default="auto",
+                    help="position noise to smooth away, mm: 'auto' (estimated from the "
+                         "samples), 0 (interpolate exactly) or a value")
+    sp.add_argument("--report", metavar="DIR", default=None,
+                    help="also write an HTML/JSON/CSV report into DIR")
+    sp.add_argument("--json", metavar="F", help="write the result as JSON")
+    common(sp)
+    sp.set_defaults(func=cmd_check)
+
+
+# --------------------------------------------------------------------- helpers
+def _load(program_file: str, args: argparse.Namespace):
+    machine = load_machine(args.machine)
+    program = parse_file(program_file, dialect=args.dialect)
+    for w in tuple(program.warnings) + unmodelled_features(program):
+        print(str(w), file=sys.stderr)
+    return program, machine
+
+
+def _prefixed(progress, prefix: str):
+    """A progress callback that prefixes messages (``None``-safe)."""
+    if progress is None:
+        return None
+    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
+
+
+def _ms(x: float) -> str:
+    return "-" if not math.isfinite(x) else f"{1e3 * x:+.1f}"
+
+
+def _num(x: float, nd: int = 3) -> str:
+    if isinstance(x, float) and math.isnan(x):
+        return "-"
+    if isinstance(x, float) and math.isinf(x):
+        return "inf"
+    return f"{x:.{nd}f}"
+
+
+def _block_table(rows, out: TextIO, limit: int | None = None) -> None:
+    out.write(f"    {'line':>5} {'label':<8} {'kind':<8} {'length_mm':>9} {'t_ref_s':>8} "
+              f"{'t_opt_s':>8} {'gap_ms':>8} {'v_exit ref/opt mm/s':>19}  limit (ref / opt)\n")
+    for r in list(rows)[:limit]:
+        vx = f"{r.v_exit_reference:.1f}/{_num(r.v_exit_oracle, 1)}"
+        kind = r.kind if not r.corner else f"{r.kind}@{r.corner[0]}"
+        out.write(f"    {r.line:>5} {r.label[:8]:<8} {kind[:8]:<8} {r.length_mm:>9.3f} "
+                  f"{r.t_reference_s:>8.4f} {_num(r.t_oracle_s, 4):>8} {_ms(r.gap_s):>8} "
+                  f"{vx:>19}  {r.limit_reference} / {r.limit_oracle}\n")
+
+
+def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
+                     n_worst: int = 5) -> None:
+    """The text summary of one comparison (totals, gap, verdict, notes, worst blocks)."""
+    v = c.verdict(max_gap)
+    who = "recorded" if c.reference_name == "recorded" else "heuristic"
+    out.write(f"{c.program}: machine {c.machine!r}, oracle bounds {c.bounds}, "
+              f"{who} bounds {c.reference_bounds}\n")
+    viol = c.reference_violations
+    out.write(f"  {who:<10} {c.t_reference_s:10.4f} s   "
+              f"{'no violations of ' + ', '.join(BOUND_SETS[c.reference_bounds]) if not viol else str(len(viol)) + ' violation(s)'}\n")
+    for item in viol:
+        out.write(f"    VIOLATION {describe_violation(item, c)}\n")
+    o = c.oracle
+    out.write(f"  {'oracle':<10} LB {_num(o.lower_bound_s, 4)} s, UB {_num(o.upper_bound_s, 4)} s"
+              f"   ({o.status}, {o.grid_points} grid points, {o.solve_time_s:.2f} s)\n")
+    for item in c.oracle_violations:
+        out.write(f"    ORACLE VIOLATION {describe_violation(item, c)}\n")
+    if c.certified:
+        valid = "" if c.gap_lower_valid else "   (lower end: gap to the relaxation only)"
+        out.write(f"  {'gap':<10} {format_interval(c)}   [t_ref/UB - 1, t_ref/LB - 1]{valid}\n")
+    out.write(f"  {'verdict':<10} {'ok' if v.ok else 'FAIL'}: {v.text}\n")
+    for note in c.notes:
+        out.write(f"  note: {note}\n")
+    worst = c.worst_blocks(n_worst)
+    if worst:
+        out.write(f"  largest block gaps:\n")
+        _block_table(worst, out)
+
+
+# --------------------------------------------------------------------- plan
+def _rows_table(rows, out: TextIO, t_key: str, v_key: str, limit_key: str) -> None:
+    out.write(f"    {'line':>5} {'label':<8} {'kind':<8} {'length_mm':>9} {'t_s':>8} "
+              f"{'v_exit':>8}  limit\n")
+    for r in rows:
+        out.write(f"    {r.get('line', 0):>5} {str(r.get('label', ''))[:8]:<8} "
+                  f"{str(r.get('kind', ''))[:8]:<8} {r.get('length_mm', 0.0):>9.3f} "
+                  f"{_num(r.get(t_key) or 0.0, 4):>8} {_num(r.get(v_key) or 0.0, 1):>8}"
+                  f"  {r.get(limit_key, '')}\n")
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """``feedoracle plan``: run the heuristic, print its block table."""
+    from reference.planner import ipo_samples, to_json_dict
+    program, machine = _load(args.program, args)
+    plan = engines.run_heuristic(program, machine, progress=args.progress)
+    args.progress.done()
+    doc = to_json_dict(plan)
+    if args.json:
+        write_json(doc, args.json)
+    if args.csv:
+        header, data = ipo_samples(plan)
+        write_samples_csv(header, data, args.csv)
+    out = sys.stdout if args.json != "-" and args.csv != "-" else sys.stderr
+    viol = plan.report.violations(BOUND_SETS[plan.bound_set]) if plan.report else ()
+    out.write(f"{program.file}: machine {machine.name!r}, heuristic bounds {plan.bound_set}, "
+              f"time {plan.profile.duration:.4f} s, "
+              f"{'no violations' if not viol else str(len(viol)) + ' violation(s)'}\n")
+    for v in viol:
+        out.write(f"  VIOLATION {v.constraint} {v.axis or ''} ratio {v.ratio:.4g} at "
+                  f"s = {v.s:.3f} mm, t = {v.t:.4f} s\n")
+    _rows_table(doc.get("blocks", []), out, "t_reference_s", "v_exit_reference",
+                "limit_reference")
+    return EXIT_FAIL if viol else EXIT_OK
+
+
+# --------------------------------------------------------------------- optimize
+def cmd_optimize(args: argparse.Namespace) -> int:
+    """``feedoracle optimize``: the oracle on the heuristic's path."""
+    import optimal
+    bounds, _ = engines.resolve_bounds(args.bounds, None)
+    program, machine = _load(args.program, args)
+    plan = engines.run_heuristic(program, machine, progress=_prefixed(args.progress, "path: "))
+    sol = engines.run_oracle(plan.path, machine.limits, bounds,
+                             progress=_prefixed(args.progress, "oracle: "))
+    args.progress.done()
+    d = optimal.to_json_dict(sol)
+    o = d.get("oracle", d)
+    spans = {b.block: b for b in plan.path.blocks}
+    rows = []
+    for r in d.get("blocks", []):
+        sp = spans.get(int(r.get("block", -1)))
+        rows.append({"block": sp.block, "line": max(1, sp.line), "label": sp.label,
+                     "kind": sp.kind, "length_mm": sp.length, **r} if sp else dict(r))
+    if args.json:
+        doc = {"program": program.file, "machine": machine.name, "bounds": bounds,
+               "oracle": {k: (0.0 if v is None else v) for k, v in o.items()},
+               "blocks": [{k: v for k, v in r.items() if v is not None} for r in rows]}
+        write_json(doc, args.json)
+    if args.csv and sol.profile is not None:
+        header, data = profile_samples(plan.path, sol.profile, machine.limits.t_ipo_s)
+        write_samples_csv(header, data, args.csv)
+    out = sys.stdout if args.json != "-" and args.csv != "-" else sys.stderr
+    out.write(f"{program.file}: machine {machine.name!r}, bounds {bounds}: status "
+              f"{o.get('status')}, LB {_num(o.get('lower_bound_s') or math.nan, 4)} s, UB "
+              f"{_num(o.get('upper_bound_s') or math.nan, 4)} s ({o.get('grid_points', 0)} "
+              f"grid points, {o.get('solve_time_s', 0.0):.2f} s)\n")
+    _rows_table(rows, out, "t_oracle_s", "v_exit_oracle", "limit_oracle")
+    ok = o.get("status") in ("optimal", "gap_not_met")
+    return EXIT_OK if ok else EXIT_FAIL
+
+
+# --------------------------------------------------------------------- compare
+def _report_stems(files: Sequence[str]) -> list[str]:
+    """Unique file stems for report names (``dir_name`` when two stems collide)."""
+    stems = [FsPath(f).stem for f in files]
+    out = []
+    for f, st in zip(files, stems):
+        if stems.count(st) > 1:
+            parent = FsPath(f).resolve().parent.name or "root"
+            st = f"{parent}_{st}"
+        base, k = st, 2
+        while st in out:
+            st, k = f"{base}_{k}", k + 1
+        out.append(st)
+    return out
+
+
+def compare_program(program_file: str, args: argparse.Namespace, prefix: str = ""
+                    ) -> tuple[Comparison, object]:
+    """Plan, solve and compare one program (the work of ``compare`` per program)."""
+    program, machine = _load(program_file, args)
+    plan = engines.run_heuristic(program, machine,
+                                 progress=_prefixed(args.progress, f"{prefix}heuristic: "))
+    bounds, notes = engines.resolve_bounds(args.bounds, getattr(plan, "bound_set", None))
+    sol = engines.run_oracle(plan.path, machine.limits, bounds,
+                             progress=_prefixed(args.progress, f"{prefix}oracle: "))
+    c = compare(plan, sol, limits=machine.limits, program=program, machine=machine.name)
+    if notes:
+        from dataclasses import replace
+        c = replace(c, notes=tuple(notes) + c.notes)
+    return c, machine
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    """``feedoracle compare``: heuristic vs oracle per program; reports; the CI gate."""
+    files = list(args.programs)
+    for f in files:
+        if not FsPath(f).is_file():
+            raise UsageError(f"{f}: no such program file")
+    if args.bounds != "auto":
+        engines.resolve_bounds(args.bounds, None)       # an unavailable set: exit 2 now
+    stems = _report_stems(files)
+    out = sys.stdout if args.json != "-" else sys.stderr
+    results: list[tuple[str, Comparison]] = []
+    docs = []
+    report_dir = None if args.no_report else FsPath(args.report)
+    n = len(files)
+    for i, (f, stem) in enumerate(zip(files, stems)):
+        prefix = f"[{i + 1}/{n}] {f}: " if n > 1 else f"{f}: "
+        c, machine = compare_program(f, args, prefix)
+        args.progress.done()
+        doc = comparison_dict(c, args.max_gap)
+        docs.append(doc)
+        results.append((stem, c))
+        if report_dir is not None:
+            args.progress(f"{prefix}writing report", -1.0)
+            _write_program_report(report_dir, stem, c, doc, args.max_gap)
+            args.progress.done()
+        if n == 1:
+            print_comparison(c, args.max_gap, out)
+    if n > 1:
+        print_summary(results, args.max_gap, out)
+    if report_dir is not None:
+        if n > 1:
+            from .report_html import write_index
+            index = write_index(report_dir, results, args.max_gap)
+            out.write(f"report: {index}; open {index.resolve().as_uri()}\n")
+        else:
+            page = report_dir / (stems[0] + ".html")
+            out.write(f"report: {page} (also {stems[0]}.json, {stems[0]}.csv); open "
+                      f"{page.resolve().as_uri()}\n")
+    if args.json:
+        write_json(docs[0] if n == 1 else docs, args.json)
+    failed = [(s, c) for s, c in results if not c.verdict(args.max_gap).ok]
+    if failed:
+        err = sys.stderr
+        for _, c in failed:
+            v = c.verdict(args.max_gap)
+            err.write(f"FAIL {c.program}: {v.status}: {v.text}\n")
+            if v.status == "gap above gate":
+                for r in c.worst_blocks(5):
+                    lab = f" {r.label}" if r.label else ""
+                    err.write(f"  line {r.line}{lab} ({r.kind}): {1e3 * r.gap_s:+.1f} ms, "
+                              f"heuristic limited by {r.limit_reference}, oracle by "
+                              f"{r.limit_oracle}\n")
+        return EXIT_FAIL
+    return EXIT_OK
+
+
+def print_summary(results: Sequence[tuple[str, Comparison]], max_gap: float | None,
+                  out: TextIO) -> None:
+    """One table row per program: times, bounds, gap interval, verdict."""
+    w = max(7, max(len(c.program) for _, c in results))
+    out.write(f"{'program':<{w}} {'t_ref_s':>9} {'LB_s':>9} {'UB_s':>9} {'gap':>16} "
+              f"{'viol':>4}  verdict\n")
+    for _, c in results:
+        v = c.verdict(max_gap)
+        gap = format_interval(c) if c.certified else "-"
+        out.write(f"{c.program:<{w}} {c.t_reference_s:>9.4f} {_num(c.oracle.lower_bound_s, 4):>9} "
+                  f"{_num(c.oracle.upper_bound_s, 4):>9} {gap:>16} "
+                  f"{len(c.reference_violations):>4}  {'ok' if v.ok else 'FAIL ' + v.status}\n")
+    if max_gap is not None:
+        out.write(f"gate: gap upper end t_ref/LB - 1 <= {100 * max_gap:g} %\n")
+
+
+def _write_program_report(folder: FsPath, stem: str, c: Comparison, doc: dict,
+                          max_gap: float | None, title: str | None = None) -> None:
+    from .report_html import write_report
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json(doc, folder / f"{stem}.json")
+    (folder / f"{stem}.csv").write_text(blocks_csv(c), encoding="utf-8")
+    write_report(folder / f"{stem}.html", c, max_gap=max_gap, title=title,
+                 links={"JSON": f"{stem}.json", "CSV": f"{stem}.csv"})
+
+
+# --------------------------------------------------------------------- check
+def cmd_check(args: argparse.Namespace) -> int:
+    """``feedoracle check``: a recorded trajectory against limits and the oracle."""
+    from .recorded import check_recorded
+    program, machine = _load(args.program, args)
+    smoothing = args.smoothing
+    if smoothing != "auto":
+        try:
+            smoothing = float(smoothing)
+        except ValueError:
+            raise UsageError(f"--smoothing {args.smoothing!r}: 'auto' or a noise level "
+                             f"in mm") from None
+        if not (math.isfinite(smoothing) and smoothing >= 0):
+            raise UsageError(f"--smoothing {args.smoothing!r}: must be >= 0 mm")
+    result = check_recorded(args.trajectory, program, machine, bounds=args.bounds,
+                            path_kind=args.path_kind, smoothing=smoothing,
+                            max_deviation=args.max_deviation, progress=args.progress)
+    args.progress.done()
+    out = sys.stdout if args.json != "-" else sys.stderr
+    result.print(out)
+    doc = result.to_dict()
+    if args.report:
+        folder = FsPath(args.report)
+        stem = FsPath(args.trajectory).stem
+        _write_program_report(folder, stem, result.comparison, doc, None,
+                              title=f"{args.trajectory} on {program.file}")
+        out.write(f"report: {folder / (stem + '.html')}\n")
+    if args.json:
+        write_json(doc, args.json)
+    return EXIT_OK if result.ok else EXIT_FAIL

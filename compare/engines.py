@@ -1,0 +1,68 @@
+"""The two planners as the CLI runs them: the heuristic and the oracle, on one path.
+
+The only module of ``compare`` that calls into ``reference.planner`` and ``optimal``
+(the comparison itself reads their results through :mod:`compare.comparison`).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from reference.core.errors import FeedOracleError
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.machine import Machine
+from reference.nc.program import Program
+
+ProgressFn = Callable[[str, float], None]
+
+#: Bound sets the ``--bounds`` option names (``auto`` picks one, see :func:`resolve_bounds`).
+BOUND_CHOICES = ("auto", "acc", "jerk", "jerk+freq")
+
+
+class BoundsNotAvailable(FeedOracleError, ValueError):
+    """A bound set the oracle cannot solve yet (exit 2)."""
+
+
+def oracle_bound_sets() -> tuple[str, ...]:
+    """Bound sets the installed oracle solves."""
+    from optimal import oracle
+    return tuple(getattr(oracle, "SUPPORTED_BOUNDS", ("acc",)))
+
+
+def resolve_bounds(requested: str, planner_bounds: str | None) -> tuple[str, tuple[str, ...]]:
+    """The oracle bound set for ``--bounds``, and notes for the report.
+
+    ``auto`` asks for the planner's own bound set (``jerk`` for a SOFT heuristic) and
+    falls back to ``acc`` while the oracle cannot solve it, with a note saying what that
+    means for the gap interval. An explicit unavailable set is an input error.
+
+    Raises
+    ------
+    BoundsNotAvailable
+        ``jerk`` or ``jerk+freq`` requested explicitly but not available.
+    """
+    available = oracle_bound_sets()
+    if requested != "auto":
+        if requested not in available:
+            raise BoundsNotAvailable(f"bound set {requested!r} is not available yet; "
+                                     f"use --bounds {' or '.join(available)}")
+        return requested, ()
+    want = planner_bounds or "acc"
+    if want in available:
+        return want, ()
+    return "acc", (f"--bounds auto: the heuristic keeps the {want!r} bound set (SOFT); "
+                   f"the oracle cannot solve that yet and solved 'acc' instead.",)
+
+
+def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | None = None):
+    """``reference.planner.plan`` (the SINUMERIK-style heuristic)."""
+    from reference.planner import plan
+    return plan(program, machine, progress=progress)
+
+
+def run_oracle(path: Path, limits: MachineLimits, bounds: str,
+               progress: ProgressFn | None = None):
+    """``optimal.solve`` on ``path`` under ``bounds``."""
+    import optimal
+    return optimal.solve(path, limits, bounds=bounds, progress=progress)

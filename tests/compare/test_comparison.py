@@ -1,0 +1,163 @@
+"""compare(): per-block accounting, the gap interval, causes, notes and the verdict."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from conftest import SMALL, path_of
+from fakes import FakeSolution, fake_plan, fake_solution, toy_profile
+
+from compare.comparison import (BlockRow, OracleResult, Side, compare, compare_profiles,
+                                normalise_cause)
+from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
+
+
+@pytest.fixture
+def small(machine):
+    program, path = path_of(SMALL, machine)
+    return program, path, fake_plan(path, machine.limits), fake_solution(path, machine.limits)
+
+
+def test_block_times_sum_to_the_totals_on_both_sides(small, machine):
+    program, path, plan, sol = small
+    c = compare(plan, sol, program=program)
+    assert len(c.rows) == len(path.blocks)
+    assert sum(r.t_reference_s for r in c.rows) == pytest.approx(plan.profile.duration, rel=1e-12)
+    assert sum(r.t_oracle_s for r in c.rows) == pytest.approx(sol.profile.duration, rel=1e-12)
+    assert sum(r.gap_s for r in c.rows) == pytest.approx(c.t_reference_s - c.t_oracle_s,
+                                                         abs=1e-12)
+    assert sum(r.length_mm for r in c.rows) == pytest.approx(path.total_length)
+
+
+def test_gap_interval_is_t_ref_over_ub_and_lb(small):
+    program, path, plan, sol = small
+    c = compare(plan, sol, program=program)
+    t = plan.profile.duration
+    assert c.gap_lower == pytest.approx(t / sol.upper_bound_s - 1, rel=1e-14)
+    assert c.gap_upper == pytest.approx(t / sol.lower_bound_s - 1, rel=1e-14)
+    assert c.gap_lower < c.gap_upper
+    assert c.gap_lower_valid and c.certified
+
+
+def test_rows_carry_speeds_sources_and_causes(small):
+    program, path, plan, sol = small
+    c = compare(plan, sol, program=program)
+    by_line = {r.line: r for r in c.rows}
+    r = by_line[3]                                   # N20 G1 X50 Y0: corner at its end
+    assert r.source == "N20 G1 X50 Y0" and r.label == "N20" and r.kind == "G1"
+    assert r.v_entry_reference == 0.0 and r.v_entry_oracle == 0.0      # program start
+    assert 0 < r.v_exit_reference <= r.v_peak_reference <= 100.0 + 1e-9
+    assert r.limit_reference == "axis acceleration"                  # what the plan says
+    assert r.limit_oracle == "feed"                                  # derived
+    stop = by_line[6]                                # N50 G9: exact stop at its end
+    assert stop.v_exit_reference == 0.0 and stop.v_exit_oracle == 0.0
+    assert stop.stop_reason.startswith("exact stop")
+
+
+def test_negative_block_gap_gets_a_note(small, machine):
+    program, path, plan, sol = small
+    # an "oracle" that is slower than the plan in the first moving block only
+    slow = toy_profile(path, machine.limits, 0.35)
+    fake = FakeSolution("optimal", slow, slow.duration / 1.002, slow.duration)
+    c = compare(plan, fake, program=program)
+    neg = [r for r in c.rows if r.gap_s < -1e-6]
+    assert neg and all("negative by" in r.note for r in neg)
+    assert all("at every point of the path" in r.note for r in neg)      # acc bounds
+    assert any("negative gap" in n for n in c.notes)
+    assert not [r for r in c.rows if r.gap_s >= 0 and r.note]
+
+
+def test_jerk_bounded_oracle_explains_negative_gaps_differently(small):
+    program, path, plan, sol = small
+    c = compare(plan, FakeSolution("optimal", plan.profile, 1.0, 2.0), program=program)
+    note_rows = [r for r in c.rows if r.note]
+    assert not note_rows                                  # identical profiles: no gap
+    # a jerk oracle explains a negative gap by the global optimum
+    from compare.comparison import _gap_note
+    text = _gap_note(-0.01, 0.5, 0.002, "jerk", 1, 2, 3, 4)
+    assert "minimises the total time, not each block" in text
+
+
+def test_soft_heuristic_against_acc_oracle_is_a_relaxation(small):
+    program, path, plan, sol = small
+    c = compare(replace(plan, bound_set="jerk", report=None), sol, program=program)
+    assert not c.gap_lower_valid
+    assert any("relaxation" in n and "t_ref/LB - 1 is a valid upper end" in n for n in c.notes)
+    # the jerk bound set judges the plan's jerk: the fake (BRISK-like) breaks it
+    v = c.verdict(None)
+    assert any(x.constraint == "jerk" for x in c.reference_violations)
+    assert not v.ok and v.status == "violation"
+    # without that violation the verdict gives only the certified upper end
+    v = replace(c, reference_ratio_tol=1e9).verdict(None)
+    assert v.ok and "at most" in v.text and "relaxation" in v.text
+
+
+def test_verdict_gate_uses_the_upper_end(small):
+    program, path, plan, sol = small
+    c = compare(plan, sol, program=program)
+    assert c.verdict(None).ok
+    assert c.verdict(c.gap_upper + 1e-6).ok
+    v = c.verdict((c.gap_lower + c.gap_upper) / 2)        # between the ends: fails
+    assert not v.ok and v.status == "gap above gate"
+
+
+def test_oracle_without_certificate_fails(small):
+    program, path, plan, sol = small
+    bad = FakeSolution("solver_error", None, math.nan, math.nan)
+    c = compare(plan, bad, program=program)
+    assert not c.certified
+    v = c.verdict(None)
+    assert not v.ok and v.status == "no certificate"
+    assert all(math.isnan(r.t_oracle_s) for r in c.rows)
+
+
+def test_inserted_blocks_are_attributed_to_their_corner(machine):
+    # two lines with an inserted "rounding" segment between them (block index 2)
+    pieces = [line_segments(np.array([[0, 0, 0.]]), np.array([[9, 0, 0.]]),
+                            np.array([True] * 3), np.array([0]))]
+    ins = line_segments(np.array([[9, 0, 0.]]), np.array([[10, 1, 0.]]),
+                        np.array([True] * 3), np.array([2]))
+    ins["kind"][:] = 2                                     # "rounding"
+    pieces.append(ins)
+    pieces.append(line_segments(np.array([[10, 1, 0.]]), np.array([[10, 10, 0.]]),
+                                np.array([True] * 3), np.array([1])))
+    L = [9.0, math.sqrt(2), 9.0]
+    sb = np.concatenate(([0], np.cumsum(L)))
+    spans = (BlockSpan(0, 2, "N10", "G1", sb[0], sb[1], 0, 1, 50.0),
+             BlockSpan(2, 2, "", "rounding", sb[1], sb[2], 1, 1, 50.0),
+             BlockSpan(1, 3, "N20", "G1", sb[2], sb[3], 2, 1, 50.0))
+    path = path_from_pieces(("X", "Y", "Z"), pieces, feed=50.0, blocks=spans)
+    plan = fake_plan(path, machine.limits)
+    c = compare(plan, fake_solution(path, machine.limits))
+    rows = {r.block: r for r in c.rows}
+    assert rows[2].inserted and rows[2].corner == (2, 3) and rows[2].line == 2
+    assert not rows[0].inserted and rows[0].corner is None
+    assert sum(r.t_reference_s for r in c.rows) == pytest.approx(plan.profile.duration)
+
+
+def test_oracle_labels_map_to_the_shared_vocabulary():
+    span = BlockSpan(3, 7, "", "G1", 0.0, 1.0, 0, 1, stop_reason="exact stop G9")
+    idle = BlockSpan(4, 8, "", "none", 1.0, 1.0, 1, 0, stop_reason="dwell G4 0.2 s")
+    assert normalise_cause("acceleration X") == "axis acceleration"
+    assert normalise_cause("velocity Z") == "axis velocity"
+    assert normalise_cause("velocity_jump") == "corner rule"
+    assert normalise_cause("feed") == "feed"
+    assert normalise_cause("stop", span) == "exact stop"
+    assert normalise_cause("dwell G4 0.2 s", idle) == "forced stop"
+    assert normalise_cause("") == "-"
+    assert normalise_cause("look-ahead horizon") == "look-ahead horizon"
+
+
+def test_compare_profiles_accepts_any_side(small, machine):
+    program, path, plan, sol = small
+    side = Side("recorded", plan.profile, "acc")
+    oracle = OracleResult("optimal", sol.profile, sol.lower_bound_s, sol.upper_bound_s)
+    c = compare_profiles(path, machine.limits, side, oracle, program="x.mpf")
+    assert c.reference_name == "recorded"
+    assert "recorded trajectory" in c.verdict(None).text
+    assert all(isinstance(r, BlockRow) for r in c.rows)
+    assert all(r.limit_reference for r in c.rows)            # derived causes

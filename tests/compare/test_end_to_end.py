@@ -1,0 +1,136 @@
+"""The real heuristic and the real oracle through compare, reports, JSON and exit codes.
+
+One program (the bundled demo) goes through plan + solve + compare + HTML + JSON schema
+validation + exit codes; the heuristic's own IPO-cycle CSV read back by ``check``
+reproduces its numbers; the CI gate's thresholds in examples/gate.txt hold.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+from compare import cli
+from compare.commands import parse_max_gap
+from compare.comparison import compare
+from compare.export import schema
+from reference.machine import load_machine
+from reference.nc import parse_file
+
+DEMO = ROOT / "examples" / "demo.mpf"
+SLOT = ROOT / "examples" / "slot.ngc"
+GATE = ROOT / "examples" / "gate.txt"
+
+pytestmark = pytest.mark.xdist_group("end_to_end")
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    """``feedoracle compare examples/demo.mpf`` with report and JSON (run once)."""
+    out = tmp_path_factory.mktemp("demo")
+    r = subprocess.run([sys.executable, "-m", "compare", "compare", str(DEMO), "--report",
+                        str(out / "rep"), "--json", str(out / "demo.json")],
+                       capture_output=True, text=True, cwd=ROOT, timeout=600)
+    return r, out
+
+
+def test_demo_compare_exit_0_report_and_valid_json(demo):
+    r, out = demo
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "Traceback" not in r.stderr
+    doc = json.loads((out / "demo.json").read_text())
+    jsonschema.validate(doc, schema())
+    ref, orc, gap = doc["reference"], doc["oracle"], doc["gap"]
+    assert orc["status"] == "optimal"
+    assert 0 < orc["lower_bound_s"] <= orc["upper_bound_s"] <= ref["time_s"]
+    assert gap["lower"] == pytest.approx(ref["time_s"] / orc["upper_bound_s"] - 1)
+    assert gap["upper"] == pytest.approx(ref["time_s"] / orc["lower_bound_s"] - 1)
+    assert ref["violations"] == [] and orc["violations"] == []
+    # per-block accounting on both sides
+    assert sum(b["t_reference_s"] for b in doc["blocks"]) == pytest.approx(ref["time_s"],
+                                                                          rel=1e-9)
+    assert sum(b["t_oracle_s"] for b in doc["blocks"]) == pytest.approx(
+        orc["upper_bound_s"], rel=1e-9)
+    causes = {b["limit_reference"] for b in doc["blocks"]} | \
+        {b["limit_oracle"] for b in doc["blocks"]}
+    assert causes <= {"feed", "axis velocity", "axis acceleration", "jerk", "frequency",
+                      "corner rule", "look-ahead horizon", "IPO-cycle cap", "exact stop",
+                      "forced stop", "none", "-"}
+    html = (out / "rep" / "demo.html").read_text()
+    assert html.count('<img class="plot"') == 4
+    assert f"report: {out / 'rep' / 'demo.html'}" in r.stdout
+
+
+def test_library_api_block_times_sum_to_totals():
+    from reference.planner import plan
+    import optimal
+    machine = load_machine(None)
+    program = parse_file(DEMO)
+    p = plan(program, machine)
+    sol = optimal.solve(p.path, machine.limits, bounds="acc")
+    c = compare(p, sol, program=program)
+    assert sum(r.t_reference_s for r in c.rows) == pytest.approx(p.profile.duration, rel=1e-12)
+    assert sum(r.t_oracle_s for r in c.rows) == pytest.approx(sol.upper_bound_s, rel=1e-12)
+    assert c.gap_lower <= c.gap_upper
+    assert not c.gap_lower_valid                     # SOFT heuristic vs the acc oracle
+    assert c.verdict(None).ok
+    by_line = {r.line: r for r in c.rows}
+    assert by_line[24].stop_reason == "exact stop G9" and by_line[24].v_exit_reference == 0.0
+
+
+def test_gate_fails_and_names_blocks(tmp_path, capsys):
+    code = cli.main(["compare", str(DEMO), "--no-report", "--quiet", "--max-gap", "5%"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert f"FAIL {DEMO}: gap above gate" in err
+    assert "  line 24 N200 (G1):" in err
+
+
+def test_heuristic_csv_read_back_reproduces_its_numbers(tmp_path, capsys):
+    csv, pj, cj = tmp_path / "ipo.csv", tmp_path / "plan.json", tmp_path / "check.json"
+    assert cli.main(["plan", str(DEMO), "--csv", str(csv), "--json", str(pj)]) == 0
+    code = cli.main(["check", str(csv), "--program", str(DEMO), "--json", str(cj)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    plan_doc, check_doc = json.loads(pj.read_text()), json.loads(cj.read_text())
+    jsonschema.validate(plan_doc, schema())
+    jsonschema.validate(check_doc, schema())
+    assert check_doc["reference"]["time_s"] == pytest.approx(plan_doc["reference"]["time_s"],
+                                                             abs=1e-9)
+    t_plan = {b["block"]: b["t_reference_s"] for b in plan_doc["blocks"]}
+    err = [abs(b["t_reference_s"] - t_plan[b["block"]]) for b in check_doc["blocks"]]
+    t_ipo = load_machine(None).limits.t_ipo_s
+    assert max(err) <= t_ipo                          # within one IPO cycle per block
+    assert check_doc["recorded"]["max_deviation_mm"] < 1e-6
+    assert check_doc["reference"]["violations"] == []
+
+
+def test_optimize_json_and_csv(tmp_path, capsys):
+    js, csv = tmp_path / "o.json", tmp_path / "o.csv"
+    assert cli.main(["optimize", str(SLOT), "--json", str(js), "--csv", str(csv)]) == 0
+    doc = json.loads(js.read_text())
+    jsonschema.validate(doc, schema())
+    assert doc["bounds"] == "acc" and doc["oracle"]["status"] == "optimal"
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert csv.read_text().splitlines()[0] == "t,s,v,X,Y,Z"
+    assert data[-1, 0] == pytest.approx(doc["oracle"]["upper_bound_s"])
+
+
+def test_gate_thresholds_hold_today():
+    lines = [ln.split() for ln in GATE.read_text().splitlines()
+             if ln.strip() and not ln.startswith("#")]
+    assert lines
+    for prog, gap in lines:
+        r = subprocess.run([sys.executable, "-m", "compare", "compare", prog, "--no-report",
+                            "--quiet", "--max-gap", gap], capture_output=True, text=True,
+                           cwd=ROOT, timeout=600)
+        assert r.returncode == 0, f"{prog}: {r.stdout}{r.stderr}"
+        assert parse_max_gap(gap) > 0
