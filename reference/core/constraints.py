@@ -2,79 +2,163 @@
 
 ``check_profile(path, limits, profile)`` evaluates the motion analytically or densely
 *inside every interval* (never only at knots) and returns, per constraint, the worst
-ratio value/limit with its place (s, t, NC block, axis). A ratio <= 1 satisfies it.
+ratio ``value / limit`` with its place (path position, time, NC block, axis), plus the
+worst ratio of every NC block. A ratio <= 1 satisfies a constraint; the report counts a
+constraint as violated above ``1 + RATIO_TOL``.
 
-Constraints (:data:`CONSTRAINTS`):
+Notation: ``q'``, ``q''``, ``q'''`` are the path derivatives of the axis positions with
+respect to ``s`` (exact, from :class:`~reference.core.geometry.Path`), ``v = s'``,
+``s''`` and ``s'''`` the path velocity, acceleration and jerk of the
+:class:`~reference.core.profile.Profile`.
 
+Constraints (:data:`CONSTRAINTS`)
+---------------------------------
 ``velocity``
-    per-axis ``|q'_i v| <= v_max_i``.
+    per axis ``|q'_i v| <= v_max_i`` (mm/s; deg/s for rotary axes).
 ``acceleration``
-    per-axis ``|q'_i a + q''_i v^2| <= a_max_i`` (tangential plus centripetal part).
+    per axis ``|q'_i s'' + q''_i v^2| <= a_max_i`` (tangential plus centripetal part).
 ``jerk``
-    per-axis ``|q'_i j + 3 q''_i v a + q'''_i v^3| <= j_max_i`` inside intervals, and
-    every *step* of an axis acceleration (a knot where the path acceleration jumps, a
-    tangential segment break with a curvature jump) spread over one IPO cycle, as the
-    control does it: ``|delta a_i| / t_ipo`` against ``path_trans_jerk_i`` at breaks with
-    a curvature jump and ``j_max_i`` elsewhere. BRISK profiles therefore show large
-    jerk ratios by design; their bound set does not contain jerk.
+    per axis ``|q'_i s''' + 3 q''_i v s'' + q'''_i v^3| <= j_max_i`` inside intervals,
+    **plus acceleration steps**: wherever an axis acceleration ``A_i`` steps (a knot
+    where the path acceleration jumps, a segment break where the tangent or the
+    curvature vector jumps while moving, the start and end of the profile, whose
+    surroundings are taken to be at rest with zero acceleration), the control spreads
+    the step over one IPO cycle (sinumerik-model 6.3), so the step counts as the jerk
+    ``|delta A_i| / t_ipo``, ``A_i = q'_i s'' + q''_i v^2`` on each side. It is judged
+    against ``path_trans_jerk_i`` (MD32432) at a segment break where the curvature
+    vector jumps (a component by more than :data:`CURVATURE_JUMP_TOL_PER_MM`) while the
+    path moves (``v > VEL_TOL_MM_S``), and against ``j_max_i`` everywhere else. BRISK profiles (acceleration steps by design)
+    therefore show large jerk ratios; that is expected, their bound set has no jerk.
 ``feed``
-    path speed ``v <= F`` of the segment (no limit for G0).
+    path speed ``v <= F`` of the segment (``F = inf`` for G0: nothing to check). ``s``
+    is the arc length of the geometry axes, or of the moving axes where only extra
+    axes move; the feed applies to that speed as given.
 ``velocity_jump``
-    at a non-tangential break crossed at speed ``v``: per axis
-    ``v |q'_i(right) - q'_i(left)| <= a_max_i (ovl_i - 1) t_ipo`` (MD32310 rule); with
-    an allowance of 0 (ovl = 1) any jump gives ``inf``.
+    at every interior segment break whose tangents differ by more than
+    :data:`~reference.core.tolerances.TANGENT_TOL_RAD`, crossed at ``v > 0``: per axis
+    ``delta v_i = v |q'_i(right) - q'_i(left)|`` against the MD32310 allowance
+    ``jump_i = a_max_i (ovl_i - 1) t_ipo`` (sinumerik-model 4.1/4.2). A jump of at most
+    ``VEL_TOL_MM_S`` counts as none (ratio 0, as ``optimal.problem`` assumes). With an
+    allowance of 0 (``ovl = 1``) a larger jump has the ratio ``float('inf')`` (no
+    finite limit exists; JSON writers must encode it, e.g. as ``null`` or a string).
 ``stop``
-    ``v = 0`` where the path requires rest (start, end, exact stops, forced stops);
-    ratio ``v / VEL_TOL_MM_S``.
+    ``|v| <= VEL_TOL_MM_S`` at every break where ``path.stop`` is True (the path start
+    and end, exact stops, forced stops); ratio ``|v| / VEL_TOL_MM_S``, so <= 1 means at
+    rest. ``v`` at a break is the smallest ``|v|`` of the profile's knots within its
+    position tolerance ``POS_TOL_MM * max(1, L)`` of the break (the exact crossing is
+    always among them), so a stop reached a round-off distance away counts as reached;
+    the same speed enters ``velocity_jump``. Only the velocity is required; start/end accelerations are not judged here
+    (a non-zero one shows up as a jerk step).
 ``frequency``
-    no velocity-change process (a maximal span where the path acceleration keeps one
-    non-zero sign) may be shorter than ``1 / f``, ``f`` the smallest LOOKAH_FREQUENCY of
-    the axes moving during it; ratio ``(1/f) / duration``.
+    DESIGN section 6: no velocity-change process may be shorter than ``1/f``, ``f`` the
+    smallest LOOKAH_FREQUENCY of the axes moving during it. A process is a maximal time
+    span in which the path acceleration keeps one sign and is not zero
+    (``|s''| > FREQ_ACCEL_TOL_REL * max|s''|``), across knots; holds, constant-velocity
+    spans and sign changes separate processes, while an acceleration that only touches
+    zero for an instant (two S-ramps back to back) does not end one. Value ``1/duration`` (Hz), limit ``f``
+    (Hz), so the ratio is ``(1/f) / duration``; the place is the start of the shortest
+    process and the axis is the moving axis with the smallest ``f``.
 
-Sampling inside intervals: on lines the axis quantities are polynomials in time and are
-evaluated exactly (interval ends and the stationary point of ``v``). On arcs and helices
-they are sampled at an angular step of at most :data:`ARC_SAMPLE_STEP_RAD` (and at
-least :data:`MIN_ARC_SAMPLES` points per interval, plus the stationary point of ``v``);
-a maximum of a ``cos``-type function sampled at step ``dphi`` is missed by at most
-``dphi^2 / 8`` relative, 2.4e-6 for 0.25 degrees, below :data:`RATIO_TOL` = 1e-6 only
-after the factor-2 oversampling applied here (step 0.125 deg: 6e-7).
+Evaluation inside intervals and its error
+-----------------------------------------
+The profile is first split at the segment breaks, so that every sub-interval lies on
+one segment (lines, arcs, helices).
+
+* **Lines** (``q' = d`` constant, ``q'' = q''' = 0``): axis velocity, acceleration and
+  jerk are ``|d_i|`` times polynomials of degree 2, 1, 0 in ``tau``; their maxima are
+  taken exactly at the interval ends and the stationary point of ``v`` (``s''= 0``).
+* **Arcs and helices**: dense samples, uniform in time, at an angular step of at most
+  :data:`ARC_SAMPLE_STEP_RAD` (0.125 deg) *at the interval's peak speed* (so also where
+  the motion is fastest), at least :data:`MIN_ARC_SAMPLES` per sub-interval, plus the
+  stationary point of ``v``. A maximum of a cos-type function sampled at step
+  ``dphi`` is missed by at most ``1 - cos(dphi/2) <= dphi^2/8`` of its amplitude:
+  **5.9e-7 relative** at 0.125 deg, below :data:`RATIO_TOL`. In general the deficit
+  is at most ``sup|g''| dtau^2 / 8`` for a quantity ``g(tau)`` sampled at time step
+  ``dtau``; on arcs ``g''`` is dominated by ``(omega v)^2 g``, which gives the bound
+  above, plus terms from the time variation of ``s''`` and ``v`` inside the interval.
+  After sampling, the worst sample of each interval and quantity is refined once by
+  the vertex of the parabola through it and its neighbours, evaluated exactly; this
+  can only raise the maximum found and, for smooth maxima, brings the deficit to order
+  ``dphi^4`` (about 1e-12 relative).
+* The feed uses ``v`` only and is exact everywhere (ends and stationary point).
+
+Work is vectorised and done in chunks of about :data:`CHUNK_SAMPLES` evaluation points,
+so memory stays bounded for profiles of 10^5..10^6 intervals.
+
+Attribution to NC blocks: a point inside a segment belongs to the segment's block; an
+event at a segment break (velocity jump, acceleration step, stop) belongs to the block
+that *ends* there, as the control reduces the speed at the end of that block; the path
+start belongs to the first block.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Iterable, Mapping
 
 import numpy as np
 
-from .geometry import Path
-from .limits import MachineLimits
-from .profile import Profile
 from .errors import ProfileError
+from .geometry import Path
+from .limits import AxisArrays, MachineLimits
+from .profile import Profile
 from .tolerances import POS_TOL_MM, RATIO_TOL, TANGENT_TOL_RAD, VEL_TOL_MM_S
 
+__all__ = ["BOUND_SETS", "CONSTRAINTS", "ConstraintReport", "ConstraintResult", "UNITS",
+           "check_profile", "scale_time", "time_scale_factor"]
+
+#: Every constraint the checker evaluates, in report order.
 CONSTRAINTS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "feed", "velocity_jump",
                                 "stop", "frequency")
-BOUND_SETS: dict[str, tuple[str, ...]] = {
-    "acc": ("velocity", "acceleration", "feed", "velocity_jump", "stop"),
-    "jerk": ("velocity", "acceleration", "feed", "velocity_jump", "stop", "jerk"),
-    "jerk+freq": ("velocity", "acceleration", "feed", "velocity_jump", "stop", "jerk",
-                  "frequency"),
-}
-UNITS = {"velocity": "mm/s", "acceleration": "mm/s^2", "jerk": "mm/s^3", "feed": "mm/s",
-         "velocity_jump": "mm/s", "stop": "mm/s", "frequency": "s"}
 
-#: Angular sampling step on arcs, rad (0.125 deg: a cos-peak error of 6e-7 relative).
-ARC_SAMPLE_STEP_RAD = np.deg2rad(0.125)
-#: Fewest samples per interval on an arc.
+_ACC_SET = ("velocity", "acceleration", "feed", "velocity_jump", "stop")
+#: The constraints each bound set of the oracle (DESIGN section 6) and heuristic declares.
+BOUND_SETS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "acc": _ACC_SET,
+    "jerk": _ACC_SET + ("jerk",),
+    "jerk+freq": _ACC_SET + ("jerk", "frequency"),
+})
+
+#: Unit of value and limit of each constraint.
+UNITS: Mapping[str, str] = MappingProxyType({
+    "velocity": "mm/s", "acceleration": "mm/s^2", "jerk": "mm/s^3", "feed": "mm/s",
+    "velocity_jump": "mm/s", "stop": "mm/s", "frequency": "Hz"})
+
+#: Largest angular step between samples on arcs and helices, rad. 0.125 deg misses a
+#: cos-type peak by at most (step)^2/8 = 5.9e-7 of its amplitude, below RATIO_TOL.
+ARC_SAMPLE_STEP_RAD = float(np.deg2rad(0.125))
+
+#: Fewest uniform samples per sub-interval on an arc: keeps the time polynomials of
+#: short, slow intervals resolved even when they sweep almost no angle.
 MIN_ARC_SAMPLES = 8
-#: Intervals per chunk: bounds memory to a few MB whatever the profile length.
-CHUNK_INTERVALS = 20_000
-#: Path accelerations below this fraction of the profile's largest |a| count as zero
-#: when cutting the motion into velocity-change processes (round-off of a = 0 phases).
+
+#: Evaluation points per chunk. 65 536 points of n axes need about 0.5 MB per (N, n)
+#: array and axis; a chunk uses some 20 of them, so a few tens of MB at most.
+CHUNK_SAMPLES = 65_536
+
+#: Path accelerations below this fraction of the profile's largest |s''| count as zero
+#: when cutting the motion into velocity-change processes. It absorbs the round-off of
+#: a = 0 phases (a = dv/dt of equal speeds, about 1e-12 relative) and solver noise of a
+#: few 1e-7, while a process whose acceleration stays below 1e-6 of the profile's
+#: largest one changes the speed by a negligible amount and excites nothing.
 FREQ_ACCEL_TOL_REL = 1e-6
 
+#: Curvature vectors (1/mm; deg/mm^2 for rotary axes) whose components all differ by at
+#: most this count as continuous at a segment break. Same value as the heuristic's
+#: ``reference.planner.parameters.CURVATURE_JUMP_TOL``, so both classify breaks alike;
+#: float64 round-off of q'' (about 1e-16 / r) stays below it for radii above 0.1 um,
+#: and a jump that small (radius 10^12 mm) gives no measurable acceleration step.
+CURVATURE_JUMP_TOL_PER_MM = 1e-12
 
+#: An axis takes part in a velocity-change process when its tangent component can
+#: exceed this on the segment (1; deg/mm for rotary axes). Same value as the
+#: heuristic's ``AXIS_MOVING_TOL``: a 1e-9 component at 1 m/s moves the axis by 4 pm
+#: per IPO cycle.
+MOVING_AXIS_TOL = 1e-9
+
+
+# =========================================================================== results
 @dataclass(frozen=True, slots=True)
 class ConstraintResult:
     """Worst place of one constraint.
@@ -84,19 +168,21 @@ class ConstraintResult:
     constraint : str
         One of :data:`CONSTRAINTS`.
     ratio : float
-        value / limit at the worst place (<= 1 satisfied; ``inf`` for a forbidden jump).
+        ``value / limit`` at the worst place (<= 1 satisfied; ``inf`` for a velocity
+        jump where the allowance is 0; 0.0 when there was nothing to check).
     value, limit : float
-        In ``unit``.
+        In :attr:`unit` (:data:`UNITS`); both 0.0 when there was nothing to check.
     unit : str
-        Unit of value and limit.
+        Unit of ``value`` and ``limit``.
     s : float
         Path position, mm.
     t : float
         Time, s.
     block : int
-        NC block index (-1 where not tied to one).
+        NC block index (``path.blocks[i].block``), -1 when there was nothing to check.
     axis : str or None
-        Axis name for per-axis constraints.
+        Axis name for per-axis constraints (velocity, acceleration, jerk,
+        velocity_jump), the deciding axis (smallest f) for frequency, None otherwise.
     """
 
     constraint: str
@@ -111,8 +197,16 @@ class ConstraintResult:
 
     @property
     def violated(self) -> bool:
-        """True when the ratio exceeds 1 + RATIO_TOL."""
+        """True when :attr:`ratio` exceeds ``1 + RATIO_TOL``."""
         return self.ratio > 1.0 + RATIO_TOL
+
+
+def _names(constraints: Iterable[str] | None) -> tuple[str, ...]:
+    names = CONSTRAINTS if constraints is None else tuple(constraints)
+    unknown = [n for n in names if n not in CONSTRAINTS]
+    if unknown:
+        raise KeyError(f"unknown constraint {unknown[0]!r}; known: {', '.join(CONSTRAINTS)}")
+    return names
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,16 +216,28 @@ class ConstraintReport:
     Attributes
     ----------
     results : tuple[ConstraintResult, ...]
-        One per constraint in :data:`CONSTRAINTS` order.
+        One per constraint, in :data:`CONSTRAINTS` order.
     block_ratios : Mapping[str, numpy.ndarray]
-        Per constraint, shape ``(n_blocks,)`` worst ratio by NC block index.
+        Per constraint, shape ``(n_blocks,)``: worst ratio in each NC block, indexed by
+        block index (0 where the block has nothing to check).
+    components : Mapping[str, ConstraintResult]
+        Parts of a constraint that scale differently in time: ``"jerk_interval"``
+        (jerk inside intervals, ``1/lam^3``) and ``"jerk_step"`` (acceleration steps
+        over one IPO cycle, ``1/lam^2``). Used by :func:`time_scale_factor`.
     """
 
     results: tuple[ConstraintResult, ...]
     block_ratios: Mapping[str, np.ndarray] = field(default_factory=dict)
+    components: Mapping[str, ConstraintResult] = field(default_factory=dict)
 
     def worst(self, name: str) -> ConstraintResult:
-        """The result of one constraint."""
+        """The worst place of one constraint.
+
+        Raises
+        ------
+        KeyError
+            ``name`` is not in :data:`CONSTRAINTS`.
+        """
         for r in self.results:
             if r.constraint == name:
                 return r
@@ -139,66 +245,109 @@ class ConstraintReport:
 
     def violations(self, constraints: Iterable[str] | None = None,
                    tol: float = RATIO_TOL) -> tuple[ConstraintResult, ...]:
-        """Results with ratio > 1 + tol, restricted to ``constraints`` (default all)."""
-        names = set(CONSTRAINTS if constraints is None else constraints)
-        return tuple(r for r in self.results if r.constraint in names and r.ratio > 1 + tol)
+        """Results with ``ratio > 1 + tol``.
+
+        Parameters
+        ----------
+        constraints : iterable of str, optional
+            Names to consider (default: all); e.g. ``BOUND_SETS["jerk"]``.
+        tol : float
+            Relative tolerance on the ratio.
+
+        Returns
+        -------
+        tuple[ConstraintResult, ...]
+            In :data:`CONSTRAINTS` order.
+        """
+        names = set(_names(constraints))
+        return tuple(r for r in self.results if r.constraint in names and r.ratio > 1.0 + tol)
 
     def ok(self, constraints: Iterable[str] | None = None, tol: float = RATIO_TOL) -> bool:
-        """True when no constraint in ``constraints`` is violated."""
+        """True when none of ``constraints`` (default: all) is violated."""
         return not self.violations(constraints, tol)
 
     def max_ratio(self, constraints: Iterable[str] | None = None) -> float:
-        """Largest ratio among ``constraints``."""
-        names = set(CONSTRAINTS if constraints is None else constraints)
+        """Largest ratio among ``constraints`` (default: all); 0.0 for none."""
+        names = set(_names(constraints))
         return max((r.ratio for r in self.results if r.constraint in names), default=0.0)
 
 
 class _Worst:
-    """Running maximum of one constraint over chunks (private accumulator)."""
+    """Running maximum of one constraint over chunks (private accumulator).
 
-    __slots__ = ("ratio", "value", "limit", "s", "t", "block", "axis", "per_block")
+    Ties are broken towards the earliest time, so the result does not depend on the
+    chunking or on the order in which interval kinds are processed.
+    """
+
+    __slots__ = ("ratio", "value", "limit", "s", "t", "block", "axis", "found", "per_block")
 
     def __init__(self, n_blocks: int) -> None:
-        self.ratio, self.value, self.limit = 0.0, 0.0, 0.0
-        self.s = self.t = 0.0
-        self.block, self.axis = -1, None
+        self.ratio = self.value = self.limit = self.s = self.t = 0.0
+        self.block, self.axis, self.found = -1, None, False
         self.per_block = np.zeros(n_blocks)
 
-    def update(self, ratio, value, limit, s, t, block, axis_idx, axes) -> None:
-        """ratio/value/limit shaped (N, n_axes) or (N,); s, t, block shaped (N,)."""
-        if ratio.size == 0:
+    def update(self, ratio, value, limit, s, t, block, axes=None) -> None:
+        """Fold in candidate places.
+
+        ``ratio``, ``value`` shaped ``(N, n)`` (per axis, then ``axes`` names them) or
+        ``(N,)``; ``limit`` broadcastable to that shape; ``s``, ``t``, ``block`` ``(N,)``.
+        """
+        N = ratio.shape[0]
+        if N == 0:
             return
-        r2 = ratio if ratio.ndim == 2 else ratio[:, None]
-        per_row = r2.max(axis=1)
+        r2 = ratio.reshape(N, -1)
+        row_max = r2.max(axis=1)
         if self.per_block.size:
-            np.maximum.at(self.per_block, block, per_row)
-        flat = int(np.argmax(r2))
-        row, col = divmod(flat, r2.shape[1])
-        if r2[row, col] > self.ratio or self.block < 0 and r2[row, col] >= self.ratio:
-            self.ratio = float(r2[row, col])
-            v2 = value if value.ndim == 2 else value[:, None]
-            lim = np.asarray(limit, dtype=np.float64)
-            if lim.ndim == 0:
-                lval = float(lim)
-            elif lim.ndim == 1 and ratio.ndim == 1:
-                lval = float(lim[row])               # one limit per sample
-            elif lim.ndim == 1:
-                lval = float(lim[col])               # one limit per axis
-            else:
-                lval = float(lim[row, col])
-            self.value, self.limit = float(v2[row, col]), lval
-            self.s, self.t, self.block = float(s[row]), float(t[row]), int(block[row])
-            self.axis = axes[col] if axis_idx else None
+            np.maximum.at(self.per_block, block, row_max)
+        best = float(row_max.max())
+        if self.found and best < self.ratio:
+            return
+        rows = np.flatnonzero(row_max == best)
+        row = int(rows[np.argmin(t[rows])])
+        if self.found and best == self.ratio and t[row] >= self.t:
+            return
+        col = int(np.argmax(r2[row]))
+        self.found = True
+        self.ratio = best
+        self.value = float(value.reshape(N, -1)[row, col])
+        self.limit = float(np.broadcast_to(limit, ratio.shape).reshape(N, -1)[row, col])
+        self.s, self.t, self.block = float(s[row]), float(t[row]), int(block[row])
+        self.axis = axes[col] if axes is not None else None
+
+    def merge(self, other: "_Worst") -> None:
+        """Fold another accumulator of the same constraint into this one."""
+        if self.per_block.size:
+            np.maximum(self.per_block, other.per_block, out=self.per_block)
+        if other.found and (not self.found or other.ratio > self.ratio or
+                            (other.ratio == self.ratio and other.t < self.t)):
+            for name in ("ratio", "value", "limit", "s", "t", "block", "axis", "found"):
+                setattr(self, name, getattr(other, name))
 
     def result(self, name: str) -> ConstraintResult:
         return ConstraintResult(name, self.ratio, self.value, self.limit, UNITS[name],
                                 self.s, self.t, self.block, self.axis)
 
 
-def _safe_div(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+def _jump_ratio(dv: np.ndarray, allowance: np.ndarray) -> np.ndarray:
+    """``dv / allowance``; a jump of at most VEL_TOL_MM_S is standstill-level (0), and a
+    larger one against a zero allowance is ``inf``."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.where(num > 0, np.inf, 0.0))
-    return r
+        r = dv / np.where(allowance > 0, allowance, 1.0)
+    return np.where(dv <= VEL_TOL_MM_S, 0.0, np.where(allowance > 0, r, np.inf))
+
+
+# ====================================================================== the checker
+@dataclass(frozen=True, slots=True, eq=False)
+class _Ctx:
+    """What every stage of one check needs (private)."""
+
+    path: Path
+    lim: AxisArrays
+    t_ipo: float
+    prof: Profile
+    h: np.ndarray          # (K,) interval durations, s
+    seg: np.ndarray        # (K,) segment of each interval
+    n_blocks: int
 
 
 def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> ConstraintReport:
@@ -211,235 +360,470 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
     limits : MachineLimits
         Machine limits; must define every axis of the path.
     profile : Profile
-        The motion ``s(t)``; its ``s`` must span ``[0, path.total_length]``.
+        The motion ``s(t)``; its knots must span ``[0, path.total_length]`` (mm).
 
     Returns
     -------
     ConstraintReport
-        Worst ratio per constraint with its place, and per NC block.
+        Worst ratio per constraint with its place, per-block worst ratios, and the jerk
+        components for time scaling. See the module docstring for the rules.
+
+    Raises
+    ------
+    ProfileError
+        The profile does not cover the path.
+    MachineDataError
+        ``limits`` lacks an axis of the path.
     """
     lim = limits.for_axes(path.axes)
-    axes = path.axes
+    L = path.total_length
     if profile.s.size and (abs(profile.s[0]) > POS_TOL_MM or
-                           abs(profile.s[-1] - path.total_length) > POS_TOL_MM * max(
-                               1.0, path.total_length)):
+                           abs(profile.s[-1] - L) > POS_TOL_MM * max(1.0, L)):
         raise ProfileError(f"profile starts at s = {profile.s[0]:.6g} mm and ends at s = "
-                           f"{profile.s[-1]:.6g} mm but the path is "
-                           f"{path.total_length:.6g} mm long")
-    n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
+                           f"{profile.s[-1]:.6g} mm but the path is {L:.6g} mm long")
+    n_blocks = max([b.block + 1 for b in path.blocks] +
+                   [int(path.block.max()) + 1 if path.n_segments else 0])
     worst = {c: _Worst(n_blocks) for c in CONSTRAINTS}
-    if path.n_segments == 0 or profile.n_intervals == 0:
-        st = worst["stop"]
-        v_max = float(np.max(profile.v)) if profile.v.size else 0.0
-        st.ratio, st.value, st.limit = v_max / VEL_TOL_MM_S, v_max, VEL_TOL_MM_S
-        return ConstraintReport(tuple(worst[c].result(c) for c in CONSTRAINTS),
-                                {c: worst[c].per_block for c in CONSTRAINTS})
-    prof = profile.split_at(path.s_breaks)
-    h_all = np.diff(prof.t)
-    ds_all = np.diff(prof.s)
-    moving = np.flatnonzero(ds_all > 0)
-    for lo in range(0, moving.size, CHUNK_INTERVALS):
-        _check_intervals(path, lim, prof, moving[lo:lo + CHUNK_INTERVALS], h_all, worst, axes)
-    _check_knots(path, lim, limits.t_ipo_s, prof, worst, axes)
-    _check_frequency(path, lim, prof, worst, axes)
-    return ConstraintReport(tuple(worst[c].result(c) for c in CONSTRAINTS),
-                            {c: worst[c].per_block for c in CONSTRAINTS})
+    jerk_step = _Worst(n_blocks)
+    prof = _drop_empty(profile)
+    if path.n_segments and prof.n_intervals:
+        # interior breaks only: a cut at a path end that the profile overshoots by
+        # round-off would create a knot just short of the final rest
+        prof = prof.split_at(path.s_breaks[1:-1])
+        h = np.diff(prof.t)
+        seg = path.segment_index(0.5 * (prof.s[:-1] + prof.s[1:]))
+        ctx = _Ctx(path, lim, limits.t_ipo_s, prof, h, seg, n_blocks)
+        _check_intervals(ctx, worst)
+        _check_steps(ctx, jerk_step)
+        _check_breaks(ctx, worst)
+        _check_frequency(ctx, worst["frequency"])
+    else:
+        # no motion to judge: only rest can be asked for
+        v = np.abs(prof.v)
+        k = int(np.argmax(v)) if v.size else 0
+        w = worst["stop"]
+        if v.size:
+            blk = np.full(1, path.blocks[0].block if path.blocks else 0)
+            w.update(v[k:k + 1] / VEL_TOL_MM_S, v[k:k + 1], VEL_TOL_MM_S, prof.s[k:k + 1],
+                     prof.t[k:k + 1], blk)
+    jerk_interval = worst["jerk"]
+    components = {"jerk_interval": jerk_interval.result("jerk"),
+                  "jerk_step": jerk_step.result("jerk")}
+    total_jerk = _Worst(n_blocks)
+    total_jerk.merge(jerk_interval)
+    total_jerk.merge(jerk_step)
+    worst["jerk"] = total_jerk
+    for w in worst.values():
+        w.per_block.setflags(write=False)
+    return ConstraintReport(
+        results=tuple(worst[c].result(c) for c in CONSTRAINTS),
+        block_ratios=MappingProxyType({c: worst[c].per_block for c in CONSTRAINTS}),
+        components=MappingProxyType(components))
 
 
-def _check_intervals(path, lim, prof, k, h_all, worst, axes) -> None:
-    """Dense/analytic evaluation inside the moving intervals ``k`` (one chunk)."""
-    h = h_all[k]
-    s0, v0, a0, jj = prof.s[k], prof.v[k], prof.a[k], prof.j[k]
-    seg = path.segment_index(0.5 * (prof.s[k] + prof.s[k + 1]))
-    arc = path.radius[seg] > 0
-    dphi = np.abs(path.omega[seg]) * (prof.s[k + 1] - prof.s[k])
-    n_s = np.where(arc, np.maximum(MIN_ARC_SAMPLES,
-                                   np.ceil(dphi / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 2)
-    n_s = n_s + 1                                          # + the stationary point of v
-    idx = np.repeat(np.arange(k.size), n_s)
-    first = np.concatenate(([0], np.cumsum(n_s)[:-1]))
-    pos = np.arange(idx.size) - first[idx]
-    n_uni = n_s[idx] - 1
-    tau = h[idx] * np.minimum(pos, n_uni - 1) / np.maximum(n_uni - 1, 1)
-    # the last sample of each interval is the stationary point of v (a + j tau = 0)
+def _drop_empty(profile: Profile) -> Profile:
+    """The same motion without zero-duration intervals.
+
+    Their acceleration is never held, so they must not create acceleration steps.
+    """
+    h = np.diff(profile.t)
+    empty = h == 0
+    if not np.any(empty):
+        return profile
+    keep_iv = ~empty
+    keep_knot = np.concatenate(([True], keep_iv))
+    if not np.any(keep_iv):
+        keep_knot = np.zeros_like(keep_knot)
+        keep_knot[0] = True
+    return Profile(t=profile.t[keep_knot], s=profile.s[keep_knot], v=profile.v[keep_knot],
+                   a=profile.a[keep_iv], j=profile.j[keep_iv], block=profile.block[keep_iv])
+
+
+def _chunks(cost: np.ndarray) -> list[tuple[int, int]]:
+    """Index ranges whose summed cost is about CHUNK_SAMPLES (at least one item each)."""
+    if cost.size == 0:
+        return []
+    cum = np.cumsum(cost)
+    cid = (cum - 1) // CHUNK_SAMPLES
+    cut = np.flatnonzero(np.diff(cid)) + 1
+    bounds = np.concatenate(([0], cut, [cost.size]))
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _poly(s0, v0, a0, j, tau):
+    """Path position, velocity and acceleration at ``tau`` inside intervals."""
+    s = s0 + tau * (v0 + tau * (a0 / 2 + tau * j / 6))
+    v = v0 + tau * (a0 + tau * j / 2)
+    return s, v, a0 + j * tau
+
+
+def _speed_peak(ctx: _Ctx, k: np.ndarray):
+    """Largest |v| on intervals ``k`` and where (exact: ends and stationary point)."""
+    p, h = ctx.prof, ctx.h[k]
+    v0, a0, j = p.v[k], p.a[k], p.j[k]
+    v1 = p.v[k + 1]
     with np.errstate(divide="ignore", invalid="ignore"):
-        tstar = np.where(jj != 0, -a0 / np.where(jj != 0, jj, 1.0), -1.0)
-    tstar = np.clip(np.where((tstar > 0) & (tstar < h), tstar, 0.0), 0.0, h)
-    is_star = pos == n_s[idx] - 1
-    tau = np.where(is_star, tstar[idx], tau)
-    a_i, j_i = a0[idx], jj[idx]
-    s = s0[idx] + v0[idx] * tau + a_i * tau ** 2 / 2 + j_i * tau ** 3 / 6
-    v = np.maximum(v0[idx] + a_i * tau + j_i * tau ** 2 / 2, 0.0)
-    a = a_i + j_i * tau
-    segi = seg[idx]
-    # keep s inside the segment (round-off at the interval end)
-    s = np.clip(s, path.s_breaks[segi], path.s_breaks[segi + 1])
-    _, dq, ddq, dddq = path.evaluate(s, segment=segi)
-    t = prof.t[k][idx] + tau
-    blk = path.block[segi]
+        ts = np.where(j != 0, -a0 / np.where(j != 0, j, 1.0), -1.0)
+    inside = (ts > 0) & (ts < h)
+    ts = np.where(inside, ts, 0.0)
+    vs = v0 + ts * (a0 + ts * j / 2)
+    cand = np.stack([np.abs(v0), np.abs(v1), np.where(inside, np.abs(vs), 0.0)])
+    pick = np.argmax(cand, axis=0)
+    tau = np.choose(pick, [np.zeros_like(h), h, ts])
+    return cand.max(axis=0), tau, ts
+
+
+def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
+    """Velocity, acceleration, jerk (inside intervals) and feed on every interval."""
+    path = ctx.path
+    k_all = np.flatnonzero(ctx.h > 0)
+    arc = path.radius[ctx.seg[k_all]] > 0
+    vpk_all, _, _ = _speed_peak(ctx, k_all)
+    n_uni = np.where(arc, np.maximum(
+        MIN_ARC_SAMPLES,
+        np.ceil(np.abs(path.omega[ctx.seg[k_all]]) * vpk_all * ctx.h[k_all]
+                / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 0)
+    # cost: one row per line interval; uniform + stationary + 3 refinement rows per arc
+    cost = np.where(arc, n_uni + 4, 1)
+    for lo, hi in _chunks(cost):
+        k = k_all[lo:hi]
+        a_mask = arc[lo:hi]
+        _check_feed(ctx, k, worst["feed"])
+        if np.any(~a_mask):
+            _check_lines(ctx, k[~a_mask], worst)
+        if np.any(a_mask):
+            _check_arcs(ctx, k[a_mask], n_uni[lo:hi][a_mask], worst)
+
+
+def _check_feed(ctx: _Ctx, k: np.ndarray, w: _Worst) -> None:
+    feed = ctx.path.feed[ctx.seg[k]]
+    fin = np.isfinite(feed)
+    if not np.any(fin):
+        return
+    k, feed = k[fin], feed[fin]
+    vpk, tau, _ = _speed_peak(ctx, k)
+    p = ctx.prof
+    s, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau)
+    w.update(vpk / feed, vpk, feed, s, p.t[k] + tau, ctx.path.block[ctx.seg[k]])
+
+
+def _check_lines(ctx: _Ctx, k: np.ndarray, worst: dict[str, _Worst]) -> None:
+    """Exact maxima on straight segments: |d_i| times a polynomial in tau."""
+    p, path, lim, axes = ctx.prof, ctx.path, ctx.lim, ctx.path.axes
+    h, seg = ctx.h[k], ctx.seg[k]
+    d = np.abs(path.d[seg])
+    blk = path.block[seg]
+    vpk, tau_v, _ = _speed_peak(ctx, k)
+    a0 = p.a[k]
+    a1 = a0 + p.j[k] * h
+    tau_a = np.where(np.abs(a1) > np.abs(a0), h, 0.0)
+    apk = np.maximum(np.abs(a0), np.abs(a1))
+    jpk = np.abs(p.j[k])
+    for name, peak, tau, lim_i in (("velocity", vpk, tau_v, lim.v_max),
+                                   ("acceleration", apk, tau_a, lim.a_max),
+                                   ("jerk", jpk, np.zeros_like(h), lim.j_max)):
+        val = d * peak[:, None]
+        s, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau)
+        worst[name].update(val / lim_i, val, lim_i, s, p.t[k] + tau, blk, axes)
+
+
+def _axis_kinematics(ctx: _Ctx, k: np.ndarray, tau: np.ndarray):
+    """Axis velocity, acceleration and jerk at ``tau`` inside intervals ``k``.
+
+    Returns
+    -------
+    vel, acc, jer : numpy.ndarray, shape (N, n)
+        Absolute values.
+    s, t : numpy.ndarray, shape (N,)
+    """
+    p, path = ctx.prof, ctx.path
+    seg = ctx.seg[k]
+    j = p.j[k]
+    s, v, a = _poly(p.s[k], p.v[k], p.a[k], j, tau)
+    # round-off must not push a point into the neighbouring segment
+    s = np.clip(s, path.s_breaks[seg], path.s_breaks[seg + 1])
+    _, dq, ddq, dddq = path.evaluate(s, segment=seg)
     vel = np.abs(dq * v[:, None])
     acc = np.abs(dq * a[:, None] + ddq * (v * v)[:, None])
-    jer = np.abs(dq * j_i[:, None] + 3 * ddq * (v * a)[:, None] + dddq * (v ** 3)[:, None])
-    worst["velocity"].update(vel / lim.v_max, vel, lim.v_max, s, t, blk, True, axes)
-    worst["acceleration"].update(acc / lim.a_max, acc, lim.a_max, s, t, blk, True, axes)
-    worst["jerk"].update(jer / lim.j_max, jer, lim.j_max, s, t, blk, True, axes)
-    feed = path.feed[segi]
-    finite = np.isfinite(feed)
-    if finite.any():
-        worst["feed"].update(v[finite] / feed[finite], v[finite], feed[finite], s[finite],
-                             t[finite], blk[finite], False, axes)
+    jer = np.abs(dq * j[:, None] + ddq * (3 * v * a)[:, None] + dddq * (v ** 3)[:, None])
+    return vel, acc, jer, s, p.t[k] + tau
 
 
-def _check_knots(path, lim, t_ipo, prof, worst, axes) -> None:
-    """Velocity jumps and acceleration steps at knots; rest where the path stops."""
-    K = prof.n_intervals
-    # knot index of the first arrival at each break (breaks are knots after split_at)
-    kb = np.searchsorted(prof.s, path.s_breaks, side="left")
-    kb = np.clip(kb, 0, K)
-    v_b = prof.v[kb]
-    t_b = prof.t[kb]
-    m = path.n_segments
-    breaks = np.arange(m + 1)
-    seg_after = np.minimum(breaks, m - 1)
-    blk_b = path.block[seg_after]
-    # --- stops (start, end, exact and forced stops)
-    stop = np.flatnonzero(path.stop)
-    # at a stop the motion must be at rest on arrival and on departure
-    kl = np.clip(np.searchsorted(prof.s, path.s_breaks, side="right") - 1, 0, K)
-    v_stop = np.maximum(v_b[stop], prof.v[kl[stop]])
-    worst["stop"].update(v_stop / VEL_TOL_MM_S, v_stop, VEL_TOL_MM_S,
-                         path.s_breaks[stop], t_b[stop], path.block[np.minimum(
-                             np.maximum(stop - 1, 0), m - 1)], False, axes)
-    if m >= 2:
-        t_in, t_out = path.junction_tangents()
-        k_in, k_out = path.junction_curvatures()
-        vj = v_b[1:m]
-        dv = np.abs(t_out - t_in) * vj[:, None]
-        ratio = _safe_div(dv, np.broadcast_to(lim.jump, dv.shape))
-        ratio = np.where(dv <= VEL_TOL_MM_S, 0.0, ratio)
-        worst["velocity_jump"].update(ratio, dv, np.broadcast_to(lim.jump, dv.shape),
-                                      path.s_breaks[1:m], t_b[1:m], path.block[:m - 1], True,
-                                      axes)
-        # acceleration step at tangential breaks (curvature jump and/or s'' jump)
-        cosang = np.sum(t_in * t_out, axis=1) / np.maximum(
-            np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1), 1e-300)
-        tangential = np.arccos(np.clip(cosang, -1, 1)) <= TANGENT_TOL_RAD
-        k_left = np.clip(kb[1:m] - 1, 0, K - 1)
-        k_right = np.clip(kb[1:m], 0, K - 1)
-        h_left = prof.t[k_left + 1] - prof.t[k_left]
-        a_left = prof.a[k_left] + prof.j[k_left] * h_left
-        a_right = prof.a[k_right]
-        # a hold at the break: the acceleration at departure is the one after the hold
-        acc_l = t_in * a_left[:, None] + k_in * (vj * vj)[:, None]
-        acc_r = t_out * a_right[:, None] + k_out * (vj * vj)[:, None]
+def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
+                worst: dict[str, _Worst]) -> None:
+    """Dense samples on arcs/helices, then one parabolic refinement per interval."""
+    lim, path, axes = ctx.lim, ctx.path, ctx.path.axes
+    h = ctx.h[k]
+    ni = k.size
+    # uniform samples, contiguous per interval
+    first = np.concatenate(([0], np.cumsum(n_uni)[:-1]))
+    row_iv = np.repeat(np.arange(ni), n_uni)
+    pos = np.arange(row_iv.size) - first[row_iv]
+    dtau = h / (n_uni - 1)
+    tau_u = np.minimum(pos * dtau[row_iv], h[row_iv])
+    _, _, ts = _speed_peak(ctx, k)
+    iv = np.concatenate((row_iv, np.arange(ni)))
+    tau = np.concatenate((tau_u, ts))
+    kin = _axis_kinematics(ctx, k[iv], tau)
+    s, t = kin[3], kin[4]
+    blk = path.block[ctx.seg[k[iv]]]
+    limits = (lim.v_max, lim.a_max, lim.j_max)
+    names = ("velocity", "acceleration", "jerk")
+    ref_iv, ref_tau = [], []
+    nu = row_iv.size
+    for name, val, lim_i in zip(names, kin[:3], limits):
+        ratio = val / lim_i
+        worst[name].update(ratio, val, lim_i, s, t, blk, axes)
+        # refinement: worst uniform sample of each interval, parabola through neighbours
+        r_u = ratio[:nu]
+        flat = r_u.max(axis=1)
+        col = r_u.argmax(axis=1)
+        mx = np.maximum.reduceat(flat, first)
+        hit = np.flatnonzero(flat == mx[row_iv])
+        _, firsthit = np.unique(row_iv[hit], return_index=True)
+        p = hit[firsthit]                                     # one row per interval
+        c = np.clip(p, first + 1, first + n_uni - 2)          # centre with two neighbours
+        cc = col[p]
+        ym, y0, yp = r_u[c - 1, cc], r_u[c, cc], r_u[c + 1, cc]
+        den = ym - 2 * y0 + yp
+        with np.errstate(divide="ignore", invalid="ignore"):
+            off = np.where(den < 0, 0.5 * (ym - yp) / den, 0.0)
+        off = np.clip(off, -1.0, 1.0)
+        ref_iv.append(np.arange(ni))
+        ref_tau.append(np.clip(tau_u[c] + off * dtau, 0.0, h))
+    riv = np.concatenate(ref_iv)
+    rk = _axis_kinematics(ctx, k[riv], np.concatenate(ref_tau))
+    rblk = path.block[ctx.seg[k[riv]]]
+    for name, val, lim_i in zip(names, rk[:3], limits):
+        worst[name].update(val / lim_i, val, lim_i, rk[3], rk[4], rblk, axes)
+
+
+def _axis_acc_at_knots(ctx: _Ctx, kn: np.ndarray, side: str) -> np.ndarray:
+    """Axis acceleration just before (``"left"``) or after (``"right"``) knots ``kn``.
+
+    Outside the profile (before knot 0, after knot K) the motion is at rest: 0.
+    """
+    p, path = ctx.prof, ctx.path
+    K = p.n_intervals
+    iv = kn - 1 if side == "left" else kn
+    valid = (iv >= 0) & (iv < K)
+    ivc = np.clip(iv, 0, K - 1)
+    a = p.a[ivc] + (p.j[ivc] * ctx.h[ivc] if side == "left" else 0.0)
+    v = p.v[kn]
+    seg = ctx.seg[ivc]
+    s = np.clip(p.s[kn], path.s_breaks[seg], path.s_breaks[seg + 1])
+    _, dq, ddq, _ = path.evaluate(s, segment=seg)
+    acc = dq * a[:, None] + ddq * (v * v)[:, None]
+    return np.where(valid[:, None], acc, 0.0), ddq, valid, seg
+
+
+def _check_steps(ctx: _Ctx, w: _Worst) -> None:
+    """Axis acceleration steps at knots, spread over one IPO cycle (jerk)."""
+    p, path, lim = ctx.prof, ctx.path, ctx.lim
+    K = p.n_intervals
+    knots = np.arange(K + 1)
+    for lo, hi in _chunks(np.full(K + 1, 4)):
+        kn = knots[lo:hi]
+        acc_l, ddq_l, val_l, seg_l = _axis_acc_at_knots(ctx, kn, "left")
+        acc_r, ddq_r, val_r, seg_r = _axis_acc_at_knots(ctx, kn, "right")
         step = np.abs(acc_r - acc_l)
-        curv_jump = np.any(np.abs(k_out - k_in) > 1e-12, axis=1)
-        jlim = np.where(curv_jump[:, None], lim.path_trans_jerk[None, :], lim.j_max[None, :])
-        jstep = step / t_ipo
-        rj = np.where(tangential[:, None], jstep / jlim, 0.0)
-        worst["jerk"].update(rj, jstep, jlim, path.s_breaks[1:m], t_b[1:m], path.block[1:m],
-                             True, axes)
-    # --- acceleration steps at knots inside segments (BRISK switching points)
-    if K >= 2:
-        inner = np.arange(1, K)
-        ds_prev = prof.s[inner] - prof.s[inner - 1]
-        ds_next = prof.s[inner + 1] - prof.s[inner]
-        on_break = np.isin(prof.s[inner], path.s_breaks)
-        keep = (ds_prev > 0) & (ds_next > 0) & ~on_break
-        kk = inner[keep]
-        if kk.size:
-            h_prev = prof.t[kk] - prof.t[kk - 1]
-            a_left = prof.a[kk - 1] + prof.j[kk - 1] * h_prev
-            da = np.abs(prof.a[kk] - a_left)
-            seg = path.segment_index(prof.s[kk])
-            _, dq, _, _ = path.evaluate(prof.s[kk], segment=seg)
-            jstep = np.abs(dq) * (da / t_ipo)[:, None]
-            worst["jerk"].update(jstep / lim.j_max, jstep, lim.j_max, prof.s[kk], prof.t[kk],
-                                 path.block[seg], True, axes)
+        jump = np.any(np.abs(ddq_r - ddq_l) > CURVATURE_JUMP_TOL_PER_MM, axis=1)
+        curv = val_l & val_r & (seg_l != seg_r) & jump & (np.abs(p.v[kn]) > VEL_TOL_MM_S)
+        jlim = np.where(curv[:, None], lim.path_trans_jerk[None, :], lim.j_max[None, :])
+        val = step / ctx.t_ipo
+        # the block the motion is in just before the knot (the first block at the start)
+        blk = path.block[np.where(val_l, seg_l, seg_r)]
+        w.update(val / jlim, val, jlim, p.s[kn], p.t[kn], blk, path.axes)
 
 
-def _check_frequency(path, lim, prof, worst, axes) -> None:
+def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
+    """Velocity jumps at interior breaks and rest where the path stops."""
+    p, path, lim = ctx.prof, ctx.path, ctx.lim
+    K, m = p.n_intervals, path.n_segments
+    sb = path.s_breaks
+    # Speed at each break: after split_at every crossed interior break is a knot. A
+    # profile that comes to rest within the position tolerance of a break (e.g. 1e-13 mm
+    # after it, by round-off of its own integration) is at rest there, although it
+    # crosses the exact break at sqrt(2 a 1e-13) ~ 1e-5 mm/s: so take the smallest |v|
+    # of the knots within the profile's position tolerance of the break.
+    win = POS_TOL_MM * max(1.0, path.total_length)
+    k_lo = np.clip(np.searchsorted(p.s, sb - win, side="left"), 0, K)
+    k_hi = np.maximum(np.searchsorted(p.s, sb + win, side="right"), k_lo + 1)
+    k_lo = np.minimum(k_lo, k_hi - 1)
+    knots = _ranges(k_lo, k_hi)
+    v_b = np.minimum.reduceat(np.abs(p.v[knots]),
+                              np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
+    k_first = k_lo
+    blk_b = path.block[np.clip(np.arange(m + 1) - 1, 0, m - 1)]   # block ending there
+    stop = np.flatnonzero(path.stop)
+    if stop.size:
+        vs = v_b[stop]
+        worst["stop"].update(vs / VEL_TOL_MM_S, vs, VEL_TOL_MM_S, sb[stop], p.t[k_first[stop]],
+                             blk_b[stop])
+    if m < 2:
+        return
+    for lo, hi in _chunks(np.full(m - 1, 16)):
+        b = np.arange(lo, hi) + 1
+        # tangents on both sides (Path.junction_tangents, chunk by chunk)
+        ti = path.evaluate(sb[b], segment=b - 1)[1]
+        to = path.evaluate(sb[b], segment=b)[1]
+        # angle between the tangents, stable for tiny angles: 2 atan(|u1-u2| / |u1+u2|)
+        u1 = ti / np.linalg.norm(ti, axis=1, keepdims=True)
+        u2 = to / np.linalg.norm(to, axis=1, keepdims=True)
+        ang = 2 * np.arctan2(np.linalg.norm(u1 - u2, axis=1), np.linalg.norm(u1 + u2, axis=1))
+        dv = np.abs(to - ti) * v_b[b][:, None]
+        dv = np.where((ang > TANGENT_TOL_RAD)[:, None], dv, 0.0)
+        jump = np.broadcast_to(lim.jump, dv.shape)
+        worst["velocity_jump"].update(_jump_ratio(dv, jump), dv, jump, sb[b], p.t[k_first[b]],
+                                      blk_b[b], path.axes)
+
+
+def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     """Shortest velocity-change process against 1/f of the axes moving in it."""
-    K = prof.n_intervals
-    h = np.diff(prof.t)
-    a0, jj = prof.a, prof.j
-    a1 = a0 + jj * h
-    scale = max(float(np.max(np.abs(a0))), float(np.max(np.abs(a1))), 0.0)
+    p, path, lim = ctx.prof, ctx.path, ctx.lim
+    h = ctx.h
+    a0, j = p.a, p.j
+    a1 = a0 + j * h
+    scale = float(max(np.max(np.abs(a0)), np.max(np.abs(a1))))
     if scale == 0.0:
         return
     tol = FREQ_ACCEL_TOL_REL * scale
-    # split each interval where a(tau) crosses zero (at most once: a is linear in tau)
+    # pieces: intervals cut where a(tau), linear in tau, changes sign clearly (both ends
+    # beyond tol); an end within tol of zero is a touch, not a change of sign, so that
+    # round-off at the end of a ramp (a = -1e-13 instead of 0) cannot split a process
+    cross = (j != 0) & (a0 * a1 < 0) & (np.abs(a0) > tol) & (np.abs(a1) > tol)
     with np.errstate(divide="ignore", invalid="ignore"):
-        tz = np.where(jj != 0, -a0 / np.where(jj != 0, jj, 1.0), -1.0)
-    cross = (tz > 0) & (tz < h) & (np.sign(a0) != np.sign(a1))
-    t_start = np.concatenate([prof.t[:-1], prof.t[:-1][cross] + tz[cross]])
-    t_end = np.concatenate([np.where(cross, prof.t[:-1] + tz, prof.t[1:]), prof.t[1:][cross]])
-    a_mid_first = np.where(cross, a0 / 2, (a0 + a1) / 2)
-    a_mid_second = (a1[cross]) / 2
-    a_mid = np.concatenate([a_mid_first, a_mid_second])
-    src = np.concatenate([np.arange(K), np.flatnonzero(cross)])
-    order = np.argsort(t_start, kind="stable")
-    t_start, t_end, a_mid, src = t_start[order], t_end[order], a_mid[order], src[order]
-    sign = np.where(np.abs(a_mid) <= tol, 0, np.sign(a_mid)).astype(int)
-    sign = np.where(np.diff(prof.s)[src] > 0, sign, 0)      # holds separate processes
+        tz = np.where(cross, -a0 / np.where(cross, j, 1.0), 0.0)
+    npc = 1 + cross.astype(np.int64)
+    parent = np.repeat(np.arange(h.size), npc)
+    second = np.zeros(parent.size, bool)
+    second[np.cumsum(npc)[cross] - 1] = True
+    first_of_two = np.repeat(cross, npc) & ~second
+    tau0 = np.where(second, tz[parent], 0.0)
+    tau1 = np.where(first_of_two, tz[parent], h[parent])
+    pa0 = a0[parent] + j[parent] * tau0
+    pa1 = a0[parent] + j[parent] * tau1
+    amax = np.maximum(np.abs(pa0), np.abs(pa1))
+    moving = (p.s[1:] > p.s[:-1])[parent]
+    dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
+    sign = np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8)
     if not np.any(sign):
         return
-    # runs of equal non-zero sign
-    change = np.flatnonzero(np.diff(sign) != 0) + 1
-    starts = np.concatenate(([0], change))
-    ends = np.concatenate((change, [sign.size]))
-    run_sign = sign[starts]
-    keep = run_sign != 0
-    starts, ends = starts[keep], ends[keep]
-    dur = t_end[ends - 1] - t_start[starts]
-    # axes moving during each process: sample the tangent at piece mid-points
-    s_mid = 0.5 * (prof.s[src] + prof.s[src + 1])
-    _, dq, _, _ = path.evaluate(s_mid)
-    moving_axes = np.abs(dq) > 1e-9
-    run_id = np.repeat(np.arange(starts.size), ends - starts)
-    piece = np.concatenate([np.arange(a, b) for a, b in zip(starts, ends)]) if starts.size else \
-        np.zeros(0, int)
-    mv = np.zeros((starts.size, len(axes)), bool)
-    np.logical_or.at(mv, run_id, moving_axes[piece])
-    f = np.where(mv, lim.frequency_hz[None, :], np.inf)
+    starts = np.concatenate(([0], np.flatnonzero(np.diff(sign)) + 1))
+    ends = np.concatenate((starts[1:], [sign.size]))
+    nz = sign[starts] != 0
+    t0 = p.t[parent] + tau0
+    t1 = p.t[parent] + tau1
+    dur = t1[ends - 1] - t0[starts]
+    # axes that can move on each piece's segment, OR-ed over each run of pieces
+    seg = ctx.seg
+    rw = path.radius * np.abs(path.omega)
+    reach = np.abs(path.d) + rw[:, None] * (np.abs(path.e1) + np.abs(path.e2))
+    seg_moving = (reach > MOVING_AXIS_TOL).astype(np.uint8)
+    run_moving = np.maximum.reduceat(seg_moving[seg[parent]], starts, axis=0).astype(bool)
+    f = np.where(run_moving, lim.frequency_hz[None, :], np.inf)
     f_min = f.min(axis=1)
-    ax_min = f.argmin(axis=1)
-    finite = np.isfinite(f_min)
-    if not finite.any():
+    ax = f.argmin(axis=1)
+    ok = nz & np.isfinite(f_min) & (dur > 0)
+    if not np.any(ok):
         return
-    need = np.where(finite, 1.0 / np.where(finite, f_min, 1.0), 0.0)
-    ratio = _safe_div(need, dur)
-    i = int(np.argmax(ratio))
-    s_at = prof.s[src[starts[i]]]
-    blk_all = path.block_of(prof.s[src[starts]])
-    w = worst["frequency"]
+    starts, ends, dur, f_min, ax = starts[ok], ends[ok], dur[ok], f_min[ok], ax[ok]
+    ratio = (1.0 / f_min) / dur
+    # per block: every block a process touches
+    run_of_piece = np.repeat(np.arange(starts.size), ends - starts)
+    pieces = _ranges(starts, ends)
     if w.per_block.size:
-        np.maximum.at(w.per_block, blk_all, ratio)
-    w.ratio, w.value, w.limit = float(ratio[i]), float(dur[i]), float(need[i])
-    w.s, w.t, w.block = float(s_at), float(t_start[starts[i]]), int(blk_all[i])
-    w.axis = axes[int(ax_min[i])]
+        np.maximum.at(w.per_block, path.block[seg[parent[pieces]]], ratio[run_of_piece])
+    i = int(np.argmax(ratio))
+    pc = starts[i]
+    k = parent[pc]
+    s_at, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau0[pc])
+    w.found = True
+    w.ratio, w.value, w.limit = float(ratio[i]), float(1.0 / dur[i]), float(f_min[i])
+    w.s, w.t = float(s_at), float(t0[pc])
+    w.block = int(path.block[seg[k]])
+    w.axis = path.axes[int(ax[i])]
+
+
+def _ranges(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Concatenation of ``arange(a, b)`` for all pairs, vectorised."""
+    n = ends - starts
+    off = np.repeat(starts - np.concatenate(([0], np.cumsum(n)[:-1])), n)
+    return np.arange(n.sum()) + off
+
+
+# ===================================================================== time scaling
+#: How each ratio falls when time is stretched by lam: ratio / lam**power.
+_POWER = {"velocity": 1, "feed": 1, "velocity_jump": 1, "stop": 1, "frequency": 1,
+          "acceleration": 2, "jerk_interval": 3, "jerk_step": 2}
 
 
 def time_scale_factor(report: ConstraintReport, constraints: Iterable[str]) -> float:
-    """Smallest factor ``lam >= 1`` by which slowing the profile down in time satisfies
-    the given constraints (velocity-like ratios scale with ``1/lam``, acceleration with
-    ``1/lam^2``, jerk with ``1/lam^3``, frequency ratios with ``1/lam``).
+    """Smallest factor ``lam >= 1`` by which stretching time satisfies ``constraints``.
 
-    ``stop`` violations cannot be fixed by time scaling and are ignored here.
+    Stretching time by ``lam`` (:func:`scale_time`) divides velocities by ``lam``,
+    accelerations by ``lam^2`` and jerks by ``lam^3``. So velocity, feed and
+    velocity-jump ratios scale like ``1/lam`` (``v`` at a break shrinks, the allowance
+    does not), acceleration like ``1/lam^2``, jerk inside intervals like ``1/lam^3``,
+    acceleration *steps* spread over the fixed IPO cycle like ``1/lam^2``, and
+    frequency ratios like ``1/lam`` (every process lasts ``lam`` times longer). The
+    stop ratio ``|v| / VEL_TOL_MM_S`` also falls like ``1/lam``; a real stop violation
+    therefore gives an absurdly large but correct factor. Stops met stay met.
+
+    Parameters
+    ----------
+    report : ConstraintReport
+        The checker's report on the unscaled profile.
+    constraints : iterable of str
+        The constraints to satisfy, e.g. ``BOUND_SETS["jerk"]``.
+
+    Returns
+    -------
+    float
+        ``max(1, r_v, r_feed, r_jump, r_stop, r_freq, sqrt(r_a), cbrt(r_j,interval),
+        sqrt(r_j,step))``; ``inf`` when a ratio is infinite (a velocity jump with zero
+        allowance cannot be repaired by slowing down).
     """
-    power = {"velocity": 1, "feed": 1, "velocity_jump": 1, "acceleration": 2, "jerk": 3,
-             "frequency": 1}
     lam = 1.0
-    for name in constraints:
-        if name not in power:
-            continue
-        r = report.worst(name).ratio
-        if r > 1.0:
-            lam = max(lam, r ** (1.0 / power[name]))
-    return lam
+    for name in _names(constraints):
+        if name == "jerk":
+            parts = report.components
+            if "jerk_interval" in parts and "jerk_step" in parts:
+                items = [("jerk_interval", parts["jerk_interval"].ratio),
+                         ("jerk_step", parts["jerk_step"].ratio)]
+            else:       # no split known: 1/lam^2 is the safe (slower) assumption
+                items = [("jerk_step", report.worst("jerk").ratio)]
+        else:
+            items = [(name, report.worst(name).ratio)]
+        for key, r in items:
+            if r > 1.0:
+                lam = max(lam, r ** (1.0 / _POWER[key]))
+    return float(lam)
 
 
 def scale_time(profile: Profile, lam: float) -> Profile:
-    """The same path motion slowed down by ``lam`` (t * lam, v / lam, a / lam^2, j / lam^3)."""
+    """The same path motion, ``lam`` times slower.
+
+    Parameters
+    ----------
+    profile : Profile
+        The motion.
+    lam : float
+        Time-stretch factor (finite, > 0).
+
+    Returns
+    -------
+    Profile
+        ``t * lam``, ``v / lam``, ``a / lam^2``, ``j / lam^3``; positions, blocks and
+        rest (``v = 0``) unchanged.
+
+    Raises
+    ------
+    ProfileError
+        ``lam`` is not a finite number > 0.
+    """
+    lam = float(lam)
+    if not (np.isfinite(lam) and lam > 0):
+        raise ProfileError(f"time-scale factor must be finite and > 0, got {lam}")
     return Profile(t=profile.t * lam, s=profile.s, v=profile.v / lam,
                    a=profile.a / lam ** 2, j=profile.j / lam ** 3, block=profile.block)
