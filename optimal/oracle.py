@@ -465,8 +465,6 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         if new_grid is grid:
             break
         grid = new_grid
-    else:  # pragma: no cover - loop always breaks
-        pass
 
     t_total = time.perf_counter() - t_start
     if best is None:

@@ -865,7 +865,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         elif name == "L":
             l_word = (val, w.col)
         elif name == "N":
-            pass
+            continue                     # block numbers were taken as labels by the lexer
         else:
             raise ip.err(st, w.col, f"unknown address {name}")
     for key, value in pending:
@@ -1112,8 +1112,6 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             centre_out, plane_basis, turns = _arc(ip, st, motion, prog, target, centre,
                                                   named, r_word, p_word, motion_word_col)
         ip.pos.update(machine)
-    elif centre and not axis_words:
-        pass
     end = tuple(ip.pos[a] for a in ip.axes)
     tang = ip.tang_defs.get(ip.tang_active) if ip.tang_active else None
     modal_values = (ip.plane, ip.mode10, ip.criterion, ip.adis, ip.adispos, ip.ctol, ip.otol,
