@@ -943,7 +943,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         elif ngc and gi == 10:
             g10 = True
         elif not ngc and gi == 500:              # settable frames off: zero, as modelled
-            pass
+            continue
         elif ngc and gi == 53 or (not ngc and gi in (53, 153)):
             g53 = True
             ip.warn(st, f"G{gi:g}: positions in machine coordinates (frames suppressed for "
@@ -1079,9 +1079,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         for a in aux:
             if a[0] == "S" and a[1] > 0:
                 ip.spindle_rpm = a[1]
-    if is_dwell:
-        pass
-    elif feed_word is not None:
+    if feed_word is not None and not is_dwell:   # a dwell's F is its time, not a feed
         f, col = feed_word
         if f < 0:
             raise ip.err(st, col, f"negative feed F{f:g}")
