@@ -2,18 +2,14 @@
 
 from __future__ import annotations
 
-import math
-
 from ..core.constraints import BOUND_SETS
 from .engine import ReferencePlan
 
 
 def _num(x: float) -> float:
-    """JSON has no inf/NaN: infinite values become a large finite number, NaN 0."""
-    if math.isnan(x):
-        return 0.0
-    if math.isinf(x):
-        return 1e300 if x > 0 else -1e300
+    """A plain float. Infinite values (a velocity jump where the machine allows none)
+    stay ``inf``: the one JSON writer (``compare.export.write_json``) encodes them for
+    every part of the contract alike, so the planner does not invent its own rule."""
     return float(x)
 
 
@@ -27,6 +23,8 @@ def to_json_dict(plan: ReferencePlan) -> dict:
     Returns
     -------
     dict
+        Plain floats (an infinite ratio stays ``inf``; write the dict with
+        ``compare.export.write_json``, which encodes it as the JSON contract says).
         ``{"program", "machine", "bounds", "reference": {"time_s", "violations"},
         "blocks": [...]}``; ``bounds`` is the planner's own bound set, ``violations``
         lists the constraints of that set the own profile breaks
