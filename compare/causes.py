@@ -18,15 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference.core.causes import (AXIS_ACCELERATION, AXIS_VELOCITY, CAUSES, FEED, JERK,
+                                   stop_cause)
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
+from reference.core.rules import (FEASIBLE, axis_acceleration, axis_jerk, is_tangential,
+                                  junction_speed_cap)
 
-#: The cause vocabulary shared with the heuristic and the oracle (plus ``"none"`` for a
-#: block where no limit is tight and ``"-"`` for a block without motion or time).
-CAUSES: tuple[str, ...] = ("feed", "axis velocity", "axis acceleration", "jerk", "frequency",
-                           "corner rule", "look-ahead horizon", "IPO-cycle cap", "exact stop",
-                           "forced stop")
+__all__ = ["CAUSES", "MIN_SHARE", "TIGHT_REL", "derive_causes"]
 
 #: A limit is tight where value/limit >= 1 - TIGHT_REL. 2 % covers the oracle's
 #: discretisation (constant path acceleration between grid nodes on arcs) and the
@@ -42,7 +42,7 @@ _TAU = np.array([1.0, 3.0, 5.0]) / 6.0
 #: Intervals per chunk (bounds memory on long profiles).
 _CHUNK = 50_000
 
-_SHARED = ("feed", "axis velocity", "axis acceleration", "jerk")
+_SHARED = tuple(CAUSES[c] for c in (FEED, AXIS_VELOCITY, AXIS_ACCELERATION, JERK))
 
 
 def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
@@ -97,11 +97,11 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
             ratios = {
                 "feed": np.where(np.isfinite(feed), v / feed, 0.0),
                 "axis velocity": np.max(np.abs(dq) * v[:, None] / lim.v_max, axis=1),
-                "axis acceleration": np.max(np.abs(dq * a[:, None] + ddq * (v * v)[:, None])
+                "axis acceleration": np.max(np.abs(axis_acceleration(dq, ddq, v, a))
                                             / lim.a_max, axis=1),
             }
             if jerk:
-                jr = dq * j[:, None] + 3 * ddq * (v * a)[:, None] + dddq * (v ** 3)[:, None]
+                jr = axis_jerk(dq, ddq, dddq, v, a, j)
                 ratios["jerk"] = np.max(np.abs(jr) / lim.j_max, axis=1)
         for c in names:
             tight[c] += np.bincount(b, weights=w * (ratios[c] >= 1.0 - TIGHT_REL),
@@ -116,7 +116,7 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
             out[i] = "-"
             continue
         if span.s_end <= span.s_start:          # a hold: dwell or stop without motion
-            out[i] = _stop_cause(span.stop_reason) if span.stop_reason else "-"
+            out[i] = stop_cause(span.stop_reason) if span.stop_reason else "-"
             continue
         shares = {c: tight[c][i] / T for c in names}
         best = max(shares, key=shares.get)
@@ -130,32 +130,27 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
     return out
 
 
-def _stop_cause(reason: str) -> str:
-    return "exact stop" if reason.startswith("exact") else "forced stop"
-
-
 def _block_end_kind(path: Path, profile: Profile, lim) -> dict[int, str]:
     """Blocks that end in a required stop or in a corner crossed at the jump allowance."""
     out: dict[int, str] = {}
     if path.n_segments == 0:
         return out
     t_in, t_out = path.junction_tangents()
+    tangential = np.concatenate(([True], is_tangential(t_in, t_out), [True]))
     corners: list[tuple[int, int]] = []
     for span in path.blocks:
         if span.n_segments == 0:
             continue
         k = span.first_segment + span.n_segments          # break at the block end
         if path.stop[k]:
-            out[span.block] = _stop_cause(path.stop_reason[k]) if k < path.n_segments \
+            out[span.block] = stop_cause(path.stop_reason[k]) if k < path.n_segments \
                 else "forced stop"                        # the program end
-        elif np.any(np.abs(t_out[k - 1] - t_in[k - 1]) > 1e-9):
+        elif not tangential[k]:
             corners.append((span.block, k))
     if corners:
         ks = np.array([k for _, k in corners])
         v_end = profile.state(profile.time_at(path.s_breaks[ks]))[1]
-        dt = np.abs(t_out[ks - 1] - t_in[ks - 1])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            v_allow = np.min(np.where(dt > 1e-9, lim.jump[None, :] / dt, np.inf), axis=1)
+        v_allow = junction_speed_cap(t_in[ks - 1], t_out[ks - 1], lim.jump, FEASIBLE)[0]
         for (b, _), ve, va in zip(corners, v_end, v_allow):
             if ve >= (1.0 - TIGHT_REL) * va:
                 out[b] = "corner rule"

@@ -33,13 +33,14 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from reference.core.causes import normalise_cause
 from reference.core.constraints import BOUND_SETS, ConstraintReport, ConstraintResult, check_profile
 from reference.core.geometry import BlockSpan, Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.tolerances import RATIO_TOL
 
-from .causes import CAUSES, derive_causes
+from .causes import derive_causes
 
 #: Kinds of blocks the planner inserts (they have no NC line of their own).
 INSERTED_KINDS = ("rounding", "trc", "tlift")
@@ -141,7 +142,7 @@ class BlockRow:
     v_entry_oracle, v_exit_oracle, v_peak_oracle : float
         Path speeds, mm/s.
     limit_reference, limit_oracle : str
-        Limiting cause on each side (see :data:`compare.causes.CAUSES`).
+        Limiting cause on each side (see :data:`reference.core.causes.CAUSES`).
     ratio_reference, ratio_oracle : float
         Worst ratio value/limit in the block over the side's declared constraints.
     stop_reason : str
@@ -545,12 +546,12 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     by_block = {b.block: b for b in spans}
     jerk_ref = "jerk" in BOUND_SETS[reference.bound_set]
     jerk_opt = "jerk" in BOUND_SETS.get(oracle.bounds, ())
-    c_ref = {b: normalise_cause(v, by_block.get(b))
+    c_ref = {b: _block_cause(v, by_block.get(b))
              for b, v in (reference.causes or {}).items()}
     if any(b.block not in c_ref for b in spans):
         derived = derive_causes(path, limits, ref_prof, jerk=jerk_ref)
         c_ref = {**derived, **c_ref}
-    c_opt = {b: normalise_cause(v, by_block.get(b)) for b, v in (oracle.causes or {}).items()}
+    c_opt = {b: _block_cause(v, by_block.get(b)) for b, v in (oracle.causes or {}).items()}
     if opt_prof is not None and any(b.block not in c_opt for b in spans):
         derived = derive_causes(path, limits, opt_prof, jerk=jerk_opt)
         c_opt = {**derived, **c_opt}
@@ -608,31 +609,11 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                       reference_ratio_tol=reference.ratio_tol)
 
 
-#: The oracle's active-constraint labels -> the shared cause vocabulary.
-_ORACLE_CAUSES = {"feed": "feed", "velocity": "axis velocity",
-                  "acceleration": "axis acceleration", "jerk": "jerk",
-                  "frequency": "frequency", "velocity_jump": "corner rule"}
-
-
-def normalise_cause(label: str, span: BlockSpan | None = None) -> str:
-    """A limit label in the shared vocabulary (:data:`compare.causes.CAUSES`).
-
-    The oracle names its active constraint per block as ``"feed"``, ``"velocity X"``,
-    ``"acceleration X"``, ``"velocity_jump"`` or ``"stop"`` (and the stop reason for
-    blocks without motion); the heuristic already uses the vocabulary.
-    """
-    label = (label or "").strip()
-    if not label:
-        return "-"
-    if label in CAUSES or label in ("none", "-"):
-        return label
-    head = label.split()[0]
-    if head in _ORACLE_CAUSES:
-        return _ORACLE_CAUSES[head]
-    reason = span.stop_reason if span is not None and span.stop_reason else label
-    if head == "stop" or span is not None and span.n_segments == 0:
-        return "exact stop" if reason.startswith("exact") else "forced stop"
-    return label
+def _block_cause(label: str, span: BlockSpan | None = None) -> str:
+    """A block's limit label in the shared vocabulary (see
+    :func:`reference.core.causes.normalise_cause`)."""
+    return normalise_cause(label, span.stop_reason if span is not None else None,
+                      span is not None and span.n_segments == 0)
 
 
 def oracle_result(solution, bounds: str = "acc") -> OracleResult:

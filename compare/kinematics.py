@@ -15,6 +15,7 @@ import numpy as np
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
+from reference.core.rules import axis_acceleration, axis_jerk, axis_velocity
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,9 +66,9 @@ def axis_motion(path: Path, profile: Profile, t: np.ndarray) -> AxisMotion:
     v = np.maximum(v, 0.0)
     seg = path.segment_index(s)
     q, dq, ddq, dddq = path.evaluate(s, segment=seg)
-    vel = dq * v[:, None]
-    acc = dq * a[:, None] + ddq * (v * v)[:, None]
-    jerk = dq * j[:, None] + 3.0 * ddq * (v * a)[:, None] + dddq * (v ** 3)[:, None]
+    vel = axis_velocity(dq, v)
+    acc = axis_acceleration(dq, ddq, v, a)
+    jerk = axis_jerk(dq, ddq, dddq, v, a, j)
     return AxisMotion(t=t, s=s, v=v, a=a, j=j, q=q, vel=vel, acc=acc, jerk=jerk, segment=seg)
 
 

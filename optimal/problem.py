@@ -42,7 +42,7 @@ import numpy as np
 from reference.core.errors import InfeasibleError
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays
-from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
+from reference.core.rules import FEASIBLE, RELAXED, junction_speed_cap
 
 from .grid import Grid
 from .status import SolveStatus
@@ -220,10 +220,12 @@ def junction_speed_caps(path: Path, lim: AxisArrays, *, permissive: bool
                         ) -> tuple[np.ndarray, np.ndarray]:
     """Largest path speed at every interior segment break allowed by the axis jumps.
 
-    At a break with tangents ``t_in`` and ``t_out`` the axis velocity jumps by
-    ``v |t_out_i - t_in_i|``. ``check_profile`` accepts a jump up to the allowance
-    ``jump_i = a_max_i (ovl_i - 1) t_ipo`` and, as standstill, any jump up to
-    ``VEL_TOL_MM_S``. Hence ``v <= min_i max(jump_i, VEL_TOL) / |t_out_i - t_in_i|``.
+    The rule is the rulebook's (:func:`reference.core.rules.junction_speed_cap`, the one
+    the checker and the heuristic apply): the grid problem takes its *feasible* flavour
+    (every speed at or below it passes ``check_profile``; tangential breaks are free, the
+    standstill floor ``VEL_TOL_MM_S`` counts as an allowance, caps at standstill level
+    become a stop), the lower-bound relaxation its *relaxed* flavour (no speed above it
+    passes ``check_profile``).
 
     Parameters
     ----------
@@ -232,9 +234,8 @@ def junction_speed_caps(path: Path, lim: AxisArrays, *, permissive: bool
     lim : AxisArrays
         Limits in the path's axis order.
     permissive : bool
-        False: the cap used by the grid problem (caps at or below ``VEL_TOL_MM_S`` become
-        an exact stop, 0). True: the largest speed the checker could accept (allowance
-        times ``1 + RATIO_TOL``), used by the lower-bound relaxation.
+        False: the feasible cap of the grid problem. True: the relaxed cap of the
+        lower-bound relaxation.
 
     Returns
     -------
@@ -249,15 +250,7 @@ def junction_speed_caps(path: Path, lim: AxisArrays, *, permissive: bool
     if m < 2:
         return v_cap, axis
     t_in, t_out = path.junction_tangents()
-    dt = np.abs(t_out - t_in)
-    allow = np.maximum(lim.jump * (1.0 + RATIO_TOL) if permissive else lim.jump,
-                       VEL_TOL_MM_S)
-    with np.errstate(divide="ignore"):
-        per_axis = np.where(dt > 0, allow[None, :] / np.where(dt > 0, dt, 1.0), np.inf)
-    v = per_axis.min(axis=1)
-    ax = np.where(np.isfinite(v), per_axis.argmin(axis=1), -1)
-    if not permissive:
-        v = np.where(v <= VEL_TOL_MM_S, 0.0, v)
+    v, ax = junction_speed_cap(t_in, t_out, lim.jump, RELAXED if permissive else FEASIBLE)
     v_cap[1:m] = v
     axis[1:m] = ax
     return v_cap, axis

@@ -95,3 +95,84 @@ def test_rules_catch_a_violation(tmp_path: Path) -> None:
         assert "cvxpy" in mods and "reference.planner" in mods
     finally:
         bad.unlink()
+
+
+# ------------------------------------------------------------------ one rulebook
+#: The modules that hold the shared rules (DESIGN section 2, "One rulebook").
+RULEBOOK = ("reference/core/rules.py", "reference/core/causes.py",
+            "reference/core/tolerances.py")
+#: Where the heuristic, the oracle (grid problem and relaxation), the checker and
+#: compare live: none of them may define its own copy of a rulebook name.
+CONSUMERS = ("reference", "optimal", "compare")
+
+
+def _defined_names(py: Path) -> dict[str, int]:
+    """Module-level assignments and function/class definitions of a file -> line."""
+    tree = ast.parse(py.read_text(encoding="utf-8"))
+    out: dict[str, int] = {}
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            out[node.name] = node.lineno
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for tg in targets:
+                for n in ast.walk(tg):
+                    if isinstance(n, ast.Name):
+                        out[n.id] = node.lineno
+    return out
+
+
+def _rulebook_names() -> set[str]:
+    names: set[str] = set()
+    for rel in RULEBOOK:
+        names |= {n for n in _defined_names(ROOT / rel) if not n.startswith("_")}
+    return names
+
+
+def _cause_words() -> tuple[str, ...]:
+    """Cause words that are not also checker constraint names ("feed", "jerk", ...)."""
+    from reference.core.causes import CAUSES
+    from reference.core.constraints import CONSTRAINTS
+    return tuple(c for c in CAUSES if c not in CONSTRAINTS)
+
+
+def _copies(py: Path, names: set[str], words: tuple[str, ...]) -> list[str]:
+    """Rulebook names a file redefines, and literal collections of cause words."""
+    rel = py.relative_to(ROOT)
+    found = [f"{rel}:{line} defines {name}, a rulebook name"
+             for name, line in _defined_names(py).items() if name in names]
+    for node in ast.walk(ast.parse(py.read_text(encoding="utf-8"))):
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            elts = node.elts
+        elif isinstance(node, ast.Dict):
+            elts = [v for v in node.values if v is not None]
+        else:
+            continue
+        hits = {e.value for e in elts if isinstance(e, ast.Constant) and e.value in words}
+        if len(hits) >= 2 or isinstance(node, ast.Dict) and "corner rule" in hits:
+            found.append(f"{rel}:{node.lineno} spells out the cause vocabulary {sorted(hits)}")
+    return found
+
+
+@pytest.mark.parametrize("folder", CONSUMERS)
+def test_no_module_keeps_its_own_copy_of_a_shared_rule(folder: str) -> None:
+    names, words = _rulebook_names(), _cause_words()
+    rulebook = {ROOT / r for r in RULEBOOK}
+    problems = []
+    for py in _files(folder):
+        if py not in rulebook:
+            problems += _copies(py, names, words)
+    assert not problems, "\n".join(problems)
+
+
+def test_rulebook_check_sees_a_copy() -> None:
+    """The copy detector must see a redefined tolerance and a private cause list."""
+    bad = ROOT / "compare" / "_probe_rules_tmp.py"
+    try:
+        bad.write_text("TANGENT_TOL_RAD = 1e-7\n"
+                       "X = ('feed', 'axis velocity', 'corner rule')\n"
+                       "def junction_speed_cap():\n    pass\n")
+        found = _copies(bad, _rulebook_names(), _cause_words())
+        assert len(found) == 3, found
+    finally:
+        bad.unlink()

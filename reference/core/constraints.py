@@ -26,7 +26,7 @@ Constraints (:data:`CONSTRAINTS`)
     the step over one IPO cycle (sinumerik-model 6.3), so the step counts as the jerk
     ``|delta A_i| / t_ipo``, ``A_i = q'_i s'' + q''_i v^2`` on each side. It is judged
     against ``path_trans_jerk_i`` (MD32432) at a segment break where the curvature
-    vector jumps (a component by more than :data:`CURVATURE_JUMP_TOL_PER_MM`) while the
+    vector jumps (:func:`reference.core.rules.curvature_jumps`) while the
     path moves (``v > VEL_TOL_MM_S``), and against ``j_max_i`` everywhere else. BRISK profiles (acceleration steps by design)
     therefore show large jerk ratios; that is expected, their bound set has no jerk.
 ``feed``
@@ -103,7 +103,9 @@ from .errors import ProfileError
 from .geometry import Path
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
-from .tolerances import POS_TOL_MM, RATIO_TOL, TANGENT_TOL_RAD, VEL_TOL_MM_S
+from .rules import (axis_acceleration, axis_jerk, axis_velocity, axis_velocity_jumps,
+                    curvature_jumps, jump_ratio, step_jerk_limit)
+from .tolerances import MOVING_AXIS_TOL, POS_TOL_MM, RATIO_TOL, VEL_TOL_MM_S
 
 __all__ = ["BOUND_SETS", "CONSTRAINTS", "ConstraintReport", "ConstraintResult", "UNITS",
            "check_profile", "scale_time", "time_scale_factor"]
@@ -143,19 +145,6 @@ CHUNK_SAMPLES = 65_536
 #: few 1e-7, while a process whose acceleration stays below 1e-6 of the profile's
 #: largest one changes the speed by a negligible amount and excites nothing.
 FREQ_ACCEL_TOL_REL = 1e-6
-
-#: Curvature vectors (1/mm; deg/mm^2 for rotary axes) whose components all differ by at
-#: most this count as continuous at a segment break. Same value as the heuristic's
-#: ``reference.planner.parameters.CURVATURE_JUMP_TOL``, so both classify breaks alike;
-#: float64 round-off of q'' (about 1e-16 / r) stays below it for radii above 0.1 um,
-#: and a jump that small (radius 10^12 mm) gives no measurable acceleration step.
-CURVATURE_JUMP_TOL_PER_MM = 1e-12
-
-#: An axis takes part in a velocity-change process when its tangent component can
-#: exceed this on the segment (1; deg/mm for rotary axes). Same value as the
-#: heuristic's ``AXIS_MOVING_TOL``: a 1e-9 component at 1 m/s moves the axis by 4 pm
-#: per IPO cycle.
-MOVING_AXIS_TOL = 1e-9
 
 
 # =========================================================================== results
@@ -326,14 +315,6 @@ class _Worst:
     def result(self, name: str) -> ConstraintResult:
         return ConstraintResult(name, self.ratio, self.value, self.limit, UNITS[name],
                                 self.s, self.t, self.block, self.axis)
-
-
-def _jump_ratio(dv: np.ndarray, allowance: np.ndarray) -> np.ndarray:
-    """``dv / allowance``; a jump of at most VEL_TOL_MM_S is standstill-level (0), and a
-    larger one against a zero allowance is ``inf``."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = dv / np.where(allowance > 0, allowance, 1.0)
-    return np.where(dv <= VEL_TOL_MM_S, 0.0, np.where(allowance > 0, r, np.inf))
 
 
 # ====================================================================== the checker
@@ -543,9 +524,9 @@ def _axis_kinematics(ctx: _Ctx, k: np.ndarray, tau: np.ndarray):
     # round-off must not push a point into the neighbouring segment
     s = np.clip(s, path.s_breaks[seg], path.s_breaks[seg + 1])
     _, dq, ddq, dddq = path.evaluate(s, segment=seg)
-    vel = np.abs(dq * v[:, None])
-    acc = np.abs(dq * a[:, None] + ddq * (v * v)[:, None])
-    jer = np.abs(dq * j[:, None] + ddq * (3 * v * a)[:, None] + dddq * (v ** 3)[:, None])
+    vel = np.abs(axis_velocity(dq, v))
+    acc = np.abs(axis_acceleration(dq, ddq, v, a))
+    jer = np.abs(axis_jerk(dq, ddq, dddq, v, a, j))
     return vel, acc, jer, s, p.t[k] + tau
 
 
@@ -613,7 +594,7 @@ def _axis_acc_at_knots(ctx: _Ctx, kn: np.ndarray, side: str) -> np.ndarray:
     seg = ctx.seg[ivc]
     s = np.clip(p.s[kn], path.s_breaks[seg], path.s_breaks[seg + 1])
     _, dq, ddq, _ = path.evaluate(s, segment=seg)
-    acc = dq * a[:, None] + ddq * (v * v)[:, None]
+    acc = axis_acceleration(dq, ddq, v, a)
     return np.where(valid[:, None], acc, 0.0), ddq, valid, seg
 
 
@@ -627,9 +608,9 @@ def _check_steps(ctx: _Ctx, w: _Worst) -> None:
         acc_l, ddq_l, val_l, seg_l = _axis_acc_at_knots(ctx, kn, "left")
         acc_r, ddq_r, val_r, seg_r = _axis_acc_at_knots(ctx, kn, "right")
         step = np.abs(acc_r - acc_l)
-        jump = np.any(np.abs(ddq_r - ddq_l) > CURVATURE_JUMP_TOL_PER_MM, axis=1)
+        jump = curvature_jumps(ddq_l, ddq_r)
         curv = val_l & val_r & (seg_l != seg_r) & jump & (np.abs(p.v[kn]) > VEL_TOL_MM_S)
-        jlim = np.where(curv[:, None], lim.path_trans_jerk[None, :], lim.j_max[None, :])
+        jlim = step_jerk_limit(curv, lim.j_max, lim.path_trans_jerk)
         val = step / ctx.t_ipo
         # the block the motion is in just before the knot (the first block at the start)
         blk = path.block[np.where(val_l, seg_l, seg_r)]
@@ -662,19 +643,14 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
                              blk_b[stop])
     if m < 2:
         return
+    # the tangents every side uses (Path.junction_tangents), so the planner's and the
+    # oracle's corner caps are judged on the very numbers they were computed from
+    t_in, t_out = path.junction_tangents()
     for lo, hi in _chunks(np.full(m - 1, 16)):
         b = np.arange(lo, hi) + 1
-        # tangents on both sides (Path.junction_tangents, chunk by chunk)
-        ti = path.evaluate(sb[b], segment=b - 1)[1]
-        to = path.evaluate(sb[b], segment=b)[1]
-        # angle between the tangents, stable for tiny angles: 2 atan(|u1-u2| / |u1+u2|)
-        u1 = ti / np.linalg.norm(ti, axis=1, keepdims=True)
-        u2 = to / np.linalg.norm(to, axis=1, keepdims=True)
-        ang = 2 * np.arctan2(np.linalg.norm(u1 - u2, axis=1), np.linalg.norm(u1 + u2, axis=1))
-        dv = np.abs(to - ti) * v_b[b][:, None]
-        dv = np.where((ang > TANGENT_TOL_RAD)[:, None], dv, 0.0)
+        dv = axis_velocity_jumps(t_in[b - 1], t_out[b - 1], v_b[b])
         jump = np.broadcast_to(lim.jump, dv.shape)
-        worst["velocity_jump"].update(_jump_ratio(dv, jump), dv, jump, sb[b], p.t[k_first[b]],
+        worst["velocity_jump"].update(jump_ratio(dv, jump), dv, jump, sb[b], p.t[k_first[b]],
                                       blk_b[b], path.axes)
 
 

@@ -39,3 +39,22 @@ RATIO_TOL = 1e-6
 
 #: Relative agreement demanded between two exact methods on the same discrete problem.
 DISCRETE_AGREEMENT_RTOL = 1e-5
+
+#: Relative margin by which a construction stays on the safe side of a shared rule
+#: (reference.core.rules): a feasible cap is shrunk by it, a relaxed one grown by it, so
+#: two evaluations of the same quantity with different round-off never disagree across
+#: the threshold. Observed disagreement: 1e-14 relative (a corner speed set from the
+#: standstill floor was measured back at 1.0000000000000105e-06 mm/s); 1e-9 is 1e5 times
+#: that and still moves no bound by a measurable amount.
+ROUNDOFF_MARGIN_REL = 1e-9
+
+#: Curvature vectors (1/mm; deg/mm^2 for rotary axes) whose components all differ by at
+#: most this count as continuous at a segment break (the curvature-jump rule).
+#: float64 round-off of q'' (about 1e-16 / r) stays below it for radii above 0.1 um,
+#: and a jump that small (radius 10^12 mm) gives no measurable acceleration step.
+CURVATURE_JUMP_TOL_PER_MM = 1e-12
+
+#: An axis takes part in a motion when its tangent component can exceed this on the
+#: segment (1; deg/mm for rotary axes): a 1e-9 component at 1 m/s moves the axis by
+#: 4 pm per IPO cycle.
+MOVING_AXIS_TOL = 1e-9

@@ -12,7 +12,10 @@ cap, its cause the rule that gave it (ties: the rule listed first).
 ``G64``         non-tangential breaks: every axis' velocity step ``v |t2_i - t1_i|``
                 stays within ``A_i (ovl_i - 1) T_ipo`` (MD32310):
                 ``v <= min_i A_i (ovl_i - 1) T_ipo / |t2_i - t1_i|``; an overload factor
-                of 1.0 gives 0 at every non-tangential corner: ``corner rule``
+                of 1.0 gives a stop at every non-tangential corner except near-tangent
+                kinks, whose step stays below the standstill level at a few mm/s (the
+                feasible flavour of :func:`reference.core.rules.junction_speed_cap`, the
+                rule the checker and the oracle apply): ``corner rule``
 ``curvature``   SOFT, breaks with a curvature jump (tangential or not): the planner passes
                 every break of SOFT profiles at zero path acceleration, so each axis
                 acceleration steps by ``v^2 |q''2_i - q''1_i|``; spread over one IPO
@@ -21,8 +24,8 @@ cap, its cause the rule that gave it (ties: the rule listed first).
 ``caps``        the speed caps of both neighbouring segments (feed, axis velocity,
                 curvature, IPO cycle): their own causes
 
-Tangential means: angle between the tangents at most ``TANGENT_TOL_RAD`` (the checker's
-threshold, so both judge a break alike). The issue asks for the curvature rule "at
+Tangential means :func:`reference.core.rules.is_tangential` (the rule the checker and
+the oracle apply, so all judge a break alike). The issue asks for the curvature rule "at
 tangential transitions"; the planner applies it at every SOFT break because a corner
 with a curvature jump (arc into line at an angle) steps the axis accelerations just the
 same, and the checker judges every such step.
@@ -41,10 +44,10 @@ import numpy as np
 
 from ..core.geometry import Path
 from ..core.limits import AxisArrays
-from ..core.tolerances import TANGENT_TOL_RAD
+from ..core.rules import (FEASIBLE, curvature_jump_speed_cap, curvature_jumps, is_tangential,
+                          junction_speed_cap, step_jerk_limit)
 from . import causes as C
 from .limit_curves import SegmentLimits
-from .parameters import CURVATURE_JUMP_TOL
 from .stops import STOP_EXACT, SegmentModes
 
 
@@ -92,7 +95,7 @@ class _Inputs:
 
 
 def g64_corner_speed(t_in: np.ndarray, t_out: np.ndarray, jump: np.ndarray) -> np.ndarray:
-    """G64 corner speed ``min_i jump_i / |t_out_i - t_in_i|`` (0 if a jump is forbidden).
+    """G64 corner speed: the feasible junction cap of the shared rulebook.
 
     Parameters
     ----------
@@ -104,12 +107,9 @@ def g64_corner_speed(t_in: np.ndarray, t_out: np.ndarray, jump: np.ndarray) -> n
     Returns
     -------
     numpy.ndarray, shape (k,)
-        mm/s (``inf`` where no axis changes direction).
+        mm/s (``inf`` at tangential breaks and where no axis changes direction).
     """
-    dt = np.abs(t_out - t_in)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.where(dt > 0, jump[None, :] / np.where(dt > 0, dt, 1.0), np.inf)
-    return v.min(axis=1) if v.size else np.full(dt.shape[0], np.inf)
+    return junction_speed_cap(t_in, t_out, jump, FEASIBLE)[0]
 
 
 def _rule_stop(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
@@ -126,17 +126,11 @@ def _interior(x: _Inputs, values: np.ndarray) -> np.ndarray:
 
 def _rule_g64(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
     v = g64_corner_speed(x.t_in, x.t_out, x.lim.jump)
-    v = np.where(x.tangential, np.inf, v)
     return _interior(x, v), np.full(x.path.n_segments + 1, C.CORNER_RULE)
 
 
 def _rule_curvature(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
-    dk = np.abs(x.k_out - x.k_in)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.where(dk > CURVATURE_JUMP_TOL,
-                     np.sqrt(x.lim.path_trans_jerk[None, :] * x.t_ipo / np.where(
-                         dk > 0, dk, 1.0)), np.inf)
-    v = v.min(axis=1) if v.size else np.zeros(0)
+    v = curvature_jump_speed_cap(x.k_in, x.k_out, x.lim.path_trans_jerk, x.t_ipo)
     jl = x.modes.jerk_limited
     soft_both = jl[:-1] & jl[1:]
     v = np.where(soft_both, v, np.inf)
@@ -183,12 +177,7 @@ def junction_limits(path: Path, lim: AxisArrays, t_ipo: float, modes: SegmentMod
     m = path.n_segments
     t_in, t_out = path.junction_tangents()
     k_in, k_out = path.junction_curvatures()
-    if m >= 2:
-        cosang = np.sum(t_in * t_out, axis=1) / np.maximum(
-            np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1), 1e-300)
-        tangential = np.arccos(np.clip(cosang, -1.0, 1.0)) <= TANGENT_TOL_RAD
-    else:
-        tangential = np.zeros(0, dtype=bool)
+    tangential = is_tangential(t_in, t_out, FEASIBLE)
     x = _Inputs(path=path, lim=lim, t_ipo=t_ipo, modes=modes, seg=seg, t_in=t_in,
                 t_out=t_out, k_in=k_in, k_out=k_out, tangential=tangential)
     results = [rule(x) for _, rule in JUNCTION_RULES]
@@ -224,8 +213,7 @@ def through_acceleration(x: _Inputs) -> np.ndarray:
         return out
     dk = np.abs(x.k_out - x.k_in)
     dt = np.abs(x.t_out - x.t_in)
-    curv = np.any(dk > CURVATURE_JUMP_TOL, axis=1)
-    jlim = np.where(curv[:, None], x.lim.path_trans_jerk[None, :], x.lim.j_max[None, :])
+    jlim = step_jerk_limit(curvature_jumps(x.k_in, x.k_out), x.lim.j_max, x.lim.path_trans_jerk)
     c = np.minimum(x.seg.cap[:-1], x.seg.cap[1:])
     budget = jlim * x.t_ipo - dk * (c * c)[:, None]
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -43,7 +43,8 @@ import numpy as np
 from ..core.geometry import Path
 from ..machine import Machine
 from . import causes as C
-from .parameters import AXIS_MOVING_TOL, PlannerParameters
+from ..core.tolerances import MOVING_AXIS_TOL
+from .parameters import PlannerParameters
 from .stops import ACCEL_MODES, SegmentModes
 
 
@@ -153,7 +154,7 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     m = path.n_segments
     lim, A, J = _axis_factors(path, machine, modes)
     D, P, Q, R = axis_amplitudes(path)
-    moving = (D + P) > AXIS_MOVING_TOL
+    moving = (D + P) > MOVING_AXIS_TOL
     inf = np.full(m, np.inf)
     soft = modes.jerk_limited
     with np.errstate(divide="ignore", invalid="ignore"):

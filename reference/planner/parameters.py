@@ -30,13 +30,6 @@ DISTANCE_REL_TOL = 1e-9
 #: already shrink the bracket to 2^-60 of its width.
 PEAK_SOLVE_ITERATIONS = 60
 
-#: Curvature differences below this are "no curvature jump", 1/mm. Same threshold as the
-#: checker's (reference.core.constraints) so both classify breaks alike.
-CURVATURE_JUMP_TOL = 1e-12
-
-#: Axis tangent components below this count as "axis not moving", 1 (mm/mm). A 1e-9
-#: component at 1 m/s moves the axis by 4 pm per IPO cycle.
-AXIS_MOVING_TOL = 1e-9
 
 
 @dataclass(frozen=True, slots=True)

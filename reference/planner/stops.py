@@ -36,7 +36,8 @@ import numpy as np
 from ..core.geometry import Path
 from ..machine import Machine
 from ..nc.program import Program
-from .parameters import AXIS_MOVING_TOL, PlannerParameters
+from ..core.tolerances import MOVING_AXIS_TOL
+from .parameters import PlannerParameters
 
 
 @dataclass(frozen=True, slots=True)
@@ -201,7 +202,7 @@ def settle_times(program: Program, path: Path, machine: Machine, modes: SegmentM
             continue
         window = np.array([getattr(st, field) for st in settings])
         v_axis = np.abs(dq[row]) * v_before_brake[k]
-        moving = np.abs(dq[row]) > AXIS_MOVING_TOL
+        moving = np.abs(dq[row]) > MOVING_AXIS_TOL
         e0 = params.settle_lag_factor * v_axis / kv
         with np.errstate(divide="ignore"):
             t = np.where(moving & (e0 > window), np.log(e0 / window) / kv, 0.0)

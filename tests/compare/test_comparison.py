@@ -11,8 +11,8 @@ import pytest
 from conftest import SMALL, path_of
 from fakes import FakeSolution, fake_plan, fake_solution, toy_profile
 
-from compare.comparison import (BlockRow, OracleResult, Side, compare, compare_profiles,
-                                normalise_cause)
+from compare.comparison import BlockRow, OracleResult, Side, compare, compare_profiles
+from reference.core.causes import normalise_cause
 from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
 
 
@@ -146,8 +146,9 @@ def test_oracle_labels_map_to_the_shared_vocabulary():
     assert normalise_cause("velocity Z") == "axis velocity"
     assert normalise_cause("velocity_jump") == "corner rule"
     assert normalise_cause("feed") == "feed"
-    assert normalise_cause("stop", span) == "exact stop"
-    assert normalise_cause("dwell G4 0.2 s", idle) == "forced stop"
+    assert normalise_cause("stop", span.stop_reason) == "exact stop"
+    assert normalise_cause("dwell G4 0.2 s", idle.stop_reason,
+                           idle.n_segments == 0) == "forced stop"
     assert normalise_cause("") == "-"
     assert normalise_cause("look-ahead horizon") == "look-ahead horizon"
 

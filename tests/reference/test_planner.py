@@ -369,13 +369,6 @@ def test_parameters_are_validated():
         PlannerParameters(settle_lag_factor=-1.0)
 
 
-def test_planner_tolerances_match_the_checker():
-    from reference.core import constraints
-    from reference.planner import parameters
-    assert parameters.CURVATURE_JUMP_TOL == constraints.CURVATURE_JUMP_TOL_PER_MM
-    assert parameters.AXIS_MOVING_TOL == constraints.MOVING_AXIS_TOL
-
-
 # ----------------------------------------------------------------- outputs
 PROGRAM = ("G90 G64 SOFT F6000\nN10 G1 X50\nN20 G1 Y50\nN30 G3 X0 Y50 CR=25\n"
            "N40 G4 F0.2\nN50 G1 X0 Y0 G9\nM30\n")
