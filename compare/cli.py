@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import traceback
 from pathlib import Path as FsPath
 from typing import Sequence
 
@@ -19,7 +20,7 @@ from reference.prepare import prepare, unmodelled_features
 
 from .progress import Progress
 
-EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 
 
 class _Parser(argparse.ArgumentParser):
@@ -88,6 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--dialect", choices=("sinumerik", "ngc"), default=None,
                         help="NC dialect (default: from the file extension)")
         sp.add_argument("--quiet", action="store_true", help="no progress output")
+        sp.add_argument("--debug", action="store_true",
+                        help="on an internal error (exit 3), print the traceback")
 
     sp = sub.add_parser("inspect", help="blocks -> path segments table")
     sp.add_argument("program")
@@ -124,6 +127,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         progress.done()
         print("feedoracle: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:          # noqa: BLE001 - the last line of defence, exit 3
+        # anything else is a bug of feedoracle, never bad input and never a gap: one
+        # line saying so (the traceback with --debug), and an exit code of its own
+        progress.done()
+        print(f"feedoracle: internal error (a bug in feedoracle, please report it): "
+              f"{type(exc).__name__}: {exc}"
+              + ("" if args.debug else "; run with --debug for the "
+                 "traceback"), file=sys.stderr)
+        if args.debug:
+            traceback.print_exc(file=sys.stderr)
+        return EXIT_INTERNAL
     finally:
         progress.done()
 

@@ -1,14 +1,7 @@
 """JSON and CSV output (the contract of DESIGN section 7 and ``schema/result.schema.json``).
 
-JSON has no infinity and no NaN. Where a value is not finite we write:
-
-* ``+inf`` (a velocity jump at a corner where the machine allows none has ratio
-  ``inf``; a gap upper end with a zero lower bound) as ``1.7976931348623157e+308``, the
-  largest double, together with a sibling flag ``"<name>_infinite": true``. It parses
-  back to a float larger than any real value, so ``ratio > 1`` tests stay right;
-* ``-inf`` as ``-1.7976931348623157e+308`` (same flag);
-* ``NaN`` (a quantity that does not exist, e.g. the oracle's speed without an oracle
-  profile) by leaving the key out, or ``null`` in fields the schema does not type.
+Non-finite numbers are encoded by the one JSON writer of the project,
+:mod:`reference.core.jsonio` (re-exported here).
 
 Every ``--json`` output validates against the schema; the tests check it.
 """
@@ -28,12 +21,15 @@ import numpy as np
 
 from reference.core.constraints import BOUND_SETS, ConstraintResult
 from reference.core.geometry import Path
+from reference.core.jsonio import JSON_INF, dumps, json_ready, write_json
 from reference.core.profile import Profile
 
 from .comparison import BlockRow, Comparison, block_span
 
-#: How +inf is written (see the module docstring).
-JSON_INF = sys.float_info.max
+__all__ = ["CSV_COLUMNS", "JSON_INF", "blocks_csv", "comparison_dict", "dumps", "json_ready",
+           "profile_samples", "schema", "violation_dict", "write_json",
+           "write_samples_csv"]
+
 
 #: Block-row columns of the CSV report, in order.
 CSV_COLUMNS = ("block", "line", "label", "kind", "corner", "length_mm", "t_reference_s",
@@ -47,48 +43,6 @@ def schema() -> dict:
     """The result schema shipped with the package (a copy of ``shared/schema``)."""
     text = resources.files("compare").joinpath("schema/result.schema.json").read_text("utf-8")
     return json.loads(text)
-
-
-def _clean(obj: Any) -> Any:
-    """Replace non-finite floats recursively (see the module docstring)."""
-    if isinstance(obj, dict):
-        out = {}
-        for k, v in obj.items():
-            if isinstance(v, (float, np.floating)) and not math.isfinite(float(v)):
-                if math.isnan(float(v)):
-                    continue
-                out[k] = JSON_INF if v > 0 else -JSON_INF
-                out[f"{k}_infinite"] = True
-            else:
-                out[k] = _clean(v)
-        return out
-    if isinstance(obj, (list, tuple)):
-        return [None if isinstance(v, (float, np.floating)) and math.isnan(float(v))
-                else (JSON_INF if v > 0 else -JSON_INF)
-                if isinstance(v, (float, np.floating)) and math.isinf(float(v))
-                else _clean(v) for v in obj]
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
-
-
-def dumps(obj: dict | list) -> str:
-    """JSON text of a result (non-finite floats replaced, strict JSON)."""
-    return json.dumps(_clean(obj), indent=1, allow_nan=False, ensure_ascii=False) + "\n"
-
-
-def write_json(obj: dict | list, file: str | FsPath) -> None:
-    """Write a result as JSON (``-`` writes to stdout)."""
-    text = dumps(obj)
-    if str(file) == "-":
-        sys.stdout.write(text)
-        return
-    FsPath(file).parent.mkdir(parents=True, exist_ok=True)
-    FsPath(file).write_text(text, encoding="utf-8")
 
 
 def violation_dict(v: ConstraintResult, path: Path | None = None) -> dict:

@@ -56,6 +56,7 @@ import numpy as np
 
 from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
                                         scale_time, time_scale_factor)
+from reference.core.errors import InternalError
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
@@ -455,6 +456,14 @@ def verified_profile(path: Path, limits: MachineLimits, s: np.ndarray, b: np.nda
     prof = Profile.from_path_velocity(s, np.sqrt(np.maximum(b, 0.0)), block)
     report = check_profile(path, limits, prof)
     lam = time_scale_factor(report, BOUND_SETS[bounds])
+    if not np.isfinite(lam):
+        # the grid problem obeys the rulebook's feasible caps, which the checker accepts
+        # by construction; a profile no time scaling can repair is a bug, not bad input
+        bad = [r for r in report.results if not np.isfinite(r.ratio)]
+        where = (f"{bad[0].constraint} at s = {bad[0].s:.6g} mm, block {bad[0].block}"
+                 if bad else "unknown constraint")
+        raise InternalError(f"the oracle's grid profile breaks {where} by an infinite "
+                            f"ratio; no time scaling repairs it")
     if lam > 1.0:
         prof = scale_time(prof, lam)
     return prof, lam, report

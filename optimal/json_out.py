@@ -1,19 +1,17 @@
 """JSON view of an :class:`~optimal.oracle.OptimalSolution` (DESIGN section 7, "oracle").
 
 Velocities in mm/s, times in s. Non-finite numbers (an upper bound that does not exist
-after a solver error) become ``null``.
+after a solver error is ``inf``) stay as they are: the one JSON writer,
+:func:`reference.core.jsonio.write_json`, encodes them for every part alike.
 """
 
 from __future__ import annotations
 
-import math
-
 from .oracle import OptimalSolution
 
 
-def _num(x: float) -> float | None:
-    x = float(x)
-    return x if math.isfinite(x) else None
+def _num(x: float) -> float:
+    return float(x)
 
 
 def to_json_dict(solution: OptimalSolution) -> dict:

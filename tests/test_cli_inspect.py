@@ -70,3 +70,21 @@ def test_usage_error_exit_2() -> None:
     r = subprocess.run([sys.executable, "-m", "compare", "inspect"], capture_output=True,
                        text=True, cwd=ROOT)
     assert r.returncode == 2 and "Traceback" not in r.stderr
+
+
+def test_an_internal_error_exits_3_with_one_line_and_the_traceback_only_with_debug(
+        monkeypatch, capsys):
+    """A bug is never bad input (2) nor a gap (1): exit 3, one line, --debug for more."""
+    from compare import cli
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(cli, "load_inputs", broken)
+    assert cli.main(["inspect", "whatever.mpf"]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error" in err and "--debug" in err
+    assert "Traceback" not in err
+    assert cli.main(["inspect", "whatever.mpf", "--debug"]) == 3
+    err = capsys.readouterr().err
+    assert "Traceback" in err and "ZeroDivisionError" in err

@@ -20,7 +20,7 @@ Import rule: this package imports only the standard library, numpy and scipy.
 """
 
 from .errors import (BackendNotFoundError, FeedOracleError, InfeasibleError,
-                     MachineDataError, NCSyntaxError, PathError, ProfileError,
+                     InternalError, MachineDataError, NCSyntaxError, PathError, ProfileError,
                      SolverError, TrajectoryError)
 from .geometry import (BlockSpan, HelicalSegment, Path, arc_segment, line_segments,
                        path_from_pieces)
@@ -29,7 +29,7 @@ from .profile import Profile
 
 __all__ = [
     "AxisArrays", "AxisLimits", "BackendNotFoundError", "BlockSpan", "FeedOracleError",
-    "HelicalSegment", "InfeasibleError", "MachineDataError", "MachineLimits",
+    "HelicalSegment", "InfeasibleError", "InternalError", "MachineDataError", "MachineLimits",
     "NCSyntaxError", "Path", "PathError", "Profile", "ProfileError", "SolverError",
     "TrajectoryError", "arc_segment", "line_segments", "path_from_pieces",
 ]

@@ -106,3 +106,11 @@ class SolverError(FeedOracleError, RuntimeError):
 
 class TrajectoryError(FeedOracleError, ValueError):
     """A recorded trajectory (CSV) that cannot be read or projected (names file and row)."""
+
+
+class InternalError(RuntimeError):
+    """An invariant of feedoracle itself failed: a bug, never a property of the input.
+
+    Deliberately *not* a :class:`FeedOracleError`: the CLI reports it with exit code 3
+    ("internal error"), so a CI gate never mistakes a crash for bad input or a gap.
+    """

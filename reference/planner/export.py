@@ -8,7 +8,7 @@ from .engine import ReferencePlan
 
 def _num(x: float) -> float:
     """A plain float. Infinite values (a velocity jump where the machine allows none)
-    stay ``inf``: the one JSON writer (``compare.export.write_json``) encodes them for
+    stay ``inf``: the one JSON writer (:func:`reference.core.jsonio.write_json`) encodes them for
     every part of the contract alike, so the planner does not invent its own rule."""
     return float(x)
 
@@ -24,7 +24,7 @@ def to_json_dict(plan: ReferencePlan) -> dict:
     -------
     dict
         Plain floats (an infinite ratio stays ``inf``; write the dict with
-        ``compare.export.write_json``, which encodes it as the JSON contract says).
+        ``reference.core.jsonio.write_json``, which encodes it as the JSON contract says).
         ``{"program", "machine", "bounds", "reference": {"time_s", "violations"},
         "blocks": [...]}``; ``bounds`` is the planner's own bound set, ``violations``
         lists the constraints of that set the own profile breaks
