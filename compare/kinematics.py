@@ -15,7 +15,7 @@ import numpy as np
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
-from reference.core.rules import axis_acceleration, axis_jerk, axis_velocity
+from reference.core.rules import axis_acceleration, axis_jerk, axis_velocity, speed_caps
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,10 +122,7 @@ def limit_curve(path: Path, limits: MachineLimits, s: np.ndarray) -> dict[str, n
     lim = limits.for_axes(path.axes)
     seg = path.segment_index(s)
     _, dq, ddq, _ = path.evaluate(s, segment=seg)
-    with np.errstate(divide="ignore"):
-        v_ax = np.min(np.where(np.abs(dq) > 1e-12, lim.v_max / np.abs(dq), np.inf), axis=1)
-        v_cen = np.min(np.where(np.abs(ddq) > 1e-15, np.sqrt(lim.a_max / np.abs(ddq)),
-                                np.inf), axis=1)
+    v_ax, v_cen = speed_caps(dq, ddq, lim.v_max, lim.a_max)
     feed = path.feed[seg]
     return {"feed": feed, "axis velocity": v_ax, "axis acceleration": v_cen,
             "limit": np.minimum(np.minimum(feed, v_ax), v_cen)}

@@ -310,6 +310,38 @@ def axis_jerk(dq: np.ndarray, ddq: np.ndarray, dddq: np.ndarray, v: np.ndarray,
             + dddq * (v ** 3)[:, None])
 
 
+def speed_caps(dq: np.ndarray, ddq: np.ndarray, v_max: np.ndarray,
+               a_max: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Path-speed caps of a motion at constant path speed (``a = 0``) at sample points.
+
+    ``v <= min_i V_i / |q'_i|`` (axis velocity) and ``v <= min_i sqrt(A_i / |q''_i|)``
+    (centripetal axis acceleration); ``inf`` where no axis component is non-zero. These
+    are the checker's velocity and acceleration rules with ``a = 0`` solved for ``v``.
+
+    Parameters
+    ----------
+    dq, ddq : numpy.ndarray, shape (N, n)
+        ``q'`` (1) and ``q''`` (1/mm).
+    v_max, a_max : numpy.ndarray, shape (n,)
+        mm/s and mm/s^2.
+
+    Returns
+    -------
+    v_axis, v_centripetal : numpy.ndarray, shape (N,)
+        mm/s.
+    """
+    adq, addq = np.abs(dq), np.abs(ddq)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_axis = np.where(adq > 0, np.asarray(v_max)[None, :] / np.where(adq > 0, adq, 1.0),
+                          np.inf)
+        v_cen = np.where(addq > 0, np.sqrt(np.asarray(a_max)[None, :]
+                                           / np.where(addq > 0, addq, 1.0)), np.inf)
+    n = adq.shape[0]
+    if adq.shape[1] == 0:
+        return np.full(n, np.inf), np.full(n, np.inf)
+    return v_axis.min(axis=1), v_cen.min(axis=1)
+
+
 def _flavour(flavour: str) -> None:
     if flavour not in (FEASIBLE, RELAXED):
         raise ValueError(f"flavour must be {FEASIBLE!r} or {RELAXED!r}, got {flavour!r}")

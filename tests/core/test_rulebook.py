@@ -22,7 +22,7 @@ from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.rules import (FEASIBLE, RELAXED, axis_acceleration, axis_jerk,
                                   axis_velocity, axis_velocity_jumps, curvature_jumps,
                                   is_tangential, jump_ratio, junction_angle,
-                                  junction_speed_cap)
+                                  junction_speed_cap, speed_caps)
 from reference.core.tolerances import (CURVATURE_JUMP_TOL_PER_MM, RATIO_TOL, TANGENT_TOL_RAD,
                                        VEL_TOL_MM_S)
 from reference.machine import machine_from_dict
@@ -182,3 +182,15 @@ def test_heuristic_is_never_below_the_lower_bound(seed, ovl, mode):
     assert sol.lower_bound_s <= p.profile.duration, (
         f"LB {sol.lower_bound_s!r} above a profile the checker accepts "
         f"({p.profile.duration!r})")
+
+
+def test_speed_caps_on_a_circle_by_hand():
+    # a circle of radius 10 in XY at 30 degrees: |q'| = (sin 30, cos 30), |q''| = (cos, sin)/R
+    R, th = 10.0, math.radians(30)
+    dq = np.array([[-math.sin(th), math.cos(th), 0.0]])
+    ddq = np.array([[-math.cos(th) / R, -math.sin(th) / R, 0.0]])
+    V, A = np.array([500.0, 400.0, 100.0]), np.array([2000.0, 1000.0, 1.0])
+    v_ax, v_cen = speed_caps(dq, ddq, V, A)
+    assert v_ax[0] == pytest.approx(min(500 / 0.5, 400 / math.cos(th)))
+    assert v_cen[0] == pytest.approx(min(math.sqrt(2000 * R / math.cos(th)),
+                                         math.sqrt(1000 * R / 0.5)))
