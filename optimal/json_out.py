@@ -1,4 +1,4 @@
-"""JSON view of an :class:`~optimal.oracle.OptimalSolution` (DESIGN section 7, "oracle").
+"""JSON view of an :class:`~optimal.solution.OptimalSolution` (DESIGN section 7, "oracle").
 
 Velocities in mm/s, times in s. Non-finite numbers (an upper bound that does not exist
 after a solver error) become ``null``.
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .oracle import OptimalSolution
+from .solution import OptimalSolution
 
 
 def _num(x: float) -> float | None:
