@@ -15,7 +15,8 @@ from .backends import available_backends, known_backends, solve_discrete
 from .grid import Grid, initial_grid
 from .json_out import to_json_dict
 from .problem import DiscreteProblem, DiscreteResult, build_grid_problem
-from .oracle import BlockResult, IterationRecord, OptimalSolution, solve
+from .oracle import solve
+from .solution import BlockResult, IterationRecord, OptimalSolution
 from .status import SolveStatus
 
 __all__ = ["BlockResult", "DiscreteProblem", "DiscreteResult", "Grid", "IterationRecord",

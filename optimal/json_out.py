@@ -1,4 +1,4 @@
-"""JSON view of an :class:`~optimal.oracle.OptimalSolution` (DESIGN section 7, "oracle").
+"""JSON view of an :class:`~optimal.solution.OptimalSolution` (DESIGN section 7, "oracle").
 
 Velocities in mm/s, times in s. Non-finite numbers (an upper bound that does not exist
 after a solver error is ``inf``) stay as they are: the one JSON writer,
@@ -7,7 +7,7 @@ after a solver error is ``inf``) stay as they are: the one JSON writer,
 
 from __future__ import annotations
 
-from .oracle import OptimalSolution
+from .solution import OptimalSolution
 
 
 def _num(x: float) -> float:

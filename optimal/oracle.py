@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping
 
 import numpy as np
@@ -36,7 +36,8 @@ from .backends import DEFAULT_BACKEND, get_backend
 from .bounds import lower_bound, node_bounds_on, verified_profile
 from .grid import Grid, initial_grid, split
 from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, DiscreteProblem,
-                      build_grid_problem, check_feed, interval_times)
+                      DiscreteResult, build_grid_problem, check_feed, interval_times)
+from .solution import BlockResult, IterationRecord, OptimalSolution
 from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS)
@@ -45,132 +46,65 @@ SUPPORTED_BOUNDS = ("acc",)
 
 ProgressFn = Callable[[str, float], None]
 
+# the result types live in optimal.solution; re-exported here for existing imports
+__all__ = ["BlockResult", "IterationRecord", "OptimalSolution", "SUPPORTED_BOUNDS",
+           "active_labels", "solve"]
 
-@dataclass(frozen=True, slots=True)
-class BlockResult:
-    """The oracle's numbers for one NC block.
+
+# --------------------------------------------------------------------------- loop state
+@dataclass(frozen=True, slots=True, eq=False)
+class _Candidate:
+    """The best verified round so far: everything the final result is built from.
 
     Attributes
     ----------
-    block : int
-        Block index in the program.
-    line : int
-        1-based source line.
-    label : str
-        Block number or label.
-    kind : str
-        ``"G0"``, ``"G1"``, ... (from the path's block table).
-    length_mm : float
-        Path length of the block, mm.
-    t_oracle_s : float
-        Time the verified (upper-bound) profile spends in the block, s (dwell included).
-    v_exit_oracle : float
-        Path speed at the block end, mm/s.
-    limit_oracle : str
-        Constraint active over most of the block's time: ``"feed"``,
-        ``"velocity <axis>"``, ``"acceleration <axis>"``, ``"velocity_jump"``,
-        ``"stop"``; for blocks without motion the stop reason (or ``""``).
+    upper_bound_s : float
+        Duration of the verified profile plus the dwells, s.
+    grid : Grid
+        The grid of that round.
+    problem : DiscreteProblem
+        Its grid problem.
+    result : DiscreteResult
+        The backend's solution of ``problem``.
+    profile : Profile
+        The grid profile after time scaling (the one ``check_profile`` accepted),
+        without dwell holds.
+    time_scale : float
+        Factor ``lam >= 1`` the grid profile was slowed down by.
+    report : ConstraintReport
+        The checker's report on the grid profile before time scaling.
+    interval_times_s : numpy.ndarray, shape (N,)
+        Time of the unscaled grid profile on each grid interval, s.
     """
 
-    block: int
-    line: int
-    label: str
-    kind: str
-    length_mm: float
-    t_oracle_s: float
-    v_exit_oracle: float
-    limit_oracle: str
-
-
-@dataclass(frozen=True, slots=True)
-class IterationRecord:
-    """One refinement round: grid size and the bounds found on it (s).
-
-    ``upper_bound_s`` is ``inf`` in rounds where the checker was not run (the grid
-    optimum was still farther than the requested gap from the lower bound).
-    """
-
-    grid_points: int
-    lower_bound_s: float
     upper_bound_s: float
-    objective_s: float
+    grid: Grid
+    problem: DiscreteProblem
+    result: DiscreteResult
+    profile: Profile
     time_scale: float
+    report: ConstraintReport
+    interval_times_s: np.ndarray
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class OptimalSolution:
-    """Result of :func:`solve`; ``status`` is never ``None``.
+class _WarmStart:
+    """The last relaxation, kept to give the next (finer) grid valid node bounds
+    (:func:`optimal.bounds.node_bounds_on`).
 
     Attributes
     ----------
-    status : SolveStatus
-        ``optimal`` (gap met), ``gap_not_met``, ``infeasible`` or ``solver_error``.
-    profile : Profile or None
-        The verified profile whose duration is ``upper_bound_s`` (``None`` only on
-        ``solver_error``).
-    lower_bound_s, upper_bound_s : float
-        Certified lower bound and verified upper bound of the minimum time, s (dwells
-        included in both).
-    objective_s : float
-        Time of the grid optimum before time scaling, s.
-    gap : float
-        ``(upper - lower) / lower`` (0 for an empty path).
-    time_scale : float
-        Factor ``lam >= 1`` the grid profile was slowed down by to pass the checker.
-    segment_times_s : numpy.ndarray, shape (m,)
-        Time spent moving through each segment, s.
-    block_times_s : numpy.ndarray, shape (max block index + 1,)
-        Time spent in each NC block (by block index), s.
-    blocks : tuple[BlockResult, ...]
-        One row per block of ``path.blocks``.
-    grid : numpy.ndarray, shape (N + 1,)
-        Final grid nodes, mm.
-    active : tuple[str, ...]
-        Active constraint on each final grid interval (labels as in
-        :class:`BlockResult`).
-    grid_points : int
-        ``N + 1``.
-    iterations : int
-        Refinement rounds.
-    backend : str
-        Backend of the grid problem.
-    build_time_s, solve_time_s, check_time_s, bound_time_s, total_time_s : float
-        Problem construction, discrete solves, checker, lower-bound relaxation, and the
-        whole call, s (sums over rounds).
-    dwell_s : float
-        Total dwell time of the program, s.
-    report : ConstraintReport or None
-        The checker's report on the final grid profile before time scaling.
-    history : tuple[IterationRecord, ...]
-        Bounds per round.
-    message : str
-        Human-readable summary.
+    grid : Grid
+        Grid of the relaxation.
+    b_hat : numpy.ndarray, shape (N + 1,)
+        Its optimum at the nodes, mm^2/s^2.
+    b_bar : numpy.ndarray, shape (N,)
+        Its bound inside each interval, mm^2/s^2.
     """
 
-    status: SolveStatus
-    profile: Profile | None
-    lower_bound_s: float
-    upper_bound_s: float
-    objective_s: float
-    gap: float
-    time_scale: float
-    segment_times_s: np.ndarray
-    block_times_s: np.ndarray
-    blocks: tuple[BlockResult, ...]
-    grid: np.ndarray
-    active: tuple[str, ...]
-    grid_points: int
-    iterations: int
-    backend: str
-    build_time_s: float
-    solve_time_s: float
-    check_time_s: float
-    bound_time_s: float
-    total_time_s: float
-    dwell_s: float
-    report: ConstraintReport | None = None
-    history: tuple[IterationRecord, ...] = field(default=())
-    message: str = ""
+    grid: Grid
+    b_hat: np.ndarray
+    b_bar: np.ndarray
 
 
 # --------------------------------------------------------------------------- helpers
@@ -393,9 +327,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     grid = initial_grid(path, min(initial_intervals, max_grid))
     t_build = t_solve = t_check = t_bound = 0.0
     history: list[IterationRecord] = []
-    best = None            # (ub, grid, problem, result, profile, lam, report, t_prim)
+    best: _Candidate | None = None
     best_lb = 0.0
-    prev_lb = None         # (grid, b_hat, b_bar) of the last relaxation: warm start
+    warm: _WarmStart | None = None
     status = SolveStatus.GAP_NOT_MET
     gaps: list[float] = []     # first gap, for the progress fraction
     frac = 0.0
@@ -422,9 +356,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         # lower bound first: while the grid optimum itself is farther than tol from it,
         # the gap cannot be met and the checker (the expensive part) can wait
         te = time.perf_counter()
-        b_node = (node_bounds_on(grid, *prev_lb) if prev_lb is not None else None)
+        b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
+                  if warm is not None else None)
         lb, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
-        prev_lb = (grid, b_hat, rel.b_bar)
+        warm = _WarmStart(grid, b_hat, rel.b_bar)
         t_bound += time.perf_counter() - te
         t_prim = interval_times(grid.s, res.b)
         t_grid = float(t_prim.sum()) + dwell
@@ -440,7 +375,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
                 last, new_grid = True, None
         if new_grid is not None:
             history.append(IterationRecord(grid.n_points, lb + dwell, math.inf, t_grid, 1.0))
-            gap = max(disc_gap, (best[0] - best_lb) / best_lb if best else disc_gap)
+            gap = max(disc_gap,
+                      (best.upper_bound_s - best_lb) / best_lb if best else disc_gap)
             frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
             grid = new_grid
             continue
@@ -450,10 +386,12 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds)
         t_check += time.perf_counter() - td
         ub = prof.duration + dwell
-        if best is None or ub < best[0]:
-            best = (ub, grid, problem, res, prof, lam, report, t_prim)
+        if best is None or ub < best.upper_bound_s:
+            best = _Candidate(upper_bound_s=ub, grid=grid, problem=problem, result=res,
+                              profile=prof, time_scale=lam, report=report,
+                              interval_times_s=t_prim)
         history.append(IterationRecord(grid.n_points, lb + dwell, ub, t_grid, lam))
-        gap = (best[0] - best_lb) / best_lb if best_lb > 0 else math.inf
+        gap = (best.upper_bound_s - best_lb) / best_lb if best_lb > 0 else math.inf
         frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
         if gap <= tol:
             status = SolveStatus.OPTIMAL
@@ -476,12 +414,12 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             backend=backend, build_time_s=t_build, solve_time_s=t_solve,
             check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total, dwell_s=dwell,
             history=tuple(history), message=msg)
-    ub, g, problem, res, prof, lam, report, t_prim = best
-    prof_h = _with_holds(prof, path)
+    ub, g, lam = best.upper_bound_s, best.grid, best.time_scale
+    prof_h = _with_holds(best.profile, path)
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
-    labels = active_labels(problem, res.b)
-    rows = _block_rows(path, g, prof_h, blk_t, labels, lam * t_prim)
+    labels = active_labels(best.problem, best.result.b)
+    rows = _block_rows(path, g, prof_h, blk_t, labels, lam * best.interval_times_s)
     gap = (ub - best_lb) / best_lb if best_lb > 0 else math.inf
     if status == SolveStatus.SOLVER_ERROR:
         message = msg
@@ -494,11 +432,12 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         progress("done", 1.0)
     return OptimalSolution(
         status=status, profile=prof_h, lower_bound_s=best_lb, upper_bound_s=ub,
-        objective_s=float(t_prim.sum()) + dwell, gap=gap, time_scale=lam,
+        objective_s=float(best.interval_times_s.sum()) + dwell, gap=gap, time_scale=lam,
         segment_times_s=seg_t, block_times_s=blk_t, blocks=rows, grid=g.s, active=labels,
-        grid_points=g.n_points, iterations=it, backend=res.backend, build_time_s=t_build,
-        solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
-        total_time_s=time.perf_counter() - t_start, dwell_s=dwell, report=report,
+        grid_points=g.n_points, iterations=it, backend=best.result.backend,
+        build_time_s=t_build, solve_time_s=t_solve, check_time_s=t_check,
+        bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start, dwell_s=dwell,
+        report=best.report,
         history=tuple(history), message=message)
 
 
@@ -517,7 +456,7 @@ def _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps) -> floa
     return frac
 
 
-def _first_blocked_interval(problem: DiscreteProblem, res) -> int:
+def _first_blocked_interval(problem: DiscreteProblem, res: DiscreteResult) -> int:
     if res.b is None:
         return 0
     dt = interval_times(problem.s, res.b)

@@ -9,10 +9,11 @@ adaptation).
 for every model choice the manuals leave open.
 """
 
-from .engine import BlockRow, CornerRow, ReferencePlan, plan
+from .engine import plan
 from .export import to_json_dict
 from .ipo import ipo_samples
 from .parameters import DEFAULT_PARAMETERS, PlannerParameters
+from .result import BlockRow, CornerRow, ReferencePlan, TraceEntry
 
 __all__ = ["BlockRow", "CornerRow", "DEFAULT_PARAMETERS", "PlannerParameters",
-           "ReferencePlan", "ipo_samples", "plan", "to_json_dict"]
+           "ReferencePlan", "TraceEntry", "ipo_samples", "plan", "to_json_dict"]

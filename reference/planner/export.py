@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..core.constraints import BOUND_SETS
-from .engine import ReferencePlan
+from .result import ReferencePlan
 
 
 def _num(x: float) -> float:

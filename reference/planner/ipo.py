@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .engine import ReferencePlan
+from .result import ReferencePlan
 
 
 def ipo_samples(plan: ReferencePlan) -> tuple[list[str], np.ndarray]:

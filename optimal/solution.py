@@ -1,0 +1,146 @@
+"""Result types of :func:`optimal.solve`: the solution, its per-block rows and the
+refinement history.
+
+Kept apart from the algorithm (:mod:`optimal.oracle`) so that readers of a result (the
+JSON writer, :mod:`compare`) need not read the solver. Units: mm, s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reference.core.constraints import ConstraintReport
+from reference.core.profile import Profile
+
+from .status import SolveStatus
+
+__all__ = ["BlockResult", "IterationRecord", "OptimalSolution"]
+
+
+@dataclass(frozen=True, slots=True)
+class BlockResult:
+    """The oracle's numbers for one NC block.
+
+    Attributes
+    ----------
+    block : int
+        Block index in the program.
+    line : int
+        1-based source line.
+    label : str
+        Block number or label.
+    kind : str
+        ``"G0"``, ``"G1"``, ... (from the path's block table).
+    length_mm : float
+        Path length of the block, mm.
+    t_oracle_s : float
+        Time the verified (upper-bound) profile spends in the block, s (dwell included).
+    v_exit_oracle : float
+        Path speed at the block end, mm/s.
+    limit_oracle : str
+        Constraint active over most of the block's time: ``"feed"``,
+        ``"velocity <axis>"``, ``"acceleration <axis>"``, ``"velocity_jump"``,
+        ``"stop"``; for blocks without motion the stop reason (or ``""``).
+    """
+
+    block: int
+    line: int
+    label: str
+    kind: str
+    length_mm: float
+    t_oracle_s: float
+    v_exit_oracle: float
+    limit_oracle: str
+
+
+@dataclass(frozen=True, slots=True)
+class IterationRecord:
+    """One refinement round: grid size and the bounds found on it (s).
+
+    ``upper_bound_s`` is ``inf`` in rounds where the checker was not run (the grid
+    optimum was still farther than the requested gap from the lower bound).
+    """
+
+    grid_points: int
+    lower_bound_s: float
+    upper_bound_s: float
+    objective_s: float
+    time_scale: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class OptimalSolution:
+    """Result of :func:`solve`; ``status`` is never ``None``.
+
+    Attributes
+    ----------
+    status : SolveStatus
+        ``optimal`` (gap met), ``gap_not_met``, ``infeasible`` or ``solver_error``.
+    profile : Profile or None
+        The verified profile whose duration is ``upper_bound_s`` (``None`` only on
+        ``solver_error``).
+    lower_bound_s, upper_bound_s : float
+        Certified lower bound and verified upper bound of the minimum time, s (dwells
+        included in both).
+    objective_s : float
+        Time of the grid optimum before time scaling, s.
+    gap : float
+        ``(upper - lower) / lower`` (0 for an empty path).
+    time_scale : float
+        Factor ``lam >= 1`` the grid profile was slowed down by to pass the checker.
+    segment_times_s : numpy.ndarray, shape (m,)
+        Time spent moving through each segment, s.
+    block_times_s : numpy.ndarray, shape (max block index + 1,)
+        Time spent in each NC block (by block index), s.
+    blocks : tuple[BlockResult, ...]
+        One row per block of ``path.blocks``.
+    grid : numpy.ndarray, shape (N + 1,)
+        Final grid nodes, mm.
+    active : tuple[str, ...]
+        Active constraint on each final grid interval (labels as in
+        :class:`BlockResult`).
+    grid_points : int
+        ``N + 1``.
+    iterations : int
+        Refinement rounds.
+    backend : str
+        Backend of the grid problem.
+    build_time_s, solve_time_s, check_time_s, bound_time_s, total_time_s : float
+        Problem construction, discrete solves, checker, lower-bound relaxation, and the
+        whole call, s (sums over rounds).
+    dwell_s : float
+        Total dwell time of the program, s.
+    report : ConstraintReport or None
+        The checker's report on the final grid profile before time scaling.
+    history : tuple[IterationRecord, ...]
+        Bounds per round.
+    message : str
+        Human-readable summary.
+    """
+
+    status: SolveStatus
+    profile: Profile | None
+    lower_bound_s: float
+    upper_bound_s: float
+    objective_s: float
+    gap: float
+    time_scale: float
+    segment_times_s: np.ndarray
+    block_times_s: np.ndarray
+    blocks: tuple[BlockResult, ...]
+    grid: np.ndarray
+    active: tuple[str, ...]
+    grid_points: int
+    iterations: int
+    backend: str
+    build_time_s: float
+    solve_time_s: float
+    check_time_s: float
+    bound_time_s: float
+    total_time_s: float
+    dwell_s: float
+    report: ConstraintReport | None = None
+    history: tuple[IterationRecord, ...] = field(default=())
+    message: str = ""

@@ -1,0 +1,445 @@
+"""One NC line, full treatment: from its words to one resolved
+:class:`~reference.nc.program.Block`.
+
+:func:`_block` goes through the line in sections, in this order: parameter assignments
+(NGC), words, G codes, keywords (SINUMERIK flags), named addresses, calls (``MSG``,
+tangential control, cycles), frames, feed and dwell, motion (arcs by
+:func:`reference.nc.arcs._arc`), modal snapshot and the block itself.
+"""
+
+from __future__ import annotations
+
+from ..core.units import MM_PER_INCH
+from .arcs import _arc
+from .expr import Cursor, ExprError, parse_expr
+from .frames import _apply_frame, _apply_g10, _apply_g92, _ngc_frame
+from .lines import Stmt, Word
+from .program import NO_EXTRA, Block, BlockExtra, Modal, Tangential
+from .state import (_G_GROUPS_NGC, _G_GROUPS_SIN, _IGNORED_G_NGC, _IGNORED_G_SIN,
+                    _IGNORED_WHY, _MODES10_SIN, _NGC_CS, _UNSUPPORTED_G, _Interp)
+
+
+def _block(ip: _Interp, st: Stmt) -> bool:
+    """Execute one ordinary line; returns True at program end (M2/M30)."""
+    ngc = ip.ngc
+    # --- NGC parameter assignments: all values are read before any is set, and the
+    # words of the line see the old values (RS274/NGC); committed after the words
+    pending: list[tuple[str, float]] = []
+    for target, node, col in st.assigns:
+        if ngc:
+            key = target[1] if target[0] == "var" else f"#{int(ip.ev(st, target[1], col + 1))}"
+            pending.append((key, ip.ev(st, node, col + 1)))
+        else:                                  # pragma: no cover - SINUMERIK uses words
+            ip.vars[target] = ip.ev(st, node, col + 1)
+    # --- words ------------------------------------------------------------------
+    g_codes: list[tuple[float, int]] = []
+    axis_words: list[tuple[str, float, str, int]] = []
+    centre: dict[str, tuple[float, str, int]] = {}
+    aux: list[tuple[str, float]] = []
+    named: dict[str, tuple[float, int]] = {}
+    feed_word: tuple[float, int] | None = None
+    p_word = q_word = r_word = l_word = None
+    seen: dict[str, float] = {}
+
+    def once(name: str, val: float, col: int) -> None:
+        """A word may repeat in a block only with the same value."""
+        prev = seen.get(name)
+        if prev is not None and prev != val:
+            sep = "=" if len(name) > 1 else ""
+            raise ip.err(st, col, f"{name} is programmed twice in this block with different "
+                                  f"values ({name}{sep}{prev:g} and {name}{sep}{val:g})")
+        seen[name] = val
+
+    for w in st.words:
+        name = w.name
+        if not ngc and "[" in name:                  # R[i]=, ATOL[X]=, ARRAY[i]=
+            _indexed_assignment(ip, st, w)
+            continue
+        if not ngc and name in ip.declared:          # a DEF variable, also if one letter
+            ip.vars[name] = ip.ev(st, w.value, w.col)
+            continue
+        if not ngc and len(name) > 1 or (not ngc and name not in "GMFSTDHIJKPQRLXYZABCUVWEN"):
+            if name in ("CR", "ADIS", "ADISPOS", "TURN", "CTOL", "OTOL", "DISC", "AR", "RPL",
+                        "STOLF", "RND", "RNDM", "SF", "OFFN"):
+                named[name] = (ip.ev(st, w.value, w.col), w.col)
+                once(name, named[name][0], w.col)
+                continue
+            if name.startswith("R") and name[1:].isdigit():
+                ip.vars[name] = ip.ev(st, w.value, w.col)
+                continue
+            if name in ip.declared:
+                ip.vars[name] = ip.ev(st, w.value, w.col)
+                continue
+            if ip.is_axis_name(name):
+                ip.add_axis(name)
+                axis_words.append((name, ip.ev(st, w.value, w.col), w.mode, w.col))
+                once(name, axis_words[-1][1], w.col)
+                continue
+            # an assignment to an undeclared name: accept it as a variable, say so
+            ip.declared.add(name)
+            ip.vars[name] = ip.ev(st, w.value, w.col)
+            ip.warn(st, f"variable {name} is assigned without DEF; taken as a REAL variable",
+                    once_key=f"undeclared {name}")
+            continue
+        val = ip.ev(st, w.value, w.col)
+        if name == "G":
+            g_codes.append((val, w.col))
+            continue
+        if name == "M":
+            aux.append(("M", val))
+            continue
+        if name != "N":
+            once(name, val, w.col)
+        if name in "XYZ" or name in "ABC" or (ngc and name in "UVW") or (
+                not ngc and name in "UVWE"):
+            ip.add_axis(name)
+            axis_words.append((name, val, w.mode, w.col))
+        elif name in "IJK":
+            centre[name] = (val, w.mode, w.col)
+        elif name == "F":
+            feed_word = (val, w.col)
+        elif name in "SH":
+            aux.append((name, val))
+            if name == "H":
+                ip.offset_no = int(val)
+        elif name == "T":
+            aux.append(("T", val))
+            ip.tool = int(val)
+        elif name == "D":
+            aux.append(("D", val))
+            ip.offset_no = int(val)
+        elif name == "P":
+            p_word = (val, w.col)
+        elif name == "Q":
+            q_word = (val, w.col)
+        elif name == "R":
+            if not ngc:
+                raise ip.err(st, w.col, "R parameter needs '=' (R1=10)")
+            r_word = (val, w.col)
+        elif name == "L":
+            l_word = (val, w.col)
+        elif name == "N":
+            continue                     # block numbers were taken as labels by the lexer
+        else:
+            raise ip.err(st, w.col, f"unknown address {name}")
+    for key, value in pending:
+        ip.vars[key] = value
+    # --- G codes ------------------------------------------------------------------
+    g9 = False
+    dwell = None
+    is_dwell = False
+    g10 = False
+    g53 = False
+    g92 = False
+    program_end = False
+    motion_word_col = 1
+    motion_set = False
+    groups = _G_GROUPS_NGC if ngc else _G_GROUPS_SIN
+    in_group: dict[int, float] = {}
+    for g, col in g_codes:
+        gi = round(g, 1)
+        for k, grp in enumerate(groups):
+            if gi in grp:
+                if k in in_group and in_group[k] != gi:
+                    raise ip.err(st, col, f"G{in_group[k]:g} and G{gi:g} are in the same modal "
+                                          "group: program only one of them in a block")
+                in_group[k] = gi
+    for g, col in g_codes:
+        gi = round(g, 1)
+        if gi in (0, 1, 2, 3):
+            ip.motion = f"G{int(gi)}"
+            motion_word_col = col
+            motion_set = True
+        elif gi in _UNSUPPORTED_G:
+            raise ip.err(st, col, _UNSUPPORTED_G[gi])
+        elif gi == 4:
+            is_dwell = True
+        elif gi == 9 and not ngc:
+            g9 = True
+        elif gi in (17, 18, 19):
+            ip.plane = f"G{int(gi)}"
+        elif gi == 90:
+            ip.absolute = True
+        elif gi == 91:
+            ip.absolute = False
+        elif ngc and gi == 90.1:
+            ip.ijk_absolute = True
+        elif ngc and gi == 91.1:
+            ip.ijk_absolute = False
+        elif (not ngc and gi in (70, 700)) or (ngc and gi == 20):
+            # G70 sets lengths only; G700 and NGC G20 also feeds (inch/min)
+            ip.inch = True
+            ip.feed_inch = gi != 70
+            if not ip.out:
+                ip.start_units = "inch"
+        elif (not ngc and gi in (71, 710)) or (ngc and gi == 21):
+            ip.inch = False
+            ip.feed_inch = False
+        elif not ngc and gi in _MODES10_SIN:
+            ip.mode10 = _MODES10_SIN[int(gi)]
+        elif not ngc and gi in (601, 602, 603):
+            ip.criterion = f"G{int(gi)}"
+        elif ngc and gi == 61:
+            ip.mode10 = "G61"
+        elif ngc and gi == 61.1:
+            ip.mode10 = "G60"
+        elif ngc and gi == 64:
+            ip.mode10 = "G64"
+            ip.ctol = p_word[0] * ip.lin("X") if p_word else None
+            ip.naive_cam = (q_word[0] * ip.lin("X") if q_word else ip.ctol)
+            p_word = None
+        elif gi in (40, 41, 42):
+            ip.trc = f"G{int(gi)}"
+        elif ngc and gi in (41.1, 42.1):         # dynamic TRC: the D word is the diameter
+            ip.trc = f"G{int(gi)}"
+        elif not ngc and gi in (450, 451):
+            ip.trc_corner = f"G{int(gi)}"
+        elif ngc and gi == 10:
+            g10 = True
+        elif not ngc and gi == 500:              # settable frames off: zero, as modelled
+            continue
+        elif ngc and gi == 53 or (not ngc and gi in (53, 153)):
+            g53 = True
+            ip.warn(st, f"G{gi:g}: positions in machine coordinates (frames suppressed for "
+                        "this block; work and tool offsets of the control are unknown)")
+        elif ngc and gi in (28, 30):
+            ip.warn(st, f"G{gi:g} (home move) needs the machine's home position; kept "
+                        "without motion")
+            axis_words = []
+        elif ngc and 81 <= gi <= 89 or (ngc and gi in (73, 74)):
+            raise ip.err(st, col, f"canned cycle G{gi:g} is not supported; expand it into "
+                                  "G0/G1 moves")
+        elif ngc and gi in _NGC_CS:
+            ip.cs_active = _NGC_CS[gi]
+            if ip.cs_active not in ip.cs:
+                ip.warn(st, f"work offset G{gi:g} is taken as zero (its values live in the "
+                            "control; set them with G10 L2 to model them)")
+            _ngc_frame(ip)
+        elif ngc and gi == 92:
+            g92 = True
+        elif ngc and gi in (92.1, 92.2):
+            ip.g92 = {}
+            _ngc_frame(ip)
+        elif ngc and gi == 92.3:
+            ip.warn(st, "G92.3 (restore saved G92 offsets) is not modelled; the offsets stay "
+                        "as they are")
+        elif (ngc and gi in _IGNORED_G_NGC) or (not ngc and gi in _IGNORED_G_SIN):
+            why = _IGNORED_WHY.get(gi, "work offsets are taken as zero (their values live in "
+                                       "the control)")
+            ip.warn(st, f"G{gi:g} is kept without effect on the motion model: {why}")
+        else:
+            raise ip.err(st, col, f"unknown G code G{gi:g}")
+    # --- flags (SINUMERIK keywords) ------------------------------------------------
+    frame_cmd = None
+    for flag, col in st.flags:
+        if flag in ("BRISK", "SOFT", "DRIVE"):
+            ip.accel_mode = flag
+        elif flag in ("TRANS", "ATRANS", "ROT", "AROT"):
+            frame_cmd = flag
+        elif flag == "SUPA":
+            g53 = True
+            ip.warn(st, "SUPA: positions in machine coordinates (frames suppressed for this "
+                        "block; work and tool offsets of the control are unknown)")
+        elif flag == "RET":
+            program_end = True
+        else:
+            ip.warn(st, f"{flag} is kept but not modelled")
+    # --- named addresses ------------------------------------------------------------
+    if "ADIS" in named:
+        ip.adis = named["ADIS"][0] * ip.lin("X")
+    if "ADISPOS" in named:
+        ip.adispos = named["ADISPOS"][0] * ip.lin("X")
+    if "CTOL" in named:
+        v = named["CTOL"][0]
+        ip.ctol = None if v < 0 else v * ip.lin("X")
+    if "OTOL" in named:
+        v = named["OTOL"][0]
+        ip.otol = None if v < 0 else v
+    if "AR" in named:
+        raise ip.err(st, named["AR"][1], "arcs by opening angle (AR=) are not supported; "
+                                         "program the end point with I/J/K or CR=")
+    for word, why in (("RND", "the rounding it inserts is not modelled; the corner stays "
+                                "sharp"),
+                      ("RNDM", "the rounding it inserts is not modelled; corners stay sharp"),
+                      ("OFFN", "the contour offset is not applied"),
+                      ("STOLF", "the G0 tolerance factor is not modelled"),
+                      ("SF", "the thread start angle is not modelled")):
+        if word in named:
+            ip.warn(st, f"{word}={named[word][0]:g} is kept without effect: {why}")
+    if "DISC" in named:
+        v, col = named["DISC"]
+        if not 0 <= v <= 100:
+            raise ip.err(st, col, f"DISC={v:g} must be between 0 and 100")
+        ip.disc = v
+    # --- calls (MSG, TANG..., cycles) ------------------------------------------------
+    message = st.message
+    kept: list[str] = []
+    for name, args, col in st.calls:
+        if name == "MSG":
+            a = args.strip()
+            message = a.strip('"') if a else ""
+            if '"' in a:
+                message = a[a.find('"') + 1:a.rfind('"')]
+        elif name in ("TANG", "TANGON", "TANGOF", "TLIFT", "TANGDEL"):
+            _tangential(ip, st, name, args, col)
+        elif name.startswith("$"):
+            kept.append(args)
+            ip.warn(st, f"system variable statement '{args}' needs a real control; kept "
+                        "without effect")
+        else:
+            text = f"{name}({args})" if args else name
+            kept.append(text)
+            ip.warn(st, f"{text} needs a real control (cycle or subprogram); kept as a "
+                        "block without motion")
+    if not ngc and l_word is not None:          # L123: subprogram call by number
+        text = f"L{l_word[0]:g}"
+        kept.append(text)
+        ip.warn(st, f"{text} calls a subprogram that is not part of this file; kept as a "
+                    "block without motion")
+    # --- frames ------------------------------------------------------------------------
+    if frame_cmd is not None:
+        _apply_frame(ip, st, frame_cmd, axis_words, named)
+        axis_words = []
+    if g10:
+        _apply_g10(ip, st, axis_words, l_word, p_word, r_word)
+        axis_words = []
+        r_word = None
+    if g92:
+        _apply_g92(ip, st, axis_words)
+        axis_words = []
+    # --- feed --------------------------------------------------------------------------
+    if is_dwell:
+        if ngc:
+            if p_word is None:
+                raise ip.err(st, 1, "G4 needs P (dwell time in seconds)")
+            dwell = p_word[0]
+        elif feed_word is not None:
+            dwell = feed_word[0]
+        elif any(a[0] == "S" for a in aux):
+            revs = next(a[1] for a in aux if a[0] == "S")
+            aux = [a for a in aux if a[0] != "S"]     # revolutions, not a spindle speed
+            if ip.spindle_rpm:
+                dwell = revs * 60.0 / ip.spindle_rpm
+            else:
+                kept.append(f"G4 S{revs:g}")
+                ip.warn(st, f"G4 S{revs:g} (dwell in spindle revolutions) needs the spindle "
+                            "speed, which no S word set before; the dwell time is not modelled")
+        else:
+            raise ip.err(st, 1, "G4 needs F (seconds) or S (spindle revolutions)")
+        if dwell is not None and dwell < 0:
+            raise ip.err(st, 1, f"negative dwell time {dwell:g} s")
+        feed_word = None
+    else:
+        for a in aux:
+            if a[0] == "S" and a[1] > 0:
+                ip.spindle_rpm = a[1]
+    if feed_word is not None and not is_dwell:   # a dwell's F is its time, not a feed
+        f, col = feed_word
+        if f < 0:
+            raise ip.err(st, col, f"negative feed F{f:g}")
+        ip.feed = f * (MM_PER_INCH if ip.feed_inch else 1.0) / 60.0
+    # --- motion ------------------------------------------------------------------------
+    start = tuple(ip.pos[a] for a in ip.axes)
+    centre_out = None
+    plane_basis = None
+    motion = None
+    turns = 0
+    if axis_words or (motion_set and ip.motion in ("G2", "G3") and centre):
+        if ip.motion is None:
+            raise ip.err(st, axis_words[0][3] if axis_words else 1,
+                         "axis move without a motion command (G0/G1/G2/G3)")
+        motion = ip.motion
+        if motion != "G0" and ip.feed is None:
+            col = motion_word_col if motion_set else (axis_words[0][3] if axis_words else 1)
+            raise ip.err(st, col, f"{motion} with no feed: program F before or in this block")
+        prog = ip.program_pos() if not g53 else dict(ip.pos)
+        target = dict(prog)
+        for name, val, mode, col in axis_words:
+            v = val * ip.lin(name)
+            incremental = (mode == "IC") or (mode != "AC" and not ip.absolute)
+            target[name] = prog.get(name, 0.0) + v if incremental else v
+        identity = ip.frame.theta_deg == 0.0 and not ip.frame.offset
+        machine = target if (g53 or identity) else ip.frame.to_machine(target)
+        if motion in ("G2", "G3"):
+            centre_out, plane_basis, turns = _arc(ip, st, motion, prog, target, centre,
+                                                  named, r_word, p_word, motion_word_col)
+        ip.pos.update(machine)
+    end = tuple(ip.pos[a] for a in ip.axes)
+    tang = ip.tang_defs.get(ip.tang_active) if ip.tang_active else None
+    modal_values = (ip.plane, ip.mode10, ip.criterion, ip.adis, ip.adispos, ip.ctol, ip.otol,
+                    tuple(sorted(ip.atol.items())), ip.naive_cam, ip.accel_mode, ip.trc,
+                    ip.trc_corner, ip.disc, ip.tool, ip.offset_no, tang)
+    if ip.last_modal_values == modal_values:
+        modal = ip.modal
+    else:
+        modal = Modal(*modal_values)
+        ip.last_modal_values = modal_values
+        ip.modal = modal
+    if (centre_out is None and not turns and dwell is None and not aux and message is None
+            and not st.comment and not kept and plane_basis is None):
+        extra = NO_EXTRA
+    else:
+        extra = BlockExtra(center=centre_out, turns=turns, dwell_s=dwell, aux=tuple(aux),
+                           message=message, comment=st.comment, kept_unmodelled=tuple(kept),
+                           column_of_motion=motion_word_col, plane_basis=plane_basis)
+    ip.last_end = end
+    ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end, ip.feed,
+                        (ip.mode10 == "G60") or g9, modal, extra))
+    if ngc and ("M", 99.0) in aux:
+        ip.warn(st, "M99 in the main program repeats it on the control; taken as the end of "
+                    "the program")
+        return True
+    return program_end or any(a == ("M", 2.0) or a == ("M", 30.0) or
+                              (not ngc and a == ("M", 17.0)) for a in aux)
+
+
+def _indexed_assignment(ip: _Interp, st: Stmt, w: Word) -> None:
+    """SINUMERIK ``R[i]=v``, ``ATOL[axis]=v`` and ``NAME[i]=v``."""
+    base, idx = w.name[:-1].split("[", 1)
+    value = ip.ev(st, w.value, w.col)
+    if base == "ATOL":
+        ax = idx.strip()
+        if value < 0:                          # a negative value deletes it
+            ip.atol.pop(ax, None)
+        else:
+            ip.atol[ax] = value * ip.lin(ax)
+        return
+    try:
+        node = parse_expr(Cursor(idx))
+    except ExprError as exc:
+        raise ip.err(st, w.col, str(exc)) from None
+    i = int(ip.ev(st, node, w.col))
+    ip.vars[f"R{i}" if base == "R" else f"{base}[{i}]"] = value
+
+
+def _tangential(ip: _Interp, st: Stmt, name: str, args: str, col: int) -> None:
+    parts = [a.strip().strip('"').upper() for a in args.split(",")] if args.strip() else []
+    if not parts:
+        raise ip.err(st, col, f"{name} needs the following axis, e.g. {name}(C)")
+    axis = parts[0]
+    if name == "TANG":
+        if len(parts) < 3:
+            raise ip.err(st, col, "TANG needs (following axis, leading axis 1, leading axis 2"
+                                  "[, coupling])")
+        coupling = float(parts[3]) if len(parts) > 3 and parts[3] else 1.0
+        ip.tang_defs[axis] = Tangential(axis=axis, leading=(parts[1], parts[2]),
+                                        coupling=coupling)
+        ip.add_axis(axis)
+    elif name in ("TANGON", "TLIFT", "TANGOF", "TANGDEL"):
+        if axis not in ip.tang_defs:
+            raise ip.err(st, col, f"{name}({axis}) without a TANG({axis}, ...) definition")
+        d = ip.tang_defs[axis]
+        if name == "TANGON":
+            off = float(parts[1]) if len(parts) > 1 and parts[1] else 0.0
+            ip.tang_defs[axis] = Tangential(d.axis, d.leading, d.coupling, off, d.tlift)
+            ip.tang_active = axis
+        elif name == "TLIFT":
+            ip.tang_defs[axis] = Tangential(d.axis, d.leading, d.coupling, d.offset_deg, True)
+        elif name == "TANGOF":
+            if ip.tang_active == axis:
+                ip.tang_active = None
+        else:
+            if ip.tang_active == axis:
+                raise ip.err(st, col, f"TANGDEL({axis}) while tangential control is on; "
+                                      "TANGOF first")
+            del ip.tang_defs[axis]

@@ -1,0 +1,151 @@
+"""Frames and work offsets: where program coordinates sit in machine coordinates.
+
+SINUMERIK programmable frames (``TRANS``/``ATRANS``/``ROT``/``AROT``, rotations about Z
+only) and NGC work offsets (``G10 L2``/``L20`` with ``R`` rotation, G54..G59.3, ``G92``).
+Every frame is ``machine = R(theta about Z) * program + offset``; changing it keeps the
+machine position. Units: mm, degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .lines import Stmt
+
+if TYPE_CHECKING:          # the state holds the frames; only annotations need it here
+    from .state import _Interp
+
+
+@dataclass(slots=True)
+class _Frame:
+    """Programmable frame: machine = R(theta) * program + offset (theta about Z)."""
+
+    theta_deg: float = 0.0
+    offset: dict | None = None
+
+    def to_machine(self, p: dict) -> dict:
+        out = dict(p)
+        if self.theta_deg:
+            c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
+            x, y = p.get("X", 0.0), p.get("Y", 0.0)
+            out["X"], out["Y"] = c * x - s * y, s * x + c * y
+        if self.offset:
+            for k, v in self.offset.items():
+                out[k] = out.get(k, 0.0) + v
+        return out
+
+    def to_program(self, m: dict) -> dict:
+        out = dict(m)
+        if self.offset:
+            for k, v in self.offset.items():
+                out[k] = out.get(k, 0.0) - v
+        if self.theta_deg:
+            c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
+            x, y = out.get("X", 0.0), out.get("Y", 0.0)
+            out["X"], out["Y"] = c * x + s * y, -s * x + c * y
+        return out
+
+    def rotate_vec(self, v: tuple[float, float, float]) -> tuple[float, float, float]:
+        if not self.theta_deg:
+            return v
+        c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
+        return (c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
+
+
+def _apply_frame(ip: _Interp, st: Stmt, cmd: str, axis_words, named) -> None:
+    """SINUMERIK programmable frame: machine = R(theta about Z) * program + offset.
+
+    ``TRANS`` and ``ROT`` are absolute: each replaces the whole programmable frame (a bare
+    ``TRANS`` or ``ROT`` deletes it). ``ATRANS`` adds a translation given in the current,
+    possibly rotated, coordinate system; ``AROT`` adds a rotation about the current origin.
+    Rotations about X or Y tilt the working plane and are rejected.
+    """
+    rot = 0.0
+    moves: dict[str, float] = {}
+    for name, val, _mode, col in axis_words:
+        if cmd in ("ROT", "AROT"):
+            if name != "Z":
+                raise ip.err(st, col, f"{cmd} {name}: a rotation about {name} tilts the working "
+                                      f"plane, which is not supported (only rotations about "
+                                      f"Z: {cmd} Z... or {cmd} RPL=...)")
+            rot += val
+        else:
+            moves[name] = val * ip.lin(name)
+    if "RPL" in named:
+        if ip.plane != "G17":
+            raise ip.err(st, named["RPL"][1], f"RPL= rotates in the active plane; only G17 "
+                                              f"(about Z) is supported, not {ip.plane}")
+        rot += named["RPL"][0]
+    old = ip.frame
+    if cmd == "TRANS":
+        ip.frame = _Frame(0.0, moves or None)
+    elif cmd == "ROT":
+        ip.frame = _Frame(rot, None)
+    elif cmd == "ATRANS":
+        offset = dict(old.offset or {})
+        d = old.rotate_vec((moves.pop("X", 0.0), moves.pop("Y", 0.0), 0.0))
+        for name, v in (("X", d[0]), ("Y", d[1]), *moves.items()):
+            if v or name in offset:
+                offset[name] = offset.get(name, 0.0) + v
+        ip.frame = _Frame(old.theta_deg, offset or None)
+    else:                                               # AROT
+        ip.frame = _Frame(old.theta_deg + rot, old.offset)
+
+
+def _ngc_frame(ip: _Interp) -> None:
+    """Effective NGC frame: machine = R(theta) * (program + G92 offset) + work offset."""
+    base = ip.cs.get(ip.cs_active, _Frame())
+    if not ip.g92:
+        ip.frame = base
+        return
+    offset = dict(base.offset or {})
+    g = dict(ip.g92)
+    d = base.rotate_vec((g.pop("X", 0.0), g.pop("Y", 0.0), 0.0))
+    for name, v in (("X", d[0]), ("Y", d[1]), *g.items()):
+        offset[name] = offset.get(name, 0.0) + v
+    ip.frame = _Frame(base.theta_deg, offset or None)
+
+
+def _apply_g10(ip: _Interp, st: Stmt, axis_words, l_word, p_word, r_word) -> None:
+    """NGC ``G10 L2 Pn`` (work offset n, P0 = active; R = XY rotation, degrees) and
+    ``G10 L20`` (offset chosen so that the current point gets the given coordinates)."""
+    kind = int(l_word[0]) if l_word is not None else None
+    if kind not in (2, 20):
+        ip.warn(st, f"G10 L{kind if kind is not None else '?'} (tool or offset tables) has "
+                    "no effect on the motion model")
+        return
+    num = int(p_word[0]) if p_word is not None else 0
+    if not 0 <= num <= 9:
+        raise ip.err(st, p_word[1], f"G10 L{kind} P{num}: P must be 0 (active) or 1..9 "
+                                    "(G54..G59.3)")
+    num = num or ip.cs_active
+    old = ip.cs.get(num, _Frame())
+    offset = dict(old.offset or {})
+    theta = r_word[0] if r_word is not None else old.theta_deg
+    for name, val, _, _ in axis_words:
+        v = val * ip.lin(name)
+        if kind == 2:
+            offset[name] = v
+        else:       # L20: the current machine position gets program coordinate v
+            offset[name] = ip.pos.get(name, 0.0) - v - (ip.g92.get(name, 0.0))
+    if kind == 20 and theta and axis_words:
+        ip.warn(st, "G10 L20 with a rotated coordinate system: the offset is computed per "
+                    "axis without the rotation")
+    ip.cs[num] = _Frame(theta, offset or None)
+    _ngc_frame(ip)
+    ip.warn(st, f"G10 L{kind} sets work offset {num} (G{[54, 55, 56, 57, 58, 59, 59.1, 59.2, 59.3][num - 1]:g}): "
+                f"{', '.join(f'{k}{v:g}' for k, v in offset.items()) or 'no offset'} mm, "
+                f"rotation {theta:g} deg (applied to the following moves)")
+
+
+def _apply_g92(ip: _Interp, st: Stmt, axis_words) -> None:
+    """NGC ``G92``: offsets chosen so that the current point gets the given coordinates."""
+    if not axis_words:
+        raise ip.err(st, 1, "G92 needs at least one axis word")
+    base = ip.cs.get(ip.cs_active, _Frame())
+    rel = base.to_program(ip.pos)                       # R^T (machine - work offset)
+    for name, val, _, _ in axis_words:
+        ip.g92[name] = rel.get(name, 0.0) - val * ip.lin(name)
+    _ngc_frame(ip)
