@@ -13,11 +13,9 @@ from pathlib import Path as FsPath
 from typing import Sequence
 
 from reference.core.errors import FeedOracleError
-from reference.machine import Machine, load_machine
-from reference.nc import parse_file
-from reference.nc.program import Program
-from reference.prepare import prepare, unmodelled_features
+from reference.prepare import prepare
 
+from .pipeline import load_inputs
 from .progress import Progress
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
@@ -32,28 +30,15 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
-def load_inputs(program_file: str, machine_file: str | None, dialect: str | None
-                ) -> tuple[Program, Machine]:
-    """Parse a program and load machine data (the default machine when ``None``).
-
-    Raises
-    ------
-    FeedOracleError
-        Any problem with either input, naming file and line or key.
-    """
-    machine = load_machine(machine_file)
-    program = parse_file(program_file, dialect=dialect)
-    return program, machine
-
-
 def _fmt(x: float, nd: int = 3) -> str:
     return "inf" if x == float("inf") else f"{x:.{nd}f}"
 
 
 def cmd_inspect(args: argparse.Namespace) -> int:
     """``feedoracle inspect``: print blocks, their segments and any warnings."""
-    program, machine = load_inputs(args.program, args.machine, args.dialect)
-    path = prepare(program)
+    inputs = load_inputs(args.program, args.machine, dialect=args.dialect)
+    program, machine = inputs.program, inputs.machine
+    path = prepare(program)       # the programmed contour, whatever axes the machine has
     out = sys.stdout
     out.write(f"program {program.file} ({program.dialect}, {len(program.blocks)} blocks, "
               f"{path.n_segments} segments, {path.total_length:.3f} mm); machine "
@@ -71,8 +56,7 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         out.write(f"{blk.line:>6} {span.label[:8]:<8} {span.kind:<5} {span.n_segments:>4} "
                   f"{span.length:>11.4f} {feed_s:>11} {blk.continuous_mode:<5} "
                   f"{stop[:30]:<30} {src}\n")
-    warnings = tuple(program.warnings) + unmodelled_features(program)
-    for w in warnings:
+    for w in inputs.warnings:
         print(str(w), file=sys.stderr)
     return EXIT_OK
 

@@ -20,14 +20,12 @@ from typing import Callable, Sequence, TextIO
 
 from reference.core.constraints import BOUND_SETS
 from reference.core.errors import FeedOracleError
-from reference.machine import load_machine
-from reference.nc import parse_file
-from reference.prepare import unmodelled_features
 
-from . import engines
-from .comparison import Comparison, compare, describe_violation, format_interval
+from . import engines, pipeline
+from .comparison import Comparison
 from .export import (comparison_dict, blocks_csv, profile_samples, write_json,
                      write_samples_csv)
+from .text import num, print_comparison, print_summary, rows_table
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -138,89 +136,21 @@ def register(sub: argparse._SubParsersAction, common: Callable) -> None:
 
 
 # --------------------------------------------------------------------- helpers
-def _load(program_file: str, args: argparse.Namespace):
-    machine = load_machine(args.machine)
-    program = parse_file(program_file, dialect=args.dialect)
-    for w in tuple(program.warnings) + unmodelled_features(program):
+def _load(program_file: str, args: argparse.Namespace) -> pipeline.Inputs:
+    """Program and machine of the command line; their warnings go to stderr."""
+    inputs = pipeline.load_inputs(program_file, args.machine, dialect=args.dialect)
+    for w in inputs.warnings:
         print(str(w), file=sys.stderr)
-    return program, machine
-
-
-def _prefixed(progress, prefix: str):
-    """A progress callback that prefixes messages (``None``-safe)."""
-    if progress is None:
-        return None
-    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
-
-
-def _ms(x: float) -> str:
-    return "-" if not math.isfinite(x) else f"{1e3 * x:+.1f}"
-
-
-def _num(x: float, nd: int = 3) -> str:
-    if isinstance(x, float) and math.isnan(x):
-        return "-"
-    if isinstance(x, float) and math.isinf(x):
-        return "inf"
-    return f"{x:.{nd}f}"
-
-
-def _block_table(rows, out: TextIO, limit: int | None = None) -> None:
-    out.write(f"    {'line':>5} {'label':<8} {'kind':<8} {'length_mm':>9} {'t_ref_s':>8} "
-              f"{'t_opt_s':>8} {'gap_ms':>8} {'v_exit ref/opt mm/s':>19}  limit (ref / opt)\n")
-    for r in list(rows)[:limit]:
-        vx = f"{r.v_exit_reference:.1f}/{_num(r.v_exit_oracle, 1)}"
-        kind = r.kind if not r.corner else f"{r.kind}@{r.corner[0]}"
-        out.write(f"    {r.line:>5} {r.label[:8]:<8} {kind[:8]:<8} {r.length_mm:>9.3f} "
-                  f"{r.t_reference_s:>8.4f} {_num(r.t_oracle_s, 4):>8} {_ms(r.gap_s):>8} "
-                  f"{vx:>19}  {r.limit_reference} / {r.limit_oracle}\n")
-
-
-def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
-                     n_worst: int = 5) -> None:
-    """The text summary of one comparison (totals, gap, verdict, notes, worst blocks)."""
-    v = c.verdict(max_gap)
-    who = "recorded" if c.reference_name == "recorded" else "heuristic"
-    out.write(f"{c.program}: machine {c.machine!r}, oracle bounds {c.bounds}, "
-              f"{who} bounds {c.reference_bounds}\n")
-    viol = c.reference_violations
-    out.write(f"  {who:<10} {c.t_reference_s:10.4f} s   "
-              f"{'no violations of ' + ', '.join(BOUND_SETS[c.reference_bounds]) if not viol else str(len(viol)) + ' violation(s)'}\n")
-    for item in viol:
-        out.write(f"    VIOLATION {describe_violation(item, c)}\n")
-    o = c.oracle
-    out.write(f"  {'oracle':<10} LB {_num(o.lower_bound_s, 4)} s, UB {_num(o.upper_bound_s, 4)} s"
-              f"   ({o.status}, {o.grid_points} grid points, {o.solve_time_s:.2f} s)\n")
-    for item in c.oracle_violations:
-        out.write(f"    ORACLE VIOLATION {describe_violation(item, c)}\n")
-    if c.certified:
-        valid = "" if c.gap_lower_valid else "   (lower end: gap to the relaxation only)"
-        out.write(f"  {'gap':<10} {format_interval(c)}   [t_ref/UB - 1, t_ref/LB - 1]{valid}\n")
-    out.write(f"  {'verdict':<10} {'ok' if v.ok else 'FAIL'}: {v.text}\n")
-    for note in c.notes:
-        out.write(f"  note: {note}\n")
-    worst = c.worst_blocks(n_worst)
-    if worst:
-        out.write(f"  largest block gaps:\n")
-        _block_table(worst, out)
+    return inputs
 
 
 # --------------------------------------------------------------------- plan
-def _rows_table(rows, out: TextIO, t_key: str, v_key: str, limit_key: str) -> None:
-    out.write(f"    {'line':>5} {'label':<8} {'kind':<8} {'length_mm':>9} {'t_s':>8} "
-              f"{'v_exit':>8}  limit\n")
-    for r in rows:
-        out.write(f"    {r.get('line', 0):>5} {str(r.get('label', ''))[:8]:<8} "
-                  f"{str(r.get('kind', ''))[:8]:<8} {r.get('length_mm', 0.0):>9.3f} "
-                  f"{_num(r.get(t_key) or 0.0, 4):>8} {_num(r.get(v_key) or 0.0, 1):>8}"
-                  f"  {r.get(limit_key, '')}\n")
-
-
 def cmd_plan(args: argparse.Namespace) -> int:
     """``feedoracle plan``: run the heuristic, print its block table."""
     from reference.planner import ipo_samples, to_json_dict
-    program, machine = _load(args.program, args)
-    plan = engines.run_heuristic(program, machine, progress=args.progress)
+    inputs = _load(args.program, args)
+    program, machine = inputs.program, inputs.machine
+    plan = pipeline.plan_program(program, machine, progress=args.progress)
     args.progress.done()
     doc = to_json_dict(plan)
     if args.json:
@@ -236,45 +166,33 @@ def cmd_plan(args: argparse.Namespace) -> int:
     for v in viol:
         out.write(f"  VIOLATION {v.constraint} {v.axis or ''} ratio {v.ratio:.4g} at "
                   f"s = {v.s:.3f} mm, t = {v.t:.4f} s\n")
-    _rows_table(doc.get("blocks", []), out, "t_reference_s", "v_exit_reference",
-                "limit_reference")
+    rows_table(doc.get("blocks", []), out, "t_reference_s", "v_exit_reference",
+               "limit_reference")
     return EXIT_FAIL if viol else EXIT_OK
 
 
 # --------------------------------------------------------------------- optimize
 def cmd_optimize(args: argparse.Namespace) -> int:
-    """``feedoracle optimize``: the oracle on the heuristic's path."""
-    import optimal
-    bounds, _ = engines.resolve_bounds(args.bounds, None)
-    program, machine = _load(args.program, args)
-    plan = engines.run_heuristic(program, machine, progress=_prefixed(args.progress, "path: "))
-    sol = engines.run_oracle(plan.path, machine.limits, bounds,
-                             progress=_prefixed(args.progress, "oracle: "))
+    """``feedoracle optimize``: the oracle on the program's path."""
+    bounds, _ = engines.resolve_bounds(args.bounds, None)    # an unavailable set: exit 2 now
+    inputs = _load(args.program, args)
+    res = pipeline.optimize_program(inputs.program, inputs.machine, bounds=bounds,
+                                    progress=args.progress)
     args.progress.done()
-    d = optimal.to_json_dict(sol)
-    o = d.get("oracle", d)
-    spans = {b.block: b for b in plan.path.blocks}
-    rows = []
-    for r in d.get("blocks", []):
-        sp = spans.get(int(r.get("block", -1)))
-        rows.append({"block": sp.block, "line": max(1, sp.line), "label": sp.label,
-                     "kind": sp.kind, "length_mm": sp.length, **r} if sp else dict(r))
+    o = res.oracle_dict()
+    rows = res.rows()
     if args.json:
-        doc = {"program": program.file, "machine": machine.name, "bounds": bounds,
-               "oracle": {k: (0.0 if v is None else v) for k, v in o.items()},
-               "blocks": [{k: v for k, v in r.items() if v is not None} for r in rows]}
-        write_json(doc, args.json)
-    if args.csv and sol.profile is not None:
-        header, data = profile_samples(plan.path, sol.profile, machine.limits.t_ipo_s)
+        write_json(res.to_dict(), args.json)
+    if args.csv and res.solution.profile is not None:
+        header, data = profile_samples(res.path, res.solution.profile, res.limits.t_ipo_s)
         write_samples_csv(header, data, args.csv)
     out = sys.stdout if args.json != "-" and args.csv != "-" else sys.stderr
-    out.write(f"{program.file}: machine {machine.name!r}, bounds {bounds}: status "
-              f"{o.get('status')}, LB {_num(o.get('lower_bound_s') or math.nan, 4)} s, UB "
-              f"{_num(o.get('upper_bound_s') or math.nan, 4)} s ({o.get('grid_points', 0)} "
+    out.write(f"{res.program}: machine {res.machine!r}, bounds {res.bounds}: status "
+              f"{o.get('status')}, LB {num(o.get('lower_bound_s') or math.nan, 4)} s, UB "
+              f"{num(o.get('upper_bound_s') or math.nan, 4)} s ({o.get('grid_points', 0)} "
               f"grid points, {o.get('solve_time_s', 0.0):.2f} s)\n")
-    _rows_table(rows, out, "t_oracle_s", "v_exit_oracle", "limit_oracle")
-    ok = o.get("status") in ("optimal", "gap_not_met")
-    return EXIT_OK if ok else EXIT_FAIL
+    rows_table(rows, out, "t_oracle_s", "v_exit_oracle", "limit_oracle")
+    return EXIT_OK if res.certified else EXIT_FAIL
 
 
 # --------------------------------------------------------------------- compare
@@ -293,20 +211,11 @@ def _report_stems(files: Sequence[str]) -> list[str]:
     return out
 
 
-def compare_program(program_file: str, args: argparse.Namespace, prefix: str = ""
-                    ) -> tuple[Comparison, object]:
-    """Plan, solve and compare one program (the work of ``compare`` per program)."""
-    program, machine = _load(program_file, args)
-    plan = engines.run_heuristic(program, machine,
-                                 progress=_prefixed(args.progress, f"{prefix}heuristic: "))
-    bounds, notes = engines.resolve_bounds(args.bounds, getattr(plan, "bound_set", None))
-    sol = engines.run_oracle(plan.path, machine.limits, bounds,
-                             progress=_prefixed(args.progress, f"{prefix}oracle: "))
-    c = compare(plan, sol, limits=machine.limits, program=program, machine=machine.name)
-    if notes:
-        from dataclasses import replace
-        c = replace(c, notes=tuple(notes) + c.notes)
-    return c, machine
+def _prefixed(progress, prefix: str):
+    """A progress callback that prefixes messages (``None``-safe)."""
+    if progress is None:
+        return None
+    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
@@ -325,7 +234,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     n = len(files)
     for i, (f, stem) in enumerate(zip(files, stems)):
         prefix = f"[{i + 1}/{n}] {f}: " if n > 1 else f"{f}: "
-        c, machine = compare_program(f, args, prefix)
+        inputs = _load(f, args)
+        c = pipeline.compare_program(inputs.program, inputs.machine, bounds=args.bounds,
+                                     progress=_prefixed(args.progress, prefix))
         args.progress.done()
         doc = comparison_dict(c, args.max_gap)
         docs.append(doc)
@@ -365,22 +276,6 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def print_summary(results: Sequence[tuple[str, Comparison]], max_gap: float | None,
-                  out: TextIO) -> None:
-    """One table row per program: times, bounds, gap interval, verdict."""
-    w = max(7, max(len(c.program) for _, c in results))
-    out.write(f"{'program':<{w}} {'t_ref_s':>9} {'LB_s':>9} {'UB_s':>9} {'gap':>16} "
-              f"{'viol':>4}  verdict\n")
-    for _, c in results:
-        v = c.verdict(max_gap)
-        gap = format_interval(c) if c.certified else "-"
-        out.write(f"{c.program:<{w}} {c.t_reference_s:>9.4f} {_num(c.oracle.lower_bound_s, 4):>9} "
-                  f"{_num(c.oracle.upper_bound_s, 4):>9} {gap:>16} "
-                  f"{len(c.reference_violations):>4}  {'ok' if v.ok else 'FAIL ' + v.status}\n")
-    if max_gap is not None:
-        out.write(f"gate: gap upper end t_ref/LB - 1 <= {100 * max_gap:g} %\n")
-
-
 def _write_program_report(folder: FsPath, stem: str, c: Comparison, doc: dict,
                           max_gap: float | None, title: str | None = None) -> None:
     from .report_html import write_report
@@ -394,8 +289,7 @@ def _write_program_report(folder: FsPath, stem: str, c: Comparison, doc: dict,
 # --------------------------------------------------------------------- check
 def cmd_check(args: argparse.Namespace) -> int:
     """``feedoracle check``: a recorded trajectory against limits and the oracle."""
-    from .recorded import check_recorded
-    program, machine = _load(args.program, args)
+    inputs = _load(args.program, args)
     smoothing = args.smoothing
     if smoothing != "auto":
         try:
@@ -405,9 +299,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                              f"in mm") from None
         if not (math.isfinite(smoothing) and smoothing >= 0):
             raise UsageError(f"--smoothing {args.smoothing!r}: must be >= 0 mm")
-    result = check_recorded(args.trajectory, program, machine, bounds=args.bounds,
-                            path_kind=args.path_kind, smoothing=smoothing,
-                            max_deviation=args.max_deviation, progress=args.progress)
+    result = pipeline.check_trajectory(args.trajectory, inputs.program, inputs.machine,
+                                       bounds=args.bounds, path_kind=args.path_kind,
+                                       smoothing=smoothing,
+                                       max_deviation=args.max_deviation,
+                                       progress=args.progress)
     args.progress.done()
     out = sys.stdout if args.json != "-" else sys.stderr
     result.print(out)
@@ -416,7 +312,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         folder = FsPath(args.report)
         stem = FsPath(args.trajectory).stem
         _write_program_report(folder, stem, result.comparison, doc, None,
-                              title=f"{args.trajectory} on {program.file}")
+                              title=f"{args.trajectory} on {inputs.program.file}")
         out.write(f"report: {folder / (stem + '.html')}\n")
     if args.json:
         write_json(doc, args.json)

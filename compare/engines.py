@@ -55,14 +55,24 @@ def resolve_bounds(requested: str, planner_bounds: str | None) -> tuple[str, tup
                    f"the oracle cannot solve that yet and solved 'acc' instead.",)
 
 
-def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | None = None):
-    """``reference.planner.plan`` (the SINUMERIK-style heuristic)."""
+def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | None = None,
+                  *, path: Path | None = None):
+    """``reference.planner.plan`` (the SINUMERIK-style heuristic) on ``path``, the
+    program's :func:`reference.build_path` (built by the planner when ``None``)."""
     from reference.planner import plan
-    return plan(program, machine, progress=progress)
+    return plan(program, machine, path=path, progress=progress)
 
 
 def run_oracle(path: Path, limits: MachineLimits, bounds: str,
-               progress: ProgressFn | None = None):
-    """``optimal.solve`` on ``path`` under ``bounds``."""
+               progress: ProgressFn | None = None, *, tol: float | None = None):
+    """``optimal.solve`` on ``path`` under ``bounds`` (``tol``: requested relative gap
+    between its bounds; ``None`` for the oracle's default)."""
     import optimal
-    return optimal.solve(path, limits, bounds=bounds, progress=progress)
+    options = {} if tol is None else {"tol": tol}
+    return optimal.solve(path, limits, bounds=bounds, progress=progress, **options)
+
+
+def oracle_json(solution) -> dict:
+    """``optimal.to_json_dict``: the ``"oracle"`` part and the oracle's block fields."""
+    import optimal
+    return optimal.to_json_dict(solution)

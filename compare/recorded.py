@@ -837,7 +837,7 @@ class CheckResult:
 
     def print(self, out: TextIO) -> None:
         """Text summary (deviation, limits, gap, stops, worst blocks)."""
-        from .commands import print_comparison
+        from .text import print_comparison
         rec = self.recording
         out.write(f"{rec.file}: {rec.t.size} samples over {rec.t[-1] - rec.t[0]:.4f} s, "
                   f"projected onto the {self.path_kind} path of {self.comparison.program}\n")
@@ -962,11 +962,10 @@ def check_recorded(file: str | FsPath, program, machine, *, bounds: str | None =
     CheckResult
     """
     from . import engines
-    from reference.prepare import prepare, restrict_to_machine
+    from reference.prepare import build_path, prepare, restrict_to_machine
     limits = machine.limits
     if path_kind == "reference":
-        plan = engines.run_heuristic(program, machine, progress=_pre(progress, "path: "))
-        path = plan.path
+        path = build_path(program, machine)
     else:
         path = restrict_to_machine(prepare(program), limits)
     rec = read_trajectory(file, path.axes, tuple(bool(r) for r in path.rotary))

@@ -29,6 +29,7 @@ from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segments, line_segme
 from .core.limits import MachineLimits
 from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM,
                               TANGENT_TOL_RAD)
+from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 
 _PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
@@ -291,5 +292,35 @@ def restrict_to_machine(path: Path, limits: MachineLimits) -> Path:
                 d=path.d[:, keep], **f)
 
 
-__all__ = ["prepare", "require_axes", "restrict_to_machine", "unmodelled_features",
-           "KIND_CODES"]
+def build_path(program: Program, machine: Machine) -> Path:
+    """The path both planners run on: the one way from a program and a machine to a Path.
+
+    The heuristic (:func:`reference.planner.plan`), the oracle's callers and the
+    comparison all take their path from here, so the gap measures velocity planning
+    alone (DESIGN section 1). Today this is the programmed contour (:func:`prepare`)
+    over the axes the machine knows (:func:`restrict_to_machine`); corner rounding and
+    tool radius compensation, once modelled, belong here too.
+
+    Parameters
+    ----------
+    program : Program
+        Parsed program (absolute positions in mm / degrees).
+    machine : Machine
+        Machine data; its limits name the axes the path keeps.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    PathError
+        Arc geometry out of tolerance (names file and line).
+    MachineDataError
+        The program moves an axis the machine has no limits for (names axis and line).
+    """
+    return restrict_to_machine(prepare(program), machine.limits)
+
+
+__all__ = ["build_path", "prepare", "require_axes", "restrict_to_machine",
+           "unmodelled_features", "KIND_CODES"]

@@ -176,3 +176,110 @@ def test_rulebook_check_sees_a_copy() -> None:
         assert len(found) == 3, found
     finally:
         bad.unlink()
+
+
+# ------------------------------------------------------------------ import cycles
+def _module_name(py: Path) -> str:
+    parts = py.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _import_graph(folder: str) -> dict[str, set[str]]:
+    """Module -> modules of the same package it imports (function-level imports too;
+    ``from . import x`` resolved to the submodule ``x`` where there is one). Imports under
+    ``if TYPE_CHECKING:`` are left out: they never run, so they make no cycle."""
+    mods = {_module_name(py): py for py in _files(folder)}
+    graph: dict[str, set[str]] = {}
+    for name, py in mods.items():
+        pkg = name.split(".") if py.name == "__init__.py" else name.split(".")[:-1]
+        out: set[str] = set()
+        tree = ast.parse(py.read_text(encoding="utf-8"))
+        typing_only = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
+                       and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+                       for n in ast.walk(node)}
+        for node in ast.walk(tree):
+            if id(node) in typing_only:
+                continue
+            if isinstance(node, ast.Import):
+                out |= {a.name for a in node.names if a.name in mods}
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg[: len(pkg) - node.level + 1]
+                    mod = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    mod = node.module or ""
+                for a in node.names:
+                    sub = f"{mod}.{a.name}"
+                    out |= {sub} if sub in mods else ({mod} if mod in mods else set())
+        graph[name] = out - {name}
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            v, edges = work[-1]
+            w = next((w for w in edges if w in graph), None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on_stack.add(w)
+                    work.append((w, iter(sorted(graph[w]))))
+                elif w in on_stack:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    found.append(sorted(comp))
+    return found
+
+
+@pytest.mark.parametrize("folder", ["compare", "reference", "optimal"])
+def test_no_import_cycle_within_a_package(folder: str) -> None:
+    graph = _import_graph(folder)
+    assert len(graph) > 5                              # the walk found the modules
+    assert _cycles(graph) == [], f"import cycles in {folder}/ (lazy imports count too)"
+
+
+def test_cycle_finder_sees_a_cycle() -> None:
+    """Guards against a vacuous cycle test: a known cycle and a known chain."""
+    g = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": set(), "e": {"d"}}
+    assert _cycles(g) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+    graph = _import_graph("compare")
+    assert {"compare.engines", "compare.pipeline"} <= graph["compare.commands"]
+
+
+def test_pipeline_is_free_of_the_cli() -> None:
+    """compare/pipeline.py takes plain arguments: no argparse, no printing, no CLI module."""
+    py = ROOT / "compare" / "pipeline.py"
+    mods = {m for _, m in _imports(py)}
+    cli_side = {"argparse", "sys", "compare.cli", "compare.commands", "compare.progress",
+                "compare.text"}
+    assert not mods & cli_side, f"compare/pipeline.py imports {sorted(mods & cli_side)}"
+    calls = {n.func.id for n in ast.walk(ast.parse(py.read_text(encoding="utf-8")))
+             if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+    assert "print" not in calls

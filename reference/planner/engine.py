@@ -3,12 +3,13 @@
 Stage order (spec/sinumerik-model.md 12.3; TRC, tangential control and rounding come
 in a later issue, G641..G645 behave as G64 and the stage trace says so):
 
-``prepare`` (program -> path) -> ``stops`` (acceleration modes, forced stops) ->
-``limit curves`` (segment caps, tangential limits) -> ``corners`` (junction limits) ->
-``lookahead`` (horizon caps, planning units, passes) -> ``profiles`` (unit profiles) ->
-``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation`` (ADAPT_PATH_DYNAMIC) ->
-``settle`` (exact-stop holds) -> assembly of the :class:`~reference.core.profile.Profile`
--> ``check`` (the planner's own profile against its declared bound set).
+``build_path`` (program -> path, :mod:`reference.prepare`) -> ``stops`` (acceleration
+modes, forced stops) -> ``limit curves`` (segment caps, tangential limits) -> ``corners``
+(junction limits) -> ``lookahead`` (horizon caps, planning units, passes) -> ``profiles``
+(unit profiles) -> ``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation``
+(ADAPT_PATH_DYNAMIC) -> ``settle`` (exact-stop holds) -> assembly of the
+:class:`~reference.core.profile.Profile` -> ``check`` (the planner's own profile against
+its declared bound set).
 
 Each stage is a pure function of data to data; this module only composes them, records
 the stage trace and derives the per-block and per-corner rows. The result types live in
@@ -27,7 +28,7 @@ from ..core.geometry import Path
 from ..core.profile import Profile
 from ..machine import Machine
 from ..nc.program import Program
-from ..prepare import prepare, restrict_to_machine
+from ..prepare import build_path
 from . import causes as C
 from .adaptation import adaptation_factors, adapted_units
 from .corners import junction_limits
@@ -58,8 +59,9 @@ def _replan(units: Units, idx: np.ndarray, v_nodes: np.ndarray) -> UnitProfiles:
                          units.jerk_dn[idx])
 
 
-def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | None = None,
-         progress: Progress | None = None, check: bool = True) -> ReferencePlan:
+def plan(program: Program, machine: Machine, *, path: Path | None = None,
+         parameters: PlannerParameters | None = None, progress: Progress | None = None,
+         check: bool = True) -> ReferencePlan:
     """Plan a program with the SINUMERIK-style heuristic.
 
     Parameters
@@ -68,6 +70,10 @@ def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | 
         The parsed NC program.
     machine : Machine
         Machine data (limits, channel and axis settings).
+    path : Path, optional
+        ``reference.build_path(program, machine)`` when the caller has built it already
+        (to hand the very same object to the oracle); built here when omitted. A path
+        of another program is refused.
     parameters : PlannerParameters, optional
         Model parameters where the manuals are silent (defaults documented there).
     progress : callable, optional
@@ -83,6 +89,8 @@ def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | 
     ------
     FeedOracleError
         Bad input (path geometry, axes without machine data).
+    ValueError
+        ``path`` is not this program's (another file or another number of blocks).
     """
     params = DEFAULT_PARAMETERS if parameters is None else parameters
     report_progress = progress or _noop
@@ -92,7 +100,12 @@ def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | 
     limits = machine.limits
 
     report_progress("prepare", 0.0)
-    path = restrict_to_machine(prepare(program), limits)
+    if path is None:
+        path = build_path(program, machine)
+    elif len(path.blocks) != len(program.blocks) or path.source != program.file:
+        raise ValueError(f"plan(path=...): the path of {path.source!r} "
+                         f"({len(path.blocks)} blocks) is not the path of {program.file!r} "
+                         f"({len(program.blocks)} blocks); use build_path(program, machine)")
     m = path.n_segments
     trace.append(("prepare", f"{len(path.blocks)} blocks, {m} segments, "
                              f"{path.total_length:.6g} mm"))

@@ -52,11 +52,12 @@ def fake_engines(monkeypatch):
     """Replace the heuristic and the oracle by the fakes (CLI tests of compare alone)."""
     from compare import engines
 
-    def run_heuristic(program, machine, progress=None):
-        path = restrict_to_machine(prepare(program), machine.limits)
+    def run_heuristic(program, machine, progress=None, *, path=None):
+        if path is None:
+            path = restrict_to_machine(prepare(program), machine.limits)
         return fake_plan(path, machine.limits)
 
-    def run_oracle(path, limits, bounds, progress=None):
+    def run_oracle(path, limits, bounds, progress=None, *, tol=None):
         return fake_solution(path, limits)
 
     monkeypatch.setattr(engines, "run_heuristic", run_heuristic)

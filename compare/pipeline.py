@@ -1,0 +1,309 @@
+"""The work behind ``feedoracle plan``, ``optimize``, ``compare`` and ``check`` as plain
+functions: a program and a machine in, typed results out.
+
+Nothing here parses arguments, prints, writes files or picks an exit code; that is the
+CLI's part (:mod:`compare.commands`). A program is given as a parsed
+:class:`~reference.nc.program.Program` (from :func:`reference.parse_text` for program
+text) or as a file path; a machine as a :class:`~reference.machine.Machine`, a
+``machine.toml`` path, a bundled machine's name, or ``None`` for the default machine.
+
+Every function that runs the oracle takes its path from :func:`reference.build_path`,
+the one function the heuristic uses too, so both sides run on the same path::
+
+    program + machine --build_path--> path --plan(path=path)--> heuristic plan
+                                          \\--optimal.solve-----> oracle solution
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any, Callable, Union
+
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.machine import Machine, load_machine
+from reference.nc import parse_file
+from reference.nc.program import Program, ProgramWarning
+from reference.prepare import build_path, unmodelled_features
+
+from . import engines
+from .comparison import Comparison, compare
+
+if TYPE_CHECKING:  # annotations only: importing these costs the planner and the oracle
+    from optimal import OptimalSolution
+    from reference.planner import ReferencePlan
+
+    from .recorded import CheckResult
+
+#: A program: parsed, or the path of an NC file (dialect from its extension).
+ProgramLike = Union[Program, str, "os.PathLike[str]"]
+#: A machine: loaded, a ``machine.toml`` path or bundled name, or ``None`` (the default).
+MachineLike = Union[Machine, str, "os.PathLike[str]", None]
+#: ``progress(message, fraction)``, fraction in [0, 1] or -1 when unknown.
+ProgressFn = Callable[[str, float], None]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Inputs:
+    """A parsed program and loaded machine data.
+
+    Attributes
+    ----------
+    program : Program
+    machine : Machine
+    """
+
+    program: Program
+    machine: Machine
+
+    @property
+    def warnings(self) -> tuple[ProgramWarning, ...]:
+        """The parser's warnings and the features the path does not apply (TRC, TANG)."""
+        return tuple(self.program.warnings) + unmodelled_features(self.program)
+
+
+def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
+                dialect: str | None = None) -> Inputs:
+    """Parse a program and load machine data; objects pass through unchanged.
+
+    Parameters
+    ----------
+    program : Program or path
+        A parsed program, or an NC file (dialect from the extension unless ``dialect``).
+    machine : Machine, path, str or None
+        Machine data, a ``machine.toml`` file or bundled name; ``None``: the default.
+    dialect : {"sinumerik", "ngc"}, optional
+        Dialect of a program file.
+
+    Returns
+    -------
+    Inputs
+
+    Raises
+    ------
+    FeedOracleError
+        Bad machine data (checked first) or a bad program, naming key or file and line.
+    OSError
+        The program file cannot be read.
+    """
+    m = machine if isinstance(machine, Machine) else load_machine(machine)
+    p = program if isinstance(program, Program) else parse_file(program, dialect=dialect)
+    return Inputs(program=p, machine=m)
+
+
+def _prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
+    """A progress callback that prefixes messages (``None``-safe)."""
+    if progress is None:
+        return None
+    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
+
+
+# --------------------------------------------------------------------- plan
+def plan_program(program: ProgramLike, machine: MachineLike = None, *,
+                 dialect: str | None = None, progress: ProgressFn | None = None
+                 ) -> "ReferencePlan":
+    """The heuristic alone (``feedoracle plan``).
+
+    Parameters
+    ----------
+    program, machine, dialect
+        See :func:`load_inputs`.
+    progress : callable, optional
+        ``progress(message, fraction)``.
+
+    Returns
+    -------
+    reference.planner.ReferencePlan
+        Profile, per-block rows (``to_json_dict`` gives the JSON), the own check.
+    """
+    inp = load_inputs(program, machine, dialect=dialect)
+    return engines.run_heuristic(inp.program, inp.machine, progress=progress)
+
+
+# --------------------------------------------------------------------- optimize
+@dataclass(frozen=True, slots=True, eq=False)
+class OptimizeResult:
+    """The oracle alone on a program's path (``feedoracle optimize``).
+
+    Attributes
+    ----------
+    program : str
+        Program file.
+    machine : str
+        Machine name.
+    bounds : str
+        Bound set solved.
+    path : Path
+        The path solved on (:func:`reference.build_path`).
+    limits : MachineLimits
+        Machine limits.
+    solution : optimal.OptimalSolution
+        The oracle's result.
+    """
+
+    program: str
+    machine: str
+    bounds: str
+    path: Path
+    limits: MachineLimits
+    solution: "OptimalSolution"
+
+    @property
+    def certified(self) -> bool:
+        """True when both bounds are valid (status ``optimal`` or ``gap_not_met``)."""
+        return str(self.solution.status) in ("optimal", "gap_not_met")
+
+    def oracle_dict(self) -> dict[str, Any]:
+        """The ``"oracle"`` part of the JSON contract (``None`` for a missing bound)."""
+        d = engines.oracle_json(self.solution)
+        return d.get("oracle", d)
+
+    def rows(self) -> list[dict[str, Any]]:
+        """Per-block rows: the oracle's fields with line, label, kind and length added."""
+        spans = {b.block: b for b in self.path.blocks}
+        out = []
+        for r in engines.oracle_json(self.solution).get("blocks", []):
+            sp = spans.get(int(r.get("block", -1)))
+            out.append({"block": sp.block, "line": max(1, sp.line), "label": sp.label,
+                        "kind": sp.kind, "length_mm": sp.length, **r} if sp else dict(r))
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON of ``feedoracle optimize --json`` (``schema/result.schema.json``)."""
+        oracle = {k: (0.0 if v is None else v) for k, v in self.oracle_dict().items()}
+        return {"program": self.program, "machine": self.machine, "bounds": self.bounds,
+                "oracle": oracle,
+                "blocks": [{k: v for k, v in r.items() if v is not None}
+                           for r in self.rows()]}
+
+
+def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
+                     bounds: str = "acc", tol: float | None = None,
+                     dialect: str | None = None, progress: ProgressFn | None = None
+                     ) -> OptimizeResult:
+    """The oracle alone on the program's path; the heuristic does not run.
+
+    Parameters
+    ----------
+    program, machine, dialect
+        See :func:`load_inputs`.
+    bounds : str
+        Bound set (``"acc"``; an unavailable set is an input error).
+    tol : float, optional
+        Requested relative gap between the oracle's bounds (default: the oracle's).
+    progress : callable, optional
+        ``progress(message, fraction)``.
+
+    Returns
+    -------
+    OptimizeResult
+
+    Raises
+    ------
+    FeedOracleError
+        Bad input, or a bound set the oracle cannot solve.
+    """
+    bounds, _ = engines.resolve_bounds(bounds, None)
+    inp = load_inputs(program, machine, dialect=dialect)
+    path = build_path(inp.program, inp.machine)
+    sol = engines.run_oracle(path, inp.machine.limits, bounds,
+                             progress=_prefixed(progress, "oracle: "), tol=tol)
+    return OptimizeResult(program=inp.program.file, machine=inp.machine.name, bounds=bounds,
+                          path=path, limits=inp.machine.limits, solution=sol)
+
+
+# --------------------------------------------------------------------- compare
+def compare_program(program: ProgramLike, machine: MachineLike = None, *,
+                    bounds: str = "auto", tol: float | None = None,
+                    dialect: str | None = None, progress: ProgressFn | None = None
+                    ) -> Comparison:
+    """Heuristic and oracle on one path, compared block by block (``feedoracle compare``).
+
+    Parameters
+    ----------
+    program, machine, dialect
+        See :func:`load_inputs`.
+    bounds : {"auto", "acc", "jerk", "jerk+freq"}
+        Oracle bound set; ``"auto"`` takes the heuristic's own where the oracle solves
+        it, else ``"acc"`` with a note in :attr:`Comparison.notes`.
+    tol : float, optional
+        Requested relative gap between the oracle's bounds (default: the oracle's).
+    progress : callable, optional
+        ``progress(message, fraction)``; messages start with ``heuristic:`` or
+        ``oracle:``.
+
+    Returns
+    -------
+    Comparison
+        Per-block rows, totals, the gap interval and ``verdict(max_gap)``.
+
+    Raises
+    ------
+    FeedOracleError
+        Bad input, or an explicit bound set the oracle cannot solve.
+    """
+    inp = load_inputs(program, machine, dialect=dialect)
+    path = build_path(inp.program, inp.machine)
+    plan = engines.run_heuristic(inp.program, inp.machine, path=path,
+                                 progress=_prefixed(progress, "heuristic: "))
+    bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
+    sol = engines.run_oracle(path, inp.machine.limits, bounds,
+                             progress=_prefixed(progress, "oracle: "), tol=tol)
+    c = compare(plan, sol, limits=inp.machine.limits, program=inp.program,
+                machine=inp.machine.name)
+    if notes:
+        c = replace(c, notes=tuple(notes) + c.notes)
+    return c
+
+
+# --------------------------------------------------------------------- check
+def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
+                     machine: MachineLike = None, *, bounds: str | None = None,
+                     path_kind: str = "reference", smoothing: float | str = "auto",
+                     max_deviation: float | None = None, dialect: str | None = None,
+                     progress: ProgressFn | None = None) -> "CheckResult":
+    """A recorded trajectory against the limits and the oracle (``feedoracle check``).
+
+    Parameters
+    ----------
+    trajectory : path
+        CSV file with header ``t,X,Y,Z[,A,...]`` (see :mod:`compare.recorded`).
+    program, machine, dialect
+        See :func:`load_inputs`; the program the recording ran.
+    bounds : str, optional
+        Bound set the recording is judged against (default ``"acc"``).
+    path_kind : {"reference", "programmed"}
+        Project onto :func:`reference.build_path` or onto the programmed contour.
+    smoothing : float or "auto"
+        Position noise to smooth away, mm (0: none; ``"auto"``: estimated).
+    max_deviation : float, optional
+        Largest accepted distance from the path, mm (default ``max(0.1, 5 * noise)``).
+    progress : callable, optional
+        ``progress(message, fraction)``.
+
+    Returns
+    -------
+    compare.recorded.CheckResult
+        ``ok``, ``print(out)``, ``to_dict()`` and the :class:`Comparison`.
+
+    Raises
+    ------
+    FeedOracleError
+        Bad program, machine data or recording (naming file and line or row).
+    """
+    from .recorded import check_recorded
+    if isinstance(smoothing, str) and smoothing != "auto":
+        raise ValueError(f"smoothing {smoothing!r}: 'auto' or a noise level in mm")
+    if not isinstance(smoothing, str) and not (math.isfinite(smoothing) and smoothing >= 0):
+        raise ValueError(f"smoothing {smoothing!r}: must be >= 0 mm")
+    inp = load_inputs(program, machine, dialect=dialect)
+    return check_recorded(trajectory, inp.program, inp.machine, bounds=bounds,
+                          path_kind=path_kind, smoothing=smoothing,
+                          max_deviation=max_deviation, progress=progress)
+
+
+__all__ = ["Inputs", "MachineLike", "OptimizeResult", "ProgramLike", "ProgressFn",
+           "check_trajectory", "compare_program", "load_inputs", "optimize_program",
+           "plan_program"]
