@@ -90,7 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    progress = Progress(quiet=getattr(args, "quiet", False))
+    progress = Progress(quiet=args.quiet)
     args.progress = progress
     try:
         return int(args.func(args))

@@ -26,8 +26,8 @@ class BoundsNotAvailable(FeedOracleError, ValueError):
 
 def oracle_bound_sets() -> tuple[str, ...]:
     """Bound sets the installed oracle solves."""
-    from optimal import oracle
-    return tuple(getattr(oracle, "SUPPORTED_BOUNDS", ("acc",)))
+    from optimal import SUPPORTED_BOUNDS
+    return tuple(SUPPORTED_BOUNDS)
 
 
 def resolve_bounds(requested: str, planner_bounds: str | None) -> tuple[str, tuple[str, ...]]:
