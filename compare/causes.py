@@ -26,7 +26,7 @@ from reference.core.profile import Profile
 #: block where no limit is tight and ``"-"`` for a block without motion or time).
 CAUSES: tuple[str, ...] = ("feed", "axis velocity", "axis acceleration", "jerk", "frequency",
                            "corner rule", "look-ahead horizon", "IPO-cycle cap", "exact stop",
-                           "forced stop")
+                           "forced stop", "dwell", "exact stop settle")
 
 #: A limit is tight where value/limit >= 1 - TIGHT_REL. 2 % covers the oracle's
 #: discretisation (constant path acceleration between grid nodes on arcs) and the
@@ -131,6 +131,8 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
 
 
 def _stop_cause(reason: str) -> str:
+    if reason.startswith("dwell"):
+        return "dwell"
     return "exact stop" if reason.startswith("exact") else "forced stop"
 
 

@@ -195,7 +195,13 @@ def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
         out.write(f"    ORACLE VIOLATION {describe_violation(item, c)}\n")
     if c.certified:
         valid = "" if c.gap_lower_valid else "   (lower end: gap to the relaxation only)"
-        out.write(f"  {'gap':<10} {format_interval(c)}   [t_ref/UB - 1, t_ref/LB - 1]{valid}\n")
+        if c.hold_s > 0:
+            out.write(f"  {'holds':<10} {c.hold_s:10.4f} s   dwell and exact-stop settle, the "
+                      f"same on both sides: not counted in the gap\n")
+            formula = "[(t_ref-H)/(UB-H) - 1, (t_ref-H)/(LB-H) - 1], H = holds"
+        else:
+            formula = "[t_ref/UB - 1, t_ref/LB - 1]"
+        out.write(f"  {'gap':<10} {format_interval(c)}   {formula}{valid}\n")
     out.write(f"  {'verdict':<10} {'ok' if v.ok else 'FAIL'}: {v.text}\n")
     for note in c.notes:
         out.write(f"  note: {note}\n")
@@ -249,7 +255,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     program, machine = _load(args.program, args)
     plan = engines.run_heuristic(program, machine, progress=_prefixed(args.progress, "path: "))
     sol = engines.run_oracle(plan.path, machine.limits, bounds,
-                             progress=_prefixed(args.progress, "oracle: "))
+                             progress=_prefixed(args.progress, "oracle: "), holds=getattr(plan, "holds", None))
     args.progress.done()
     d = optimal.to_json_dict(sol)
     o = d.get("oracle", d)
@@ -301,7 +307,8 @@ def compare_program(program_file: str, args: argparse.Namespace, prefix: str = "
                                  progress=_prefixed(args.progress, f"{prefix}heuristic: "))
     bounds, notes = engines.resolve_bounds(args.bounds, getattr(plan, "bound_set", None))
     sol = engines.run_oracle(plan.path, machine.limits, bounds,
-                             progress=_prefixed(args.progress, f"{prefix}oracle: "))
+                             progress=_prefixed(args.progress, f"{prefix}oracle: "),
+                             holds=getattr(plan, "holds", None))
     c = compare(plan, sol, limits=machine.limits, program=program, machine=machine.name)
     if notes:
         from dataclasses import replace

@@ -62,7 +62,8 @@ def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | Non
 
 
 def run_oracle(path: Path, limits: MachineLimits, bounds: str,
-               progress: ProgressFn | None = None):
-    """``optimal.solve`` on ``path`` under ``bounds``."""
+               progress: ProgressFn | None = None, holds=None):
+    """``optimal.solve`` on ``path`` under ``bounds`` with the imposed ``holds``
+    (``reference.holds.imposed_holds``, the heuristic's ``plan.holds``)."""
     import optimal
-    return optimal.solve(path, limits, bounds=bounds, progress=progress)
+    return optimal.solve(path, limits, bounds=bounds, progress=progress, holds=holds)

@@ -964,17 +964,20 @@ def check_recorded(file: str | FsPath, program, machine, *, bounds: str | None =
     from . import engines
     from reference.prepare import prepare, restrict_to_machine
     limits = machine.limits
+    from reference.holds import imposed_holds
     if path_kind == "reference":
         plan = engines.run_heuristic(program, machine, progress=_pre(progress, "path: "))
-        path = plan.path
+        path, holds = plan.path, plan.holds
     else:
         path = restrict_to_machine(prepare(program), limits)
+        holds = imposed_holds(program, path, machine)
     rec = read_trajectory(file, path.axes, tuple(bool(r) for r in path.rotary))
     if progress is not None:
         progress("projecting the recording", -1.0)
     prof, proj, sigma, info = recorded_profile(path, limits, rec, smoothing)
     bound_set = bounds or "acc"
-    sol = engines.run_oracle(path, limits, "acc", progress=_pre(progress, "oracle: "))
+    sol = engines.run_oracle(path, limits, "acc", progress=_pre(progress, "oracle: "),
+                             holds=holds)
     i = proj.worst
     tol = measurement_tolerance(path, limits, rec.t, sigma, info["scale"])
     notes = [f"Recorded trajectory {rec.file} ({rec.t.size} samples): judged on the "

@@ -28,9 +28,9 @@ import numpy as np
 from reference.core.constraints import BOUND_SETS, ConstraintReport
 from reference.core.errors import InfeasibleError
 from reference.core.geometry import Path
+from reference.core.holds import DWELL, NO_HOLDS, Holds, dwell_holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
-from reference.core.tolerances import VEL_TOL_MM_S
 
 from .backends import DEFAULT_BACKEND, get_backend
 from .bounds import lower_bound, node_bounds_on, verified_profile
@@ -63,7 +63,8 @@ class BlockResult:
     length_mm : float
         Path length of the block, mm.
     t_oracle_s : float
-        Time the verified (upper-bound) profile spends in the block, s (dwell included).
+        Time the verified (upper-bound) profile spends in the block, s (its holds, dwell
+        or exact-stop settle, included).
     v_exit_oracle : float
         Path speed at the block end, mm/s.
     limit_oracle : str
@@ -109,8 +110,9 @@ class OptimalSolution:
         The verified profile whose duration is ``upper_bound_s`` (``None`` only on
         ``solver_error``).
     lower_bound_s, upper_bound_s : float
-        Certified lower bound and verified upper bound of the minimum time, s (dwells
-        included in both).
+        Certified lower bound and verified upper bound of the minimum time, s (the
+        imposed holds, dwell and exact-stop settle, included in both: they are the same
+        constant in every feasible motion).
     objective_s : float
         Time of the grid optimum before time scaling, s.
     gap : float
@@ -138,13 +140,15 @@ class OptimalSolution:
         Problem construction, discrete solves, checker, lower-bound relaxation, and the
         whole call, s (sums over rounds).
     dwell_s : float
-        Total dwell time of the program, s.
+        Total dwell (G4) time of the program, s (part of ``holds``).
     report : ConstraintReport or None
         The checker's report on the final grid profile before time scaling.
     history : tuple[IterationRecord, ...]
         Bounds per round.
     message : str
         Human-readable summary.
+    holds : Holds
+        The imposed holds in ``profile`` and in both bounds (as given to :func:`solve`).
     """
 
     status: SolveStatus
@@ -171,6 +175,12 @@ class OptimalSolution:
     report: ConstraintReport | None = None
     history: tuple[IterationRecord, ...] = field(default=())
     message: str = ""
+    holds: Holds = NO_HOLDS
+
+    @property
+    def hold_s(self) -> float:
+        """Total imposed hold time (dwell and exact-stop settle), s."""
+        return self.holds.total_s
 
 
 # --------------------------------------------------------------------------- helpers
@@ -180,28 +190,6 @@ def _block_name(path: Path, blk: int) -> str:
         return f"block {blk}"
     lab = f", {span.label}" if span.label else ""
     return f"block {blk} (line {span.line}{lab})"
-
-
-def _with_holds(prof: Profile, path: Path) -> Profile:
-    """Insert the dwell holds (``s`` constant, ``v = 0``) at their blocks' positions."""
-    holds = [(b.s_end, b.block, b.dwell_s) for b in path.blocks if b.dwell_s > 0]
-    if not holds:
-        return prof
-    t, s, v = prof.t.copy(), prof.s.copy(), prof.v.copy()
-    a, j, blk = prof.a.copy(), prof.j.copy(), prof.block.copy()
-    for pos, block, dwell in reversed(holds):
-        i = int(np.clip(np.searchsorted(s, pos, side="left"), 0, s.size - 1))
-        if v[i] > VEL_TOL_MM_S:
-            continue
-        t = np.insert(t, i + 1, t[i])
-        t[i + 1:] += dwell
-        s = np.insert(s, i + 1, s[i])
-        v = np.insert(v, i + 1, 0.0)
-        v[i] = 0.0
-        a = np.insert(a, i, 0.0)
-        j = np.insert(j, i, 0.0)
-        blk = np.insert(blk, i, block)
-    return Profile(t=t, s=s, v=v, a=a, j=j, block=blk)
 
 
 def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
@@ -295,23 +283,27 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
     return mark
 
 
-def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str
-                    ) -> OptimalSolution:
-    dwell = float(sum(b.dwell_s for b in path.blocks))
-    prof = _with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path)
+def _dwell_part(holds: Holds) -> float:
+    return float(sum(d for d, c in zip(holds.duration_s, holds.cause) if c == DWELL))
+
+
+def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str,
+                    holds: Holds) -> OptimalSolution:
+    total = holds.total_s
+    prof = with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path, holds)
     n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
     bt = prof.block_times(path) if path.blocks else np.zeros(0)
     rows = tuple(BlockResult(b.block, b.line, b.label, b.kind, b.length,
                              float(bt[b.block]) if b.block < bt.size else 0.0, 0.0,
                              b.stop_reason) for b in path.blocks)
     return OptimalSolution(
-        status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=dwell, upper_bound_s=dwell,
-        objective_s=dwell, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
+        status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=total, upper_bound_s=total,
+        objective_s=total, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
         block_times_s=np.asarray(bt if n_blocks else np.zeros(0)), blocks=rows,
         grid=np.zeros(1), active=(), grid_points=1, iterations=0, backend=backend,
         build_time_s=0.0, solve_time_s=0.0, check_time_s=0.0, bound_time_s=0.0,
-        total_time_s=time.perf_counter() - t0, dwell_s=dwell,
-        message="path without motion: time = dwell time")
+        total_time_s=time.perf_counter() - t0, dwell_s=_dwell_part(holds),
+        message="path without motion: time = hold time", holds=holds)
 
 
 # --------------------------------------------------------------------------- solve
@@ -320,8 +312,13 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
           initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
-          progress: ProgressFn | None = None) -> OptimalSolution:
+          progress: ProgressFn | None = None, holds: Holds | None = None) -> OptimalSolution:
     """Minimum-time motion along ``path`` with a certified lower and a verified upper bound.
+
+    The imposed holds (dwell, exact-stop settle) are no planning decision: the motion is
+    optimised without them and they are inserted at their breaks afterwards
+    (:func:`reference.core.holds.with_holds`, as the heuristic does), so both bounds and
+    the profile contain exactly ``holds.total_s`` of waiting.
 
     Constraints (bound set ``"acc"``): programmed feed per segment (path speed of the
     geometry axes; none for G0, where only the axes' limits apply), axis velocity, axis
@@ -352,6 +349,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         Target size of the initial grid.
     progress : callable, optional
         Called as ``progress(stage_message, fraction_done)`` during refinement.
+    holds : Holds, optional
+        The imposed holds (:func:`reference.holds.imposed_holds`, the same the heuristic
+        was given). Default: the dwells of ``path.blocks`` only (no machine data here to
+        compute exact-stop settle times).
 
     Returns
     -------
@@ -382,13 +383,15 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
     solve_fn = get_backend(backend)
+    if holds is None:
+        holds = dwell_holds(path)
     lim = limits.for_axes(path.axes)
     if path.n_segments == 0:
         if progress:
             progress("no motion", 1.0)
-        return _empty_solution(path, limits, t_start, backend)
+        return _empty_solution(path, limits, t_start, backend, holds)
     check_feed(path)
-    dwell = float(sum(b.dwell_s for b in path.blocks))
+    hold_t = holds.total_s          # every hold: a constant added to every motion's time
 
     grid = initial_grid(path, min(initial_intervals, max_grid))
     t_build = t_solve = t_check = t_bound = 0.0
@@ -427,8 +430,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         prev_lb = (grid, b_hat, rel.b_bar)
         t_bound += time.perf_counter() - te
         t_prim = interval_times(grid.s, res.b)
-        t_grid = float(t_prim.sum()) + dwell
-        best_lb = max(best_lb, lb + dwell)
+        t_grid = float(t_prim.sum()) + hold_t
+        best_lb = max(best_lb, lb + hold_t)
         budget = min(max_grid - grid.n_intervals, grid.n_intervals)
         last = budget <= 0 or it == max_iterations
         disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
@@ -439,7 +442,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             if new_grid is grid:
                 last, new_grid = True, None
         if new_grid is not None:
-            history.append(IterationRecord(grid.n_points, lb + dwell, math.inf, t_grid, 1.0))
+            history.append(IterationRecord(grid.n_points, lb + hold_t, math.inf, t_grid, 1.0))
             gap = max(disc_gap, (best[0] - best_lb) / best_lb if best else disc_gap)
             frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
             grid = new_grid
@@ -449,10 +452,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         td = time.perf_counter()
         prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds)
         t_check += time.perf_counter() - td
-        ub = prof.duration + dwell
+        ub = prof.duration + hold_t
         if best is None or ub < best[0]:
             best = (ub, grid, problem, res, prof, lam, report, t_prim)
-        history.append(IterationRecord(grid.n_points, lb + dwell, ub, t_grid, lam))
+        history.append(IterationRecord(grid.n_points, lb + hold_t, ub, t_grid, lam))
         gap = (best[0] - best_lb) / best_lb if best_lb > 0 else math.inf
         frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
         if gap <= tol:
@@ -474,10 +477,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
             blocks=(), grid=grid.s, active=(), grid_points=grid.n_points, iterations=it,
             backend=backend, build_time_s=t_build, solve_time_s=t_solve,
-            check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total, dwell_s=dwell,
-            history=tuple(history), message=msg)
+            check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total,
+            dwell_s=_dwell_part(holds), history=tuple(history), message=msg, holds=holds)
     ub, g, problem, res, prof, lam, report, t_prim = best
-    prof_h = _with_holds(prof, path)
+    prof_h = with_holds(prof, path, holds)
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
     labels = active_labels(problem, res.b)
@@ -494,12 +497,12 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         progress("done", 1.0)
     return OptimalSolution(
         status=status, profile=prof_h, lower_bound_s=best_lb, upper_bound_s=ub,
-        objective_s=float(t_prim.sum()) + dwell, gap=gap, time_scale=lam,
+        objective_s=float(t_prim.sum()) + hold_t, gap=gap, time_scale=lam,
         segment_times_s=seg_t, block_times_s=blk_t, blocks=rows, grid=g.s, active=labels,
         grid_points=g.n_points, iterations=it, backend=res.backend, build_time_s=t_build,
         solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
-        total_time_s=time.perf_counter() - t_start, dwell_s=dwell, report=report,
-        history=tuple(history), message=message)
+        total_time_s=time.perf_counter() - t_start, dwell_s=_dwell_part(holds),
+        report=report, history=tuple(history), message=message, holds=holds)
 
 
 def _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps) -> float:

@@ -13,17 +13,22 @@ spelled exactly as listed; stages store them as small integer codes into :data:`
 ``look-ahead horizon``  v = 0 assumed at the end of the LookAhead horizon
 ``IPO-cycle cap``       every block needs at least one IPO cycle (v <= L / T_ipo)
 ``exact stop``          G60 / G9 (NGC G61, G61.1): rest at the block end
-``forced stop``         any other rest: program start and end, M0/M1/M2/M30, dwell, aux
+``forced stop``         any other rest: program start and end, M0/M1/M2/M30, aux
                         functions without motion, BRISK <-> SOFT change
+``dwell``               a G4 block: its whole time is the programmed wait (a hold)
+``exact stop settle``   the exact-stop window wait (G601/G602) at a block end (a hold)
+
+The last two are holds (:mod:`reference.holds`): imposed by the program or the machine,
+the same on every side, never a planning gap.
 """
 
 from __future__ import annotations
 
 CAUSES: tuple[str, ...] = ("feed", "axis velocity", "axis acceleration", "jerk", "frequency",
                            "corner rule", "look-ahead horizon", "IPO-cycle cap",
-                           "exact stop", "forced stop")
+                           "exact stop", "forced stop", "dwell", "exact stop settle")
 (FEED, AXIS_VELOCITY, AXIS_ACCELERATION, JERK, FREQUENCY, CORNER_RULE, HORIZON, IPO_CAP,
- EXACT_STOP, FORCED_STOP) = range(len(CAUSES))
+ EXACT_STOP, FORCED_STOP, DWELL, EXACT_STOP_SETTLE) = range(len(CAUSES))
 
 
 def cause_name(code: int) -> str:

@@ -147,7 +147,7 @@ def test_oracle_labels_map_to_the_shared_vocabulary():
     assert normalise_cause("velocity_jump") == "corner rule"
     assert normalise_cause("feed") == "feed"
     assert normalise_cause("stop", span) == "exact stop"
-    assert normalise_cause("dwell G4 0.2 s", idle) == "forced stop"
+    assert normalise_cause("dwell G4 0.2 s", idle) == "dwell"
     assert normalise_cause("") == "-"
     assert normalise_cause("look-ahead horizon") == "look-ahead horizon"
 
