@@ -371,7 +371,7 @@ class Verdict:
     def of(cls, c: Comparison, max_gap: float | None) -> "Verdict":
         """Decide the verdict of a comparison.
 
-        The gate compares the *upper* end ``t_ref/LB - 1`` with ``max_gap``: a program
+        The gate compares the *upper* end ``(t_ref - H)/(LB - H) - 1`` with ``max_gap``: a program
         passes only when its gap is certified to be at most ``max_gap``.
         """
         who = "the recorded trajectory" if c.reference_name == "recorded" else "the heuristic"
@@ -646,9 +646,10 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         all_notes.append(
             f"The planner keeps {', '.join(extra)} limits that the {oracle.bounds!r} oracle "
             f"does not model, so the oracle solves a relaxation: its lower bound still bounds "
-            f"the planner's true optimum from below (t_ref/LB - 1 is a valid upper end of "
-            f"the gap), but its upper bound is a motion the planner may not make, so "
-            f"t_ref/UB - 1 is not a lower end of the gap (the true gap is at least 0).")
+            f"the planner's true optimum from below (the gap's upper end, with LB, is "
+            f"valid), but its upper bound is a motion the planner may not make, so "
+            f"the lower end, with UB, is not a lower end of the gap (the true gap is at "
+            f"least 0).")
     if oracle.status not in ("optimal",):
         all_notes.append(f"Oracle status: {oracle.status}.")
     if any(r.note for r in rows):
