@@ -197,6 +197,8 @@ def test_dwell_is_a_hold_of_its_block():
     assert p.blocks[2].time_s == pytest.approx(0.5, rel=1e-12)
     assert p.blocks[2].cause == "dwell"
     assert p.corners[0].v == 0.0
+    row = to_json_dict(p)["blocks"][2]
+    assert row["hold_s"] == 0.5 and row["hold_cause"] == "dwell"
 
 
 # ----------------------------------------------------------------- IPO-cycle cap
@@ -403,7 +405,7 @@ def test_to_json_dict_follows_the_contract():
     assert d["reference"]["violations"] == []
     row = d["blocks"][1]
     assert set(row) == {"block", "line", "label", "kind", "length_mm", "t_reference_s",
-                        "v_exit_reference", "limit_reference"}
+                        "v_exit_reference", "limit_reference", "hold_s", "hold_cause"}
     json.dumps(d)                                        # JSON-ready
     if SCHEMA.is_file():
         jsonschema = pytest.importorskip("jsonschema")
