@@ -650,6 +650,12 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
             f"valid), but its upper bound is a motion the planner may not make, so "
             f"the lower end, with UB, is not a lower end of the gap (the true gap is at "
             f"least 0).")
+    if H > 0 and reference.name != "reference":
+        all_notes.append(
+            f"The oracle waits the imposed holds the machine data give, H = {H:.4f} s "
+            f"(dwell, exact-stop settle); the {reference.name} motion's own waits are "
+            f"compared with them: waiting longer shows as a gap, waiting less (e.g. a "
+            f"feed-forward the machine data do not state) as a negative one.")
     if oracle.status not in ("optimal",):
         all_notes.append(f"Oracle status: {oracle.status}.")
     if any(r.note for r in rows):
