@@ -99,6 +99,13 @@ class Holds:
             return ""
         return self.cause[int(sel[np.argmax(self.duration_s[sel])])]
 
+    def subset(self, keep: np.ndarray) -> "Holds":
+        """The holds where ``keep`` (bool, shape ``(h,)``) is True, in the same order."""
+        keep = np.asarray(keep, dtype=bool)
+        return Holds(break_index=self.break_index[keep], block=self.block[keep],
+                     duration_s=self.duration_s[keep],
+                     cause=tuple(c for c, k in zip(self.cause, keep) if k))
+
     def same_as(self, other: "Holds") -> bool:
         """True when both list the same holds (breaks, blocks, causes, bitwise times)."""
         return (self.cause == other.cause

@@ -27,12 +27,12 @@ import numpy as np
 
 from ..core.constraints import BOUND_SETS, ConstraintReport, check_profile
 from ..core.geometry import Path
-from ..core.holds import Holds, with_holds
+from ..core.holds import EXACT_STOP_SETTLE, Holds, with_holds
 from ..core.limits import MachineLimits
 from ..core.profile import Profile
+from ..holds import imposed_holds
 from ..machine import Machine
 from ..nc.program import Program
-from ..holds import imposed_holds
 from ..prepare import prepare, restrict_to_machine
 from . import causes as C
 from .adaptation import adaptation_factors, adapted_units
@@ -390,7 +390,7 @@ def plan(program: Program, machine: Machine, *, parameters: PlannerParameters | 
 
     report_progress("settle", 0.8)
     holds = imposed_holds(program, path, machine)
-    n_settle = sum(1 for c in holds.cause if c == "exact stop settle")
+    n_settle = sum(1 for c in holds.cause if c == EXACT_STOP_SETTLE)
     n_dwell = holds.n - n_settle
     trace.append(("settle", f"{int(np.sum(modes.exact_stop_block >= 0))} exact stops; "
                             f"{n_settle} settle and {n_dwell} dwell holds, "

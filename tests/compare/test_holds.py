@@ -235,3 +235,33 @@ def test_holds_reject_bad_entries():
         Holds(break_index=[0], block=[0], duration_s=[0.0], cause=(DWELL,))
     with pytest.raises(ValueError, match="non-decreasing"):
         Holds(break_index=[2, 1], block=[0, 1], duration_s=[1.0, 1.0], cause=(DWELL, DWELL))
+
+
+def test_hold_causes_are_in_every_cause_vocabulary():
+    from compare.causes import CAUSES as COMPARE_CAUSES
+    from reference.core.holds import HOLD_CAUSES
+    from reference.planner.causes import CAUSES as PLANNER_CAUSES
+    assert HOLD_CAUSES == ("dwell", "exact stop settle")
+    assert set(HOLD_CAUSES) <= set(PLANNER_CAUSES) and set(HOLD_CAUSES) <= set(COMPARE_CAUSES)
+
+
+def test_recorded_heuristic_with_a_final_settle_and_dwells_reads_back_without_gap(tmp_path):
+    """A recording cannot show the waits after its last motion (it is trimmed there):
+    the imposed holds at the path ends are put back, interior waits are measured."""
+    from compare.export import profile_samples, write_samples_csv
+    from compare.recorded import check_recorded
+    text = "G4 F0.2\nG90 BRISK G64 F6000\nG1 X100 G9\nG4 F0.3\nG1 X200 G9 G601\nG4 F0.1\nM30\n"
+    m = machine()
+    program = parse_text(text, "t.mpf")
+    p = plan(program, m)
+    header, data = profile_samples(p.path, p.profile, m.limits.t_ipo_s)
+    write_samples_csv(header, data, tmp_path / "ipo.csv")
+    res = check_recorded(tmp_path / "ipo.csv", program, m)
+    c = res.comparison
+    t_settle = settle(100.0 / KV, FINE)
+    assert c.hold_s == pytest.approx(0.2 + 0.3 + 0.1 + 2 * t_settle, rel=1e-12)
+    assert c.t_reference_s == pytest.approx(p.time_s, abs=2 * m.limits.t_ipo_s)
+    assert abs(c.gap_lower) < 0.01 and abs(c.gap_upper) < 0.01
+    by_line = {r.line: r for r in c.rows}
+    assert by_line[5].hold_cause == "exact stop settle"
+    assert [by_line[k].limit_reference for k in (1, 4, 6)] == ["dwell"] * 3
