@@ -970,9 +970,10 @@ def check_recorded(file: str | FsPath, program, machine, *, bounds: str | None =
     from reference.holds import imposed_holds
     if path_kind == "reference":
         plan = engines.run_heuristic(program, machine, progress=_pre(progress, "path: "))
-        path, holds = plan.path, plan.holds
+        path, holds = plan.path, getattr(plan, "holds", None)
     else:
-        path = restrict_to_machine(prepare(program), limits)
+        path, holds = restrict_to_machine(prepare(program), limits), None
+    if holds is None:
         holds = imposed_holds(program, path, machine)
     rec = read_trajectory(file, path.axes, tuple(bool(r) for r in path.rotary))
     if progress is not None:
