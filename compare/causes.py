@@ -79,6 +79,7 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
     tight = {c: np.zeros(n_blocks) for c in names}
     braking = np.zeros(n_blocks)
     time = np.bincount(blk, weights=h, minlength=n_blocks)
+    moving_time = np.bincount(blk[moving], weights=h[moving], minlength=n_blocks)
     for lo in range(0, moving.size, _CHUNK):
         k = moving[lo:lo + _CHUNK]
         tau = h[k][:, None] * _TAU[None, :]
@@ -117,6 +118,11 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
             continue
         if span.s_end <= span.s_start:          # a hold: dwell or stop without motion
             out[i] = stop_cause(span.stop_reason) if span.stop_reason else "-"
+            continue
+        # shares of the *motion* time: a wait at rest (exact-stop settle) limits nothing
+        T = float(moving_time[i])
+        if T <= 0:
+            out[i] = "-"
             continue
         shares = {c: tight[c][i] / T for c in names}
         best = max(shares, key=shares.get)

@@ -6,8 +6,9 @@ violation, or an oracle without certified bounds (nothing certifies the program 
 
 ``--max-gap`` takes percent: ``15%`` and ``15`` both mean 15 %; ``0.5`` means 0.5 %
 (not 50 %). The gate compares the *upper* end of the gap interval,
-``t_ref/LB - 1``, with it, so a program passes only when its gap is certified to be
-within the gate.
+``(t_ref - H)/(LB - H) - 1`` (``H``: the imposed holds, dwell and exact-stop settle, in
+both totals and in no gap), with it, so a program passes only when its gap is certified
+to be within the gate.
 """
 
 from __future__ import annotations
@@ -102,7 +103,8 @@ def register(sub: argparse._SubParsersAction, common: Callable) -> None:
     sp.add_argument("--max-gap", metavar="PCT", type=parse_max_gap, default=None,
                     help="fail (exit 1) when the gap may exceed PCT percent: '15%%' or "
                          "'15' mean 15 %%, '0.5' means 0.5 %%; compared with the upper "
-                         "end t_ref/LB - 1 of the certified gap interval")
+                         "end (t_ref-H)/(LB-H) - 1 of the certified gap interval (H: "
+                         "dwell and exact-stop settle, not counted)")
     common(sp)
     sp.set_defaults(func=cmd_compare)
 

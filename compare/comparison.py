@@ -4,17 +4,31 @@
 oracle's :class:`~optimal.OptimalSolution`; :func:`compare_profiles` takes any profile
 (a recorded trajectory, another planner) in place of the heuristic's.
 
+Holds are not gaps
+    Dwell (G4) and the exact-stop settle (G601/G602) are waits the program and the
+    machine impose; no velocity profile avoids or shortens them. One function computes
+    them (:func:`reference.holds.imposed_holds`) and both the heuristic's and the
+    oracle's profiles contain them, identical, at the same breaks. ``H`` is their total
+    (``Comparison.hold_s``); every time below that is called *motion time* is a total or
+    block time minus its holds. The gap measures velocity planning only: it compares
+    motion times.
 Per program
-    both total times, the oracle's certified bounds ``LB <= T* <= UB`` and the gap
-    interval ``[t_ref/UB - 1, t_ref/LB - 1]`` (fractions, 0.12 = 12 %), which holds the
-    true gap ``t_ref/T* - 1``; every violation :func:`check_profile` finds in either
-    profile under the bound set that side declares.
+    both total times (holds included), the oracle's certified bounds ``LB <= T* <= UB``
+    (holds included) and the gap interval
+    ``[(t_ref - H)/(UB - H) - 1, (t_ref - H)/(LB - H) - 1]`` (fractions, 0.12 = 12 %),
+    which holds the true gap of the motion ``(t_ref - H)/(T* - H) - 1``; every violation
+    :func:`check_profile` finds in either profile under the bound set that side
+    declares. A program whose optimal motion time is 0 (only holds) has gap 0 when the
+    planner adds no motion time either.
 Per NC block (one :class:`BlockRow` per :class:`~reference.core.geometry.BlockSpan`,
 inserted blocks on their own rows, attributed to the corner they replace)
-    length, time on each side, entry/exit/peak speeds, the gap ``t_ref_b - t_opt_b`` and
-    the limiting cause on each side. ``t_opt_b`` is the time the oracle's *verified*
-    profile (duration ``UB``) spends in the block, so the block gaps sum to
-    ``t_ref - UB``.
+    length, time on each side (holds included), the block's hold and its cause
+    (``dwell``, ``exact stop settle``), entry/exit/peak speeds, the gap
+    ``(t_ref_b - hold_b) - (t_opt_b - hold_b)`` and the limiting cause of the motion on
+    each side (a block that only waits, a dwell block, shows its hold's cause on both
+    sides). ``t_opt_b`` is the time the oracle's *verified* profile (duration ``UB``)
+    spends in the block, so the block gaps sum to ``t_ref - UB``. A recorded trajectory
+    carries its measured waits: what it waits beyond the imposed hold is a gap.
 
 Why a block gap can be negative: the oracle minimises the total time, not each block.
 Under acceleration bounds alone the exact optimum is at least as fast as any feasible
@@ -36,6 +50,7 @@ import numpy as np
 from reference.core.causes import normalise_cause
 from reference.core.constraints import BOUND_SETS, ConstraintReport, ConstraintResult, check_profile
 from reference.core.geometry import BlockSpan, Path
+from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.tolerances import RATIO_TOL
@@ -101,6 +116,8 @@ class OracleResult:
         Grid size.
     causes : Mapping[int, str] or None
         Active constraint per block as the oracle reports it.
+    holds : Holds
+        The imposed holds contained in ``profile`` and in both bounds.
     """
 
     status: str
@@ -111,6 +128,7 @@ class OracleResult:
     solve_time_s: float = 0.0
     grid_points: int = 0
     causes: Mapping[int, str] | None = None
+    holds: Holds = NO_HOLDS
 
 
 @dataclass(frozen=True, slots=True)
@@ -136,7 +154,7 @@ class BlockRow:
     s_start, length_mm : float
         Path position of the block start and its length, mm.
     t_reference_s, t_oracle_s : float
-        Time spent in the block, s.
+        Time spent in the block, s (its hold included).
     v_entry_reference, v_exit_reference, v_peak_reference : float
         Path speeds, mm/s.
     v_entry_oracle, v_exit_oracle, v_peak_oracle : float
@@ -149,6 +167,11 @@ class BlockRow:
         Why the motion rests at the block end (``""`` if it need not).
     note : str
         Explanation of a negative or unresolved gap, ``""`` otherwise.
+    hold_s : float
+        The block's imposed hold (dwell, exact-stop settle), s: part of both block
+        times, not of the gap.
+    hold_cause : str
+        ``"dwell"``, ``"exact stop settle"`` or ``""`` (no hold).
     """
 
     block: int
@@ -173,6 +196,8 @@ class BlockRow:
     ratio_oracle: float
     stop_reason: str = ""
     note: str = ""
+    hold_s: float = 0.0
+    hold_cause: str = ""
 
     @property
     def inserted(self) -> bool:
@@ -181,13 +206,16 @@ class BlockRow:
 
     @property
     def gap_s(self) -> float:
-        """``t_reference_s - t_oracle_s``, s (may be negative, see the module docstring)."""
-        return self.t_reference_s - self.t_oracle_s
+        """Motion-time gap ``(t_reference_s - hold_s) - (t_oracle_s - hold_s)``, s (may be
+        negative, see the module docstring); the hold never counts."""
+        return (self.t_reference_s - self.hold_s) - (self.t_oracle_s - self.hold_s)
 
     @property
     def gap_rel(self) -> float:
-        """Block gap relative to the oracle's block time (``nan`` for a zero time)."""
-        return self.gap_s / self.t_oracle_s if self.t_oracle_s > 0 else math.nan
+        """Block gap relative to the oracle's motion time in the block (``nan`` when the
+        oracle does not move there, e.g. a dwell block)."""
+        motion = self.t_oracle_s - self.hold_s
+        return self.gap_s / motion if motion > GAP_ABS_TOL_S else math.nan
 
 
 @dataclass(frozen=True, slots=True)
@@ -263,16 +291,23 @@ class Comparison:
             and self.oracle.status in ("optimal", "gap_not_met")
 
     @property
+    def hold_s(self) -> float:
+        """``H``: the imposed holds (dwell, exact-stop settle) in both totals, s."""
+        return self.oracle.holds.total_s
+
+    @property
     def gap_lower(self) -> float:
-        """``t_ref / UB - 1``: the true gap is at least this (see :attr:`gap_lower_valid`)."""
-        ub = self.oracle.upper_bound_s
-        return self.t_reference_s / ub - 1.0 if ub > 0 else math.nan
+        """``(t_ref - H)/(UB - H) - 1``: the true gap is at least this (see
+        :attr:`gap_lower_valid`); motion times, the holds ``H`` excluded."""
+        return _motion_ratio(self.t_reference_s, self.oracle.upper_bound_s, self.hold_s,
+                             math.nan)
 
     @property
     def gap_upper(self) -> float:
-        """``t_ref / LB - 1``: the true gap is at most this (``inf`` for LB = 0)."""
-        lb = self.oracle.lower_bound_s
-        return self.t_reference_s / lb - 1.0 if lb > 0 else math.inf
+        """``(t_ref - H)/(LB - H) - 1``: the true gap is at most this (``inf`` when the
+        lower bound has no motion time but the planner has)."""
+        return _motion_ratio(self.t_reference_s, self.oracle.lower_bound_s, self.hold_s,
+                             math.inf)
 
     @property
     def gap_lower_valid(self) -> bool:
@@ -337,7 +372,7 @@ class Verdict:
     def of(cls, c: Comparison, max_gap: float | None) -> "Verdict":
         """Decide the verdict of a comparison.
 
-        The gate compares the *upper* end ``t_ref/LB - 1`` with ``max_gap``: a program
+        The gate compares the *upper* end ``(t_ref - H)/(LB - H) - 1`` with ``max_gap``: a program
         passes only when its gap is certified to be at most ``max_gap``.
         """
         who = "the recorded trajectory" if c.reference_name == "recorded" else "the heuristic"
@@ -373,6 +408,18 @@ class Verdict:
 
 
 # ---------------------------------------------------------------------- helpers
+def _motion_ratio(t_ref: float, t_opt: float, hold: float, undefined: float) -> float:
+    """``(t_ref - hold)/(t_opt - hold) - 1``; 0 when neither side has motion time,
+    ``undefined`` when only the planner has."""
+    if not t_opt > 0:
+        return undefined
+    m_ref = t_ref - hold
+    m_opt = t_opt - hold
+    if m_opt <= GAP_ABS_TOL_S:
+        return 0.0 if m_ref <= GAP_ABS_TOL_S else undefined
+    return m_ref / m_opt - 1.0
+
+
 def format_interval(c: Comparison) -> str:
     """The gap interval in percent, e.g. ``"12.1 – 12.4 %"``."""
     lo, hi = c.gap_lower, c.gap_upper
@@ -561,7 +608,11 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     r_opt = _row_ratios(opt_report, BOUND_SETS.get(oracle.bounds, ()), idx) \
         if opt_report is not None else np.full(len(spans), math.nan)
     lb, ub = oracle.lower_bound_s, oracle.upper_bound_s
-    rel_band = (ub / lb - 1.0) if (lb > 0 and math.isfinite(ub)) else math.inf
+    n_blocks = int(idx.max()) + 1 if idx.size else 0
+    hold_blk = oracle.holds.per_block(n_blocks)[idx] if idx.size else np.zeros(0)
+    H = oracle.holds.total_s
+    # the oracle's resolution on motion times (holds are exact on both sides)
+    rel_band = ((ub - H) / (lb - H) - 1.0) if (lb - H > 0 and math.isfinite(ub)) else math.inf
     corners = _corners(path)
     lines = program_lines
     rows = []
@@ -569,10 +620,16 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         corner = corners.get(i)
         line = corner[0] if corner else sp.line
         source = "" if corner or not (0 < sp.line <= len(lines)) else lines[sp.line - 1]
-        gap = float(t_ref[i] - t_opt[i])
+        hold = float(hold_blk[i])
+        hold_cause = oracle.holds.cause_of(sp.block) if hold > 0 else ""
+        gap = float((t_ref[i] - hold) - (t_opt[i] - hold))
         note = "" if math.isnan(gap) else _gap_note(
-            gap, float(t_opt[i]), rel_band, oracle.bounds, float(ve_r[i]), float(vx_r[i]),
-            float(ve_o[i]), float(vx_o[i]), breaks)
+            gap, float(t_opt[i] - hold), rel_band, oracle.bounds, float(ve_r[i]),
+            float(vx_r[i]), float(ve_o[i]), float(vx_o[i]), breaks)
+        lim_r, lim_o = c_ref.get(sp.block, "-"), c_opt.get(sp.block, "-")
+        if hold_cause and sp.n_segments == 0:
+            # a block that only waits: its time is the hold on every side
+            lim_r = lim_o = hold_cause
         rows.append(BlockRow(
             block=sp.block, line=max(1, line), label=sp.label, kind=sp.kind,
             source=source.strip(), corner=corner, s_start=sp.s_start,
@@ -580,9 +637,9 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
             v_entry_reference=float(ve_r[i]), v_exit_reference=float(vx_r[i]),
             v_peak_reference=float(vp_r[i]), v_entry_oracle=float(ve_o[i]),
             v_exit_oracle=float(vx_o[i]), v_peak_oracle=float(vp_o[i]),
-            limit_reference=c_ref.get(sp.block, "-"), limit_oracle=c_opt.get(sp.block, "-"),
+            limit_reference=lim_r, limit_oracle=lim_o,
             ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
-            stop_reason=sp.stop_reason, note=note))
+            stop_reason=sp.stop_reason, note=note, hold_s=hold, hold_cause=hold_cause))
 
     all_notes = list(notes)
     if not set(BOUND_SETS[reference.bound_set]) <= set(BOUND_SETS.get(oracle.bounds, ())):
@@ -590,9 +647,16 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         all_notes.append(
             f"The planner keeps {', '.join(extra)} limits that the {oracle.bounds!r} oracle "
             f"does not model, so the oracle solves a relaxation: its lower bound still bounds "
-            f"the planner's true optimum from below (t_ref/LB - 1 is a valid upper end of "
-            f"the gap), but its upper bound is a motion the planner may not make, so "
-            f"t_ref/UB - 1 is not a lower end of the gap (the true gap is at least 0).")
+            f"the planner's true optimum from below (the gap's upper end, with LB, is "
+            f"valid), but its upper bound is a motion the planner may not make, so "
+            f"the lower end, with UB, is not a lower end of the gap (the true gap is at "
+            f"least 0).")
+    if H > 0 and reference.name != "reference":
+        all_notes.append(
+            f"The oracle waits the imposed holds the machine data give, H = {H:.4f} s "
+            f"(dwell, exact-stop settle); the {reference.name} motion's own waits are "
+            f"compared with them: waiting longer shows as a gap, waiting less (e.g. a "
+            f"feed-forward the machine data do not state) as a negative one.")
     if oracle.status not in ("optimal",):
         all_notes.append(f"Oracle status: {oracle.status}.")
     if any(r.note for r in rows):
@@ -625,7 +689,8 @@ def oracle_result(solution, bounds: str = "acc") -> OracleResult:
                         lower_bound_s=float(solution.lower_bound_s),
                         upper_bound_s=float(solution.upper_bound_s), bounds=bounds,
                         solve_time_s=float(total if total is not None else solution.solve_time_s),
-                        grid_points=int(solution.grid_points), causes=causes or None)
+                        grid_points=int(solution.grid_points), causes=causes or None,
+                        holds=getattr(solution, "holds", NO_HOLDS))
 
 
 def reference_side(plan) -> Side:
@@ -671,6 +736,11 @@ def compare(plan, solution, *, limits: MachineLimits | None = None, program=None
                                                           "limits", None)
     if limits is None:
         raise ValueError("compare() needs the machine limits: pass limits=machine.limits")
+    plan_holds = getattr(plan, "holds", None)
+    sol_holds = getattr(solution, "holds", NO_HOLDS)
+    if plan_holds is not None and not plan_holds.same_as(sol_holds):
+        raise ValueError("compare(): the oracle was solved with other holds than the plan's; "
+                         "pass holds=plan.holds to optimal.solve")
     lines = tuple(getattr(program, "lines", ()) or ())
     name = getattr(program, "file", "") if program is not None else ""
     return compare_profiles(plan.path, limits, reference_side(plan), oracle_result(solution),

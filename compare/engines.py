@@ -64,12 +64,15 @@ def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | Non
 
 
 def run_oracle(path: Path, limits: MachineLimits, bounds: str,
-               progress: ProgressFn | None = None, *, tol: float | None = None):
-    """``optimal.solve`` on ``path`` under ``bounds`` (``tol``: requested relative gap
-    between its bounds; ``None`` for the oracle's default)."""
+               progress: ProgressFn | None = None, *, tol: float | None = None,
+               holds=None):
+    """``optimal.solve`` on ``path`` under ``bounds`` with the imposed ``holds``
+    (``reference.holds.imposed_holds``, the heuristic's ``plan.holds``); ``tol``: the
+    requested relative gap between its bounds (``None`` for the oracle's default)."""
     import optimal
     options = {} if tol is None else {"tol": tol}
-    return optimal.solve(path, limits, bounds=bounds, progress=progress, **options)
+    return optimal.solve(path, limits, bounds=bounds, progress=progress, holds=holds,
+                         **options)
 
 
 def oracle_json(solution) -> dict:

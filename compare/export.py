@@ -33,7 +33,7 @@ __all__ = ["CSV_COLUMNS", "JSON_INF", "blocks_csv", "comparison_dict", "dumps", 
 
 #: Block-row columns of the CSV report, in order.
 CSV_COLUMNS = ("block", "line", "label", "kind", "corner", "length_mm", "t_reference_s",
-               "t_oracle_s", "gap_s", "gap_rel", "v_entry_reference", "v_exit_reference",
+               "t_oracle_s", "hold_s", "hold_cause", "gap_s", "gap_rel", "v_entry_reference", "v_exit_reference",
                "v_peak_reference", "v_entry_oracle", "v_exit_oracle", "v_peak_oracle",
                "limit_reference", "limit_oracle", "ratio_reference", "ratio_oracle",
                "stop_reason", "note", "source")
@@ -59,7 +59,8 @@ def violation_dict(v: ConstraintResult, path: Path | None = None) -> dict:
 def _row_dict(r: BlockRow) -> dict:
     d = {"block": r.block, "line": r.line, "label": r.label, "kind": r.kind,
          "length_mm": r.length_mm, "t_reference_s": r.t_reference_s,
-         "t_oracle_s": r.t_oracle_s, "gap_s": r.gap_s,
+         "t_oracle_s": r.t_oracle_s, "hold_s": r.hold_s, "hold_cause": r.hold_cause,
+         "gap_s": r.gap_s,
          "v_entry_reference": r.v_entry_reference, "v_exit_reference": r.v_exit_reference,
          "v_peak_reference": r.v_peak_reference, "v_entry_oracle": r.v_entry_oracle,
          "v_exit_oracle": r.v_exit_oracle, "v_peak_oracle": r.v_peak_oracle,
@@ -101,7 +102,7 @@ def comparison_dict(c: Comparison, max_gap: float | None = None) -> dict:
                    "time_s": c.t_oracle_s,
                    "violations": [violation_dict(v, c.path) for v in c.oracle_violations]},
         "gap": {"lower": c.gap_lower, "upper": c.gap_upper,
-                "lower_valid": c.gap_lower_valid},
+                "lower_valid": c.gap_lower_valid, "hold_s": c.hold_s},
         "verdict": {"ok": verdict.ok, "status": verdict.status, "text": verdict.text,
                     "max_gap": max_gap},
         "notes": list(c.notes),

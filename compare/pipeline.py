@@ -26,6 +26,7 @@ from reference.core.limits import MachineLimits
 from reference.machine import Machine, load_machine
 from reference.nc import parse_file
 from reference.nc.program import Program, ProgramWarning
+from reference.holds import imposed_holds
 from reference.prepare import build_path, unmodelled_features
 
 from . import engines
@@ -208,8 +209,11 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     bounds, _ = engines.resolve_bounds(bounds, None)
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
+    # the waits the program and machine impose (dwell, exact-stop settle): the same the
+    # heuristic would contain, computed without it
+    holds = imposed_holds(inp.program, path, inp.machine)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol)
+                             progress=_prefixed(progress, "oracle: "), tol=tol, holds=holds)
     return OptimizeResult(program=inp.program.file, machine=inp.machine.name, bounds=bounds,
                           path=path, limits=inp.machine.limits, solution=sol)
 
@@ -250,7 +254,8 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
                                  progress=_prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol)
+                             progress=_prefixed(progress, "oracle: "), tol=tol,
+                             holds=plan.holds)
     c = compare(plan, sol, limits=inp.machine.limits, program=inp.program,
                 machine=inp.machine.name)
     if notes:

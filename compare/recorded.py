@@ -33,8 +33,10 @@ the oracle works block by block, exactly as for the heuristic:
    Positions between these anchors are scaled (by a factor within ``1 +- 1e-3`` for a
    good recording) so every anchor sits exactly where it belongs. Rest before the first
    and after the last motion is trimmed: time counts from leaving the start point to
-   arriving at the end point; rest at a block end is split between the dwell blocks
-   there (their programmed time) and the block that moved there (the rest).
+   arriving at the end point, and the holds the program imposes there (dwell, the last
+   block's exact-stop settle) are put back as :func:`reference.holds.imposed_holds`
+   gives them, as the oracle has them; rest at a block end is split between the dwell
+   blocks there (their programmed time) and the block that moved there (the rest).
 5. **Judge** (:func:`check_recorded`): ``check_profile`` on the reconstructed profile
    with a measurement tolerance (:func:`measurement_tolerance`: 1 %, more for noisy
    recordings), the deviation against ``--max-deviation``, and the comparison with the
@@ -60,6 +62,7 @@ from scipy.linalg import solveh_banded
 from reference.core.constraints import BOUND_SETS
 from reference.core.errors import TrajectoryError
 from reference.core.geometry import Path
+from reference.core.holds import with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.tolerances import POS_TOL_MM
@@ -964,16 +967,25 @@ def check_recorded(file: str | FsPath, program, machine, *, bounds: str | None =
     from . import engines
     from reference.prepare import build_path, prepare, restrict_to_machine
     limits = machine.limits
+    from reference.holds import imposed_holds
     if path_kind == "reference":
-        path = build_path(program, machine)
+        path, holds = build_path(program, machine), None
     else:
-        path = restrict_to_machine(prepare(program), limits)
+        path, holds = restrict_to_machine(prepare(program), limits), None
+    if holds is None:
+        holds = imposed_holds(program, path, machine)
     rec = read_trajectory(file, path.axes, tuple(bool(r) for r in path.rotary))
     if progress is not None:
         progress("projecting the recording", -1.0)
     prof, proj, sigma, info = recorded_profile(path, limits, rec, smoothing)
+    # rest before the first and after the last motion is trimmed from the recording, so
+    # the holds the program imposes there (a dwell before any motion, the settle of the
+    # last block, dwells at the end) cannot be measured: they are put back as imposed
+    at_ends = (holds.break_index == 0) | (holds.break_index == path.n_segments)
+    prof = with_holds(prof, path, holds.subset(at_ends))
     bound_set = bounds or "acc"
-    sol = engines.run_oracle(path, limits, "acc", progress=_pre(progress, "oracle: "))
+    sol = engines.run_oracle(path, limits, "acc", progress=_pre(progress, "oracle: "),
+                             holds=holds)
     i = proj.worst
     tol = measurement_tolerance(path, limits, rec.t, sigma, info["scale"])
     notes = [f"Recorded trajectory {rec.file} ({rec.t.size} samples): judged on the "

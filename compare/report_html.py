@@ -382,7 +382,8 @@ def _info_ratios(c: Comparison) -> str:
 def _table(c: Comparison) -> str:
     worst = {r.block for r in c.worst_blocks(N_WORST)}
     head = ("<thead><tr><th class='t'>line</th><th class='t'>label</th><th class='t'>kind</th>"
-            "<th>length mm</th><th>t ref s</th><th>t opt s</th><th>gap ms</th><th>gap %</th>"
+            "<th>length mm</th><th>t ref s</th><th>t opt s</th><th>hold s</th>"
+            "<th class='t'>hold</th><th>gap ms</th><th>gap %</th>"
             "<th>v in ref</th><th>v out ref</th><th>v peak ref</th>"
             "<th>v in opt</th><th>v out opt</th><th>v peak opt</th>"
             "<th class='t'>limit ref</th><th class='t'>limit opt</th><th>ratio ref</th>"
@@ -416,6 +417,7 @@ def _table(c: Comparison) -> str:
             f"<td class='t' data-v='{r.line}'><a href='#L{r.line}'>{r.line}</a></td>"
             f"<td class='t'>{_e(r.label)}</td><td class='t'>{_e(kind)}</td>"
             f"{num(r.length_mm, 3)}{num(r.t_reference_s, 4)}{num(r.t_oracle_s, 4)}"
+            f"{num(r.hold_s, 4)}<td class='t'>{_e(r.hold_cause)}</td>"
             f"<td class='gap' data-v='{'' if math.isnan(gap_ms) else repr(gap_ms)}'>{_fmt(gap_ms, 1)}</td>"
             f"{num(gap_pct, 1)}"
             f"{num(r.v_entry_reference, 1)}{num(r.v_exit_reference, 1)}{num(r.v_peak_reference, 1)}"
@@ -468,8 +470,10 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
     name = title or c.program
     o = c.oracle
     gap = format_interval(c) if c.certified else "unknown"
-    gap_d = "t_ref/UB − 1 … t_ref/LB − 1" + ("" if c.gap_lower_valid else
-                                               " (lower end: vs. the relaxation)")
+    gap_d = ("t_ref/UB − 1 … t_ref/LB − 1" if c.hold_s <= 0 else
+             f"motion times: (t_ref − H)/(UB − H) − 1 … (t_ref − H)/(LB − H) − 1, "
+             f"H = {c.hold_s:.4f} s of dwell and exact-stop settle on both sides") + (
+        "" if c.gap_lower_valid else " (lower end: vs. the relaxation)")
     cards = "".join([
         _card(f"{who} time", f"{c.t_reference_s:.4f} s",
               f"bound set {c.reference_bounds}; {len(c.reference_violations)} violation(s)"),
@@ -522,11 +526,15 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
 <h2>Blocks</h2>
 <p class="sub">One row per NC block; inserted blocks on their own rows with the corner
 they replace. Click a column to sort, a line number to see the source. Gap = t_ref − t_opt
-(t_opt from the oracle's verified profile, so the gaps sum to t_ref − UB); speeds in mm/s.</p>
+(t_opt from the oracle's verified profile, so the gaps sum to t_ref − UB); both times contain
+the block's hold (dwell, exact-stop settle: the machine's wait, identical on both sides), which
+is therefore never a gap; gap % is relative to the oracle's motion time; speeds in mm/s.</p>
 {_table(c)}
 <h2>Program</h2>{_source(c)}
-<p class="sub">feedoracle · gap interval [t_ref/UB − 1, t_ref/LB − 1] from the oracle's
-certified lower bound LB and verified upper bound UB; the true optimum lies between them.</p>
+<p class="sub">feedoracle · gap interval [(t_ref − H)/(UB − H) − 1, (t_ref − H)/(LB − H) − 1]
+from the oracle's certified lower bound LB and verified upper bound UB (the true optimum lies
+between them), on motion times: H, the imposed holds (dwell, exact-stop settle), is in every
+total and not in the gap.</p>
 </main><script>{_JS}</script></body></html>
 """
 

@@ -59,7 +59,13 @@ def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
         out.write(f"    ORACLE VIOLATION {describe_violation(item, c)}\n")
     if c.certified:
         valid = "" if c.gap_lower_valid else "   (lower end: gap to the relaxation only)"
-        out.write(f"  {'gap':<10} {format_interval(c)}   [t_ref/UB - 1, t_ref/LB - 1]{valid}\n")
+        if c.hold_s > 0:
+            out.write(f"  {'holds':<10} {c.hold_s:10.4f} s   dwell and exact-stop settle, the "
+                      f"same on both sides: not counted in the gap\n")
+            formula = "[(t_ref-H)/(UB-H) - 1, (t_ref-H)/(LB-H) - 1], H = holds"
+        else:
+            formula = "[t_ref/UB - 1, t_ref/LB - 1]"
+        out.write(f"  {'gap':<10} {format_interval(c)}   {formula}{valid}\n")
     out.write(f"  {'verdict':<10} {'ok' if v.ok else 'FAIL'}: {v.text}\n")
     for note in c.notes:
         out.write(f"  note: {note}\n")
@@ -82,7 +88,8 @@ def print_summary(results: Sequence[tuple[str, Comparison]], max_gap: float | No
                   f"{num(c.oracle.upper_bound_s, 4):>9} {gap:>16} "
                   f"{len(c.reference_violations):>4}  {'ok' if v.ok else 'FAIL ' + v.status}\n")
     if max_gap is not None:
-        out.write(f"gate: gap upper end t_ref/LB - 1 <= {100 * max_gap:g} %\n")
+        out.write(f"gate: gap upper end (t_ref-H)/(LB-H) - 1 <= {100 * max_gap:g} % "
+                  f"(H: holds)\n")
 
 
 def rows_table(rows: Iterable[Mapping[str, Any]], out: TextIO, t_key: str, v_key: str,

@@ -28,9 +28,9 @@ import numpy as np
 from reference.core.constraints import BOUND_SETS, ConstraintReport
 from reference.core.errors import InfeasibleError
 from reference.core.geometry import Path
+from reference.core.holds import DWELL_CAUSE, NO_HOLDS, Holds, dwell_holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
-from reference.core.tolerances import VEL_TOL_MM_S
 
 from .backends import DEFAULT_BACKEND, get_backend
 from .bounds import lower_bound, node_bounds_on, verified_profile
@@ -59,7 +59,7 @@ class _Candidate:
     Attributes
     ----------
     upper_bound_s : float
-        Duration of the verified profile plus the dwells, s.
+        Duration of the verified profile plus the imposed holds, s.
     grid : Grid
         The grid of that round.
     problem : DiscreteProblem
@@ -68,7 +68,7 @@ class _Candidate:
         The backend's solution of ``problem``.
     profile : Profile
         The grid profile after time scaling (the one ``check_profile`` accepted),
-        without dwell holds.
+        without the holds.
     time_scale : float
         Factor ``lam >= 1`` the grid profile was slowed down by.
     report : ConstraintReport
@@ -114,28 +114,6 @@ def _block_name(path: Path, blk: int) -> str:
         return f"block {blk}"
     lab = f", {span.label}" if span.label else ""
     return f"block {blk} (line {span.line}{lab})"
-
-
-def _with_holds(prof: Profile, path: Path) -> Profile:
-    """Insert the dwell holds (``s`` constant, ``v = 0``) at their blocks' positions."""
-    holds = [(b.s_end, b.block, b.dwell_s) for b in path.blocks if b.dwell_s > 0]
-    if not holds:
-        return prof
-    t, s, v = prof.t.copy(), prof.s.copy(), prof.v.copy()
-    a, j, blk = prof.a.copy(), prof.j.copy(), prof.block.copy()
-    for pos, block, dwell in reversed(holds):
-        i = int(np.clip(np.searchsorted(s, pos, side="left"), 0, s.size - 1))
-        if v[i] > VEL_TOL_MM_S:
-            continue
-        t = np.insert(t, i + 1, t[i])
-        t[i + 1:] += dwell
-        s = np.insert(s, i + 1, s[i])
-        v = np.insert(v, i + 1, 0.0)
-        v[i] = 0.0
-        a = np.insert(a, i, 0.0)
-        j = np.insert(j, i, 0.0)
-        blk = np.insert(blk, i, block)
-    return Profile(t=t, s=s, v=v, a=a, j=j, block=blk)
 
 
 def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
@@ -229,23 +207,27 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
     return mark
 
 
-def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str
-                    ) -> OptimalSolution:
-    dwell = float(sum(b.dwell_s for b in path.blocks))
-    prof = _with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path)
+def _dwell_part(holds: Holds) -> float:
+    return float(sum(d for d, c in zip(holds.duration_s, holds.cause) if c == DWELL_CAUSE))
+
+
+def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str,
+                    holds: Holds) -> OptimalSolution:
+    total = holds.total_s
+    prof = with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path, holds)
     n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
     bt = prof.block_times(path) if path.blocks else np.zeros(0)
     rows = tuple(BlockResult(b.block, b.line, b.label, b.kind, b.length,
                              float(bt[b.block]) if b.block < bt.size else 0.0, 0.0,
                              b.stop_reason) for b in path.blocks)
     return OptimalSolution(
-        status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=dwell, upper_bound_s=dwell,
-        objective_s=dwell, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
+        status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=total, upper_bound_s=total,
+        objective_s=total, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
         block_times_s=np.asarray(bt if n_blocks else np.zeros(0)), blocks=rows,
         grid=np.zeros(1), active=(), grid_points=1, iterations=0, backend=backend,
         build_time_s=0.0, solve_time_s=0.0, check_time_s=0.0, bound_time_s=0.0,
-        total_time_s=time.perf_counter() - t0, dwell_s=dwell,
-        message="path without motion: time = dwell time")
+        total_time_s=time.perf_counter() - t0, dwell_s=_dwell_part(holds),
+        message="path without motion: time = hold time", holds=holds)
 
 
 # --------------------------------------------------------------------------- solve
@@ -254,8 +236,13 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
           initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
-          progress: ProgressFn | None = None) -> OptimalSolution:
+          progress: ProgressFn | None = None, holds: Holds | None = None) -> OptimalSolution:
     """Minimum-time motion along ``path`` with a certified lower and a verified upper bound.
+
+    The imposed holds (dwell, exact-stop settle) are no planning decision: the motion is
+    optimised without them and they are inserted at their breaks afterwards
+    (:func:`reference.core.holds.with_holds`, as the heuristic does), so both bounds and
+    the profile contain exactly ``holds.total_s`` of waiting.
 
     Constraints (bound set ``"acc"``): programmed feed per segment (path speed of the
     geometry axes; none for G0, where only the axes' limits apply), axis velocity, axis
@@ -286,6 +273,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         Target size of the initial grid.
     progress : callable, optional
         Called as ``progress(stage_message, fraction_done)`` during refinement.
+    holds : Holds, optional
+        The imposed holds (:func:`reference.holds.imposed_holds`, the same the heuristic
+        was given). Default: the dwells of ``path.blocks`` only (no machine data here to
+        compute exact-stop settle times).
 
     Returns
     -------
@@ -316,13 +307,15 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
     solve_fn = get_backend(backend)
+    if holds is None:
+        holds = dwell_holds(path)
     lim = limits.for_axes(path.axes)
     if path.n_segments == 0:
         if progress:
             progress("no motion", 1.0)
-        return _empty_solution(path, limits, t_start, backend)
+        return _empty_solution(path, limits, t_start, backend, holds)
     check_feed(path)
-    dwell = float(sum(b.dwell_s for b in path.blocks))
+    hold_t = holds.total_s          # every hold: a constant added to every motion's time
 
     grid = initial_grid(path, min(initial_intervals, max_grid))
     t_build = t_solve = t_check = t_bound = 0.0
@@ -362,8 +355,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         warm = _WarmStart(grid, b_hat, rel.b_bar)
         t_bound += time.perf_counter() - te
         t_prim = interval_times(grid.s, res.b)
-        t_grid = float(t_prim.sum()) + dwell
-        best_lb = max(best_lb, lb + dwell)
+        t_grid = float(t_prim.sum()) + hold_t
+        best_lb = max(best_lb, lb + hold_t)
         budget = min(max_grid - grid.n_intervals, grid.n_intervals)
         last = budget <= 0 or it == max_iterations
         disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
@@ -374,7 +367,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             if new_grid is grid:
                 last, new_grid = True, None
         if new_grid is not None:
-            history.append(IterationRecord(grid.n_points, lb + dwell, math.inf, t_grid, 1.0))
+            history.append(IterationRecord(grid.n_points, lb + hold_t, math.inf, t_grid, 1.0))
             gap = max(disc_gap,
                       (best.upper_bound_s - best_lb) / best_lb if best else disc_gap)
             frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
@@ -385,12 +378,12 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         td = time.perf_counter()
         prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds)
         t_check += time.perf_counter() - td
-        ub = prof.duration + dwell
+        ub = prof.duration + hold_t
         if best is None or ub < best.upper_bound_s:
             best = _Candidate(upper_bound_s=ub, grid=grid, problem=problem, result=res,
                               profile=prof, time_scale=lam, report=report,
                               interval_times_s=t_prim)
-        history.append(IterationRecord(grid.n_points, lb + dwell, ub, t_grid, lam))
+        history.append(IterationRecord(grid.n_points, lb + hold_t, ub, t_grid, lam))
         gap = (best.upper_bound_s - best_lb) / best_lb if best_lb > 0 else math.inf
         frac = _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps)
         if gap <= tol:
@@ -412,10 +405,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
             blocks=(), grid=grid.s, active=(), grid_points=grid.n_points, iterations=it,
             backend=backend, build_time_s=t_build, solve_time_s=t_solve,
-            check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total, dwell_s=dwell,
-            history=tuple(history), message=msg)
+            check_time_s=t_check, bound_time_s=t_bound, total_time_s=t_total,
+            dwell_s=_dwell_part(holds), history=tuple(history), message=msg, holds=holds)
     ub, g, lam = best.upper_bound_s, best.grid, best.time_scale
-    prof_h = _with_holds(best.profile, path)
+    prof_h = with_holds(best.profile, path, holds)
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
     labels = active_labels(best.problem, best.result.b)
@@ -432,13 +425,13 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         progress("done", 1.0)
     return OptimalSolution(
         status=status, profile=prof_h, lower_bound_s=best_lb, upper_bound_s=ub,
-        objective_s=float(best.interval_times_s.sum()) + dwell, gap=gap, time_scale=lam,
+        objective_s=float(best.interval_times_s.sum()) + hold_t, gap=gap, time_scale=lam,
         segment_times_s=seg_t, block_times_s=blk_t, blocks=rows, grid=g.s, active=labels,
         grid_points=g.n_points, iterations=it, backend=best.result.backend,
         build_time_s=t_build, solve_time_s=t_solve, check_time_s=t_check,
-        bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start, dwell_s=dwell,
-        report=best.report,
-        history=tuple(history), message=message)
+        bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
+        dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
+        message=message, holds=holds)
 
 
 def _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps) -> float:

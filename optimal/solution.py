@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.core.constraints import ConstraintReport
+from reference.core.holds import NO_HOLDS, Holds
 from reference.core.profile import Profile
 
 from .status import SolveStatus
@@ -36,7 +37,8 @@ class BlockResult:
     length_mm : float
         Path length of the block, mm.
     t_oracle_s : float
-        Time the verified (upper-bound) profile spends in the block, s (dwell included).
+        Time the verified (upper-bound) profile spends in the block, s (its holds, dwell
+        or exact-stop settle, included).
     v_exit_oracle : float
         Path speed at the block end, mm/s.
     limit_oracle : str
@@ -82,8 +84,9 @@ class OptimalSolution:
         The verified profile whose duration is ``upper_bound_s`` (``None`` only on
         ``solver_error``).
     lower_bound_s, upper_bound_s : float
-        Certified lower bound and verified upper bound of the minimum time, s (dwells
-        included in both).
+        Certified lower bound and verified upper bound of the minimum time, s (the
+        imposed holds, dwell and exact-stop settle, included in both: they are the same
+        constant in every feasible motion).
     objective_s : float
         Time of the grid optimum before time scaling, s.
     gap : float
@@ -111,13 +114,15 @@ class OptimalSolution:
         Problem construction, discrete solves, checker, lower-bound relaxation, and the
         whole call, s (sums over rounds).
     dwell_s : float
-        Total dwell time of the program, s.
+        Total dwell (G4) time of the program, s (part of ``holds``).
     report : ConstraintReport or None
         The checker's report on the final grid profile before time scaling.
     history : tuple[IterationRecord, ...]
         Bounds per round.
     message : str
         Human-readable summary.
+    holds : Holds
+        The imposed holds in ``profile`` and in both bounds (as given to :func:`solve`).
     """
 
     status: SolveStatus
@@ -144,3 +149,9 @@ class OptimalSolution:
     report: ConstraintReport | None = None
     history: tuple[IterationRecord, ...] = field(default=())
     message: str = ""
+    holds: Holds = NO_HOLDS
+
+    @property
+    def hold_s(self) -> float:
+        """Total imposed hold time (dwell and exact-stop settle), s."""
+        return self.holds.total_s

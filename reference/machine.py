@@ -71,6 +71,7 @@ _AXIS_KEYS: dict[str, _Key] = {
     "POSCTRL_GAIN": _Key((int, float), "(m/min)/mm", 0.0, 100.0, "MD32200"),
     "STOP_LIMIT_FINE": _Key((int, float), "mm", 0.0, 10.0, "MD36010"),
     "STOP_LIMIT_COARSE": _Key((int, float), "mm", 0.0, 10.0, "MD36000"),
+    "VELO_FFW_WEIGHT": _Key((int, float), "", -1e-12, 1.0, "MD32610 (0..1)"),
     "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433"),
     "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434"),
     "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435"),
@@ -91,6 +92,10 @@ class AxisSettings:
         Position-controller gain MD32200 converted to 1/s (1 (m/min)/mm = 16.667 1/s).
     stop_fine_mm, stop_coarse_mm : float
         MD36010 / MD36000 exact-stop windows, mm.
+    velo_ffw_weight : float
+        MD32610 VELO_FFW_WEIGHT in effect during the program, 0..1 (0 = no velocity
+        feed-forward: following error ``v/Kv``; 1 = ideal feed-forward). Used by the
+        exact-stop settle model (:mod:`reference.holds`). Default 0.
     soft_accel_factor, g00_accel_factor, g00_jerk_factor : float
         MD32433 / MD32434 / MD32435.
     """
@@ -100,6 +105,7 @@ class AxisSettings:
     kv_per_s: float = 1.0 * 1000.0 / 60.0
     stop_fine_mm: float = 0.01
     stop_coarse_mm: float = 0.04
+    velo_ffw_weight: float = 0.0
     soft_accel_factor: float = 1.0
     g00_accel_factor: float = 1.0
     g00_jerk_factor: float = 1.0
@@ -318,6 +324,7 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             kv_per_s=float(tbl.get("POSCTRL_GAIN", 1.0)) * 1000.0 / 60.0,
             stop_fine_mm=float(tbl.get("STOP_LIMIT_FINE", 0.01)),
             stop_coarse_mm=float(tbl.get("STOP_LIMIT_COARSE", 0.04)),
+            velo_ffw_weight=float(tbl.get("VELO_FFW_WEIGHT", 0.0)),
             soft_accel_factor=float(tbl.get("SOFT_ACCEL_FACTOR", 1.0)),
             g00_accel_factor=float(tbl.get("G00_ACCEL_FACTOR", 1.0)),
             g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)))))

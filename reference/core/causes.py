@@ -18,9 +18,11 @@ are spelled exactly as listed.
 ``exact stop``          G60 / G9 (NGC G61, G61.1): rest at the block end
 ``forced stop``         any other rest: program start and end, M0/M1/M2/M30, aux
                         functions without motion, BRISK <-> SOFT change
-``dwell``               a programmed wait (G4): imposed, not a planning decision
-``exact stop settle``   the wait for the following error to settle into the exact-stop
-                        window (G601/G602): imposed by the machine, not planned
+``dwell``               a G4 block: its whole time is the programmed wait (a hold)
+``exact stop settle``   the exact-stop window wait (G601/G602) at a block end (a hold)
+
+The last two are holds (:mod:`reference.holds`): imposed by the program or the machine,
+the same on every side, never a planning gap.
 
 Two more words appear in block rows: ``"none"`` (no limit is tight for a meaningful
 share of the block's time) and ``"-"`` (a block without motion or time).
@@ -35,15 +37,15 @@ CAUSES: tuple[str, ...] = ("feed", "axis velocity", "axis acceleration", "jerk",
                            "corner rule", "look-ahead horizon", "IPO-cycle cap",
                            "exact stop", "forced stop", "dwell", "exact stop settle")
 (FEED, AXIS_VELOCITY, AXIS_ACCELERATION, JERK, FREQUENCY, CORNER_RULE, HORIZON, IPO_CAP,
- EXACT_STOP, FORCED_STOP, DWELL, SETTLE) = range(len(CAUSES))
+ EXACT_STOP, FORCED_STOP, DWELL, EXACT_STOP_SETTLE) = range(len(CAUSES))
 
 #: Row words outside the limit vocabulary.
 NO_CAUSE = "none"
 NO_TIME = "-"
 
-#: Causes that are waits the program or the machine impose: they enter every profile
-#: identically and are no planning decision (not counted in the gap).
-WAIT_CAUSES: frozenset[str] = frozenset({"dwell", "exact stop settle"})
+#: Causes of holds, the waits the program or the machine impose: they enter every
+#: profile identically and are no planning decision (not counted in the gap).
+HOLD_CAUSES: tuple[str, ...] = (CAUSES[DWELL], CAUSES[EXACT_STOP_SETTLE])
 
 #: Constraint names of the checker and the oracle -> the cause they stand for.
 CONSTRAINT_CAUSES: Mapping[str, str] = MappingProxyType({
@@ -58,7 +60,10 @@ def cause_name(code: int) -> str:
 
 def stop_cause(reason: str) -> str:
     """The cause of a required rest from its stop reason (``path.stop_reason``)."""
-    return "exact stop" if (reason or "").startswith("exact") else "forced stop"
+    reason = reason or ""
+    if reason.startswith("dwell"):
+        return "dwell"
+    return "exact stop" if reason.startswith("exact") else "forced stop"
 
 
 def normalise_cause(label: str, stop_reason: str | None = None,

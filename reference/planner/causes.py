@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from ..core.causes import (AXIS_ACCELERATION, AXIS_VELOCITY, CAUSES, CORNER_RULE, DWELL,
                            EXACT_STOP, FEED, FORCED_STOP, FREQUENCY, HORIZON, IPO_CAP, JERK,
-                           SETTLE, cause_name)
+                           EXACT_STOP_SETTLE, cause_name)
 
 __all__ = ["AXIS_ACCELERATION", "AXIS_VELOCITY", "CAUSES", "CORNER_RULE", "DWELL",
            "EXACT_STOP", "FEED", "FORCED_STOP", "FREQUENCY", "HORIZON", "IPO_CAP", "JERK",
-           "SETTLE", "cause_name"]
+           "EXACT_STOP_SETTLE", "cause_name"]

@@ -7,9 +7,10 @@ in a later issue, G641..G645 behave as G64 and the stage trace says so):
 modes, forced stops) -> ``limit curves`` (segment caps, tangential limits) -> ``corners``
 (junction limits) -> ``lookahead`` (horizon caps, planning units, passes) -> ``profiles``
 (unit profiles) -> ``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation``
-(ADAPT_PATH_DYNAMIC) -> ``settle`` (exact-stop holds) -> assembly of the
-:class:`~reference.core.profile.Profile` -> ``check`` (the planner's own profile against
-its declared bound set).
+(ADAPT_PATH_DYNAMIC) -> ``holds`` (dwell and exact-stop settle,
+:func:`reference.holds.imposed_holds`: the machine's waits, not the planner's) -> assembly
+of the :class:`~reference.core.profile.Profile` -> ``check`` (the planner's own profile
+against its declared bound set).
 
 Each stage is a pure function of data to data; this module only composes them, records
 the stage trace and derives the per-block and per-corner rows. The result types live in
@@ -25,7 +26,9 @@ import numpy as np
 
 from ..core.constraints import BOUND_SETS, check_profile
 from ..core.geometry import Path
+from ..core.holds import SETTLE_CAUSE, Holds, with_holds
 from ..core.profile import Profile
+from ..holds import imposed_holds
 from ..machine import Machine
 from ..nc.program import Program
 from ..prepare import build_path
@@ -35,12 +38,12 @@ from .corners import junction_limits
 from .limit_curves import SegmentLimits, segment_limits
 from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planning_units
 from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
-from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, N_PHASES, UnitProfiles, case_name,
+from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
                        unit_profiles)
 from .result import (BlockRow, BlockTable, CornerRow, CornerTable, ReferencePlan,
                      TraceEntry)
 from .smoothing import smooth_velocity
-from .stops import ACCEL_MODES, SegmentModes, segment_modes, settle_times
+from .stops import ACCEL_MODES, SegmentModes, segment_modes
 
 Progress = Callable[[str, float], None]
 
@@ -181,17 +184,16 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
         trace.append(("adaptation", "off (ADAPT_PATH_DYNAMIC = 1)"))
 
     report_progress("settle", 0.8)
-    v_brake = np.zeros(m + 1)
-    if units.n_units:
-        v_brake[units.node_break[1:]] = prof.v_peak
-    settle = settle_times(program, path, machine, modes, v_brake, params)
-    n_settle = int(np.sum(settle > 0))
+    holds = imposed_holds(program, path, machine)
+    n_settle = sum(1 for c in holds.cause if c == SETTLE_CAUSE)
+    n_dwell = holds.n - n_settle
     trace.append(("settle", f"{int(np.sum(modes.exact_stop_block >= 0))} exact stops; "
-                            f"{n_settle} settle holds, {settle.sum():.6g} s "
-                            f"(e0 = {params.settle_lag_factor:g} * v/Kv)"))
+                            f"{n_settle} settle and {n_dwell} dwell holds, "
+                            f"{holds.total_s:.6g} s (imposed: e0 = (1 - VELO_FFW_WEIGHT) "
+                            f"* v_prog/Kv, reference.holds)"))
 
     report_progress("assemble", 0.85)
-    profile = _assemble(path, units, prof, settle, modes)
+    profile = with_holds(_assemble(path, units, prof), path, holds)
     rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
                           horizon)
     bound_set = modes.bound_set
@@ -210,7 +212,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                          profile=profile, blocks=rows, corners=corners,
                          trace=tuple(TraceEntry(*e) for e in trace),
                          bound_set=bound_set, report=report, limits=limits,
-                         parameters=params)
+                         parameters=params, holds=holds)
 
 
 def _cause_counts(what: str, codes: np.ndarray) -> str:
@@ -240,10 +242,9 @@ def _exclusive_cumsum(x: np.ndarray) -> np.ndarray:
     return out
 
 
-def _assemble(path: Path, units: Units, prof: UnitProfiles, settle: np.ndarray,
-              modes: SegmentModes) -> Profile:
-    """One Profile: unit phases in order, holds (settle, dwell) at their breaks."""
-    u = units.n_units
+def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
+    """The motion Profile: unit phases in order (the holds are inserted afterwards by
+    :func:`reference.core.holds.with_holds`, as on the oracle's side)."""
     h = prof.duration
     a0 = prof.a0
     jj = prof.jerk
@@ -252,35 +253,11 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles, settle: np.ndarray,
     ds = v_start * h + a0 * h * h / 2 + jj * h ** 3 / 6
     s_start = units.s_start[:, None] + _exclusive_cumsum(ds)
     keep = h > 0
-    major = np.repeat(np.arange(u, dtype=np.float64), N_PHASES).reshape(u, N_PHASES)
-    minor = np.tile(np.arange(N_PHASES, dtype=np.float64), (u, 1))
-    cols = dict(h=h[keep], a=a0[keep], j=jj[keep], s=s_start[keep],
-                v=np.maximum(v_start[keep], 0.0), blk=np.full(int(keep.sum()), -1),
-                major=major[keep], minor=minor[keep])
-    # holds: settle of the exact-stop block, then the dwell blocks at the same break
-    node_of_break = np.full(path.n_segments + 1, -1)
-    node_of_break[units.node_break] = np.arange(u + 1)
-    hold = []
-    for k in np.flatnonzero(settle > 0):
-        hold.append((k, 0, float(settle[k]), int(modes.exact_stop_block[k])))
-    for order, span in enumerate(path.blocks):
-        if span.dwell_s > 0:
-            hold.append((span.first_segment, 1 + order, float(span.dwell_s), span.block))
-    if hold:
-        hk = np.array([x[0] for x in hold])
-        node = node_of_break[hk] if u else np.zeros(hk.size, dtype=np.int64)
-        cols = {k: np.concatenate((cols[k], extra)) for k, extra in (
-            ("h", np.array([x[2] for x in hold])), ("a", np.zeros(len(hold))),
-            ("j", np.zeros(len(hold))), ("s", path.s_breaks[hk]),
-            ("v", np.zeros(len(hold))), ("blk", np.array([x[3] for x in hold])),
-            ("major", node - 0.5), ("minor", np.array([float(x[1]) for x in hold])))}
-    order = np.lexsort((cols["minor"], cols["major"]))
-    hh = cols["h"][order]
+    hh = h[keep]
     t = np.concatenate(([0.0], np.cumsum(hh)))
-    s = np.concatenate((cols["s"][order], [path.total_length]))
-    v = np.concatenate((cols["v"][order], [0.0]))
-    return Profile(t=t, s=s, v=v, a=cols["a"][order], j=cols["j"][order],
-                   block=cols["blk"][order])
+    s = np.concatenate((s_start[keep], [path.total_length]))
+    v = np.concatenate((np.maximum(v_start[keep], 0.0), [0.0]))
+    return Profile(t=t, s=s, v=v, a=a0[keep], j=jj[keep], block=np.full(hh.size, -1))
 
 
 # ----------------------------------------------------------------- rows
@@ -363,6 +340,9 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     stop_here = modes.stop[kb] & (t_blk > 0)
     cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
     cause_code = np.where(moving | stop_here, cause_code, -1)
+    # a dwell block's whole time is its hold: the hold's own cause, not "forced stop"
+    is_dwell = np.array([sp.dwell_s > 0 and sp.n_segments == 0 for sp in spans], dtype=bool)
+    cause_code = np.where(is_dwell & (t_blk > 0), C.DWELL, cause_code)
     mode_code = np.where(moving, modes.mode[mainc] if m else 0, -1)
     case_code = np.where(moving, case_seg[mainc] if m else 0, -1)
     rows = BlockTable(

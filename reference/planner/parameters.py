@@ -65,12 +65,6 @@ class PlannerParameters:
         limits, :func:`reference.planner.corners.through_acceleration`) is at least this
         share of the neighbouring segments' acceleration; the unit then accelerates at
         most with that value (0 < x <= 1). Default 0.5.
-    settle_lag_factor : float
-        Exact stop G601/G602: following error at interpolator end
-        ``e0_i = factor * |v_i| / kv_i`` with ``v_i`` the axis speed before the final
-        braking process (the lag ``v/Kv`` of a position loop without feed-forward,
-        frozen at the start of braking). 1.0 = no feed-forward; 0 = ideal feed-forward
-        (no settle time at all). Default 1.0.
     smoothing_rounds : int
         LOOKAH_SMOOTH_FACTOR: rounds of bump removal, shortest bumps first; each round
         can merge neighbouring bumps into a larger one. Default 3.
@@ -84,7 +78,6 @@ class PlannerParameters:
     arc_jerk_accel_share: float = 0.5
     soft_merge_cap_ratio: float = 0.95
     soft_merge_accel_ratio: float = 0.5
-    settle_lag_factor: float = 1.0
     smoothing_rounds: int = 3
     adaptation_rounds: int = 2
 
@@ -99,9 +92,6 @@ class PlannerParameters:
             val = getattr(self, name)
             if not (0.0 < val <= 1.0):
                 raise MachineDataError(f"planner.{name}", val, "must be in (0, 1]")
-        if not self.settle_lag_factor >= 0.0:
-            raise MachineDataError("planner.settle_lag_factor", self.settle_lag_factor,
-                                   "must be >= 0")
         for name in ("smoothing_rounds", "adaptation_rounds"):
             val = getattr(self, name)
             if not (isinstance(val, int) and val >= 0):

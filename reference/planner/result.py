@@ -16,6 +16,7 @@ import numpy as np
 
 from ..core.constraints import BOUND_SETS, ConstraintReport
 from ..core.geometry import Path
+from ..core.holds import Holds
 from ..core.limits import MachineLimits
 from ..core.profile import Profile
 from . import causes as C
@@ -218,6 +219,9 @@ class ReferencePlan:
         sequence, columns via ``blocks.column(name)``.
     corners : CornerTable
         One :class:`CornerRow` per interior segment break.
+    holds : Holds
+        The imposed holds (dwell, exact-stop settle) contained in ``profile``; the
+        oracle must be given the same (:func:`reference.holds.imposed_holds`).
     trace : tuple[TraceEntry, ...]
         ``(stage, note)`` pairs in stage order.
     bound_set : str
@@ -237,6 +241,7 @@ class ReferencePlan:
     profile: Profile
     blocks: BlockTable
     corners: CornerTable
+    holds: Holds
     trace: tuple[TraceEntry, ...]
     bound_set: str
     report: ConstraintReport | None

@@ -1,26 +1,12 @@
-"""Stage: stops that only the heuristic makes, and the exact-stop settle time.
+"""Stage: stops that only the heuristic makes.
 
-Two pure functions:
-
-* :func:`segment_modes` reads the acceleration mode of every segment (BRISK, SOFT, or
-  the machine default) and forces rest where the mode changes: "the axes stop between
-  the blocks anyway" at a BRISK <-> SOFT change (spec/sinumerik-model.md 5.2). Stops the
-  path itself requires (exact stop, dwell, M0/M30, ...) were decided by
-  :func:`reference.prepare.prepare` and are only classified here.
-* :func:`settle_times` gives the hold at the end of every exact-stop block (G60 modal,
-  G9 non-modal) from the block-change criterion (model note section 3):
-
-  - G603 "interpolator end": the next block starts when the set speed is 0: no hold;
-  - G601 / G602 "fine / coarse window": a first-order position loop with gain ``Kv``
-    (MD32200 POSCTRL_GAIN) lets the following error decay from ``e0`` into the window
-    ``w`` (MD36010 STOP_LIMIT_FINE, default 0.01 mm / MD36000 STOP_LIMIT_COARSE,
-    default 0.04 mm): ``t_i = max(0, ln(e0_i / w_i) / Kv_i)``, hold = max over the axes
-    that move in the block.
-  - ``e0`` (following error at interpolator end) is a model choice, the named parameter
-    :attr:`PlannerParameters.settle_lag_factor`: ``e0_i = factor * |v_i| / Kv_i`` with
-    ``v_i`` the axis speed before the final braking process (the lag ``v/Kv`` of a loop
-    without feed-forward). The fine window is smaller, so G601 waits longer than G602,
-    and G603 not at all.
+:func:`segment_modes` reads the acceleration mode of every segment (BRISK, SOFT, or the
+machine default) and forces rest where the mode changes: "the axes stop between the
+blocks anyway" at a BRISK <-> SOFT change (spec/sinumerik-model.md 5.2). Stops the path
+itself requires (exact stop, dwell, M0/M30, ...) were decided by
+:func:`reference.prepare.prepare` and are only classified here. The waits at those
+stops (dwell, exact-stop settle) are not the heuristic's:
+:func:`reference.holds.imposed_holds` computes them for every side alike.
 
 The acceleration modes form the dispatch table :data:`ACCEL_MODES`: every later stage
 asks the table (jerk-limited or not, which bound set, which acceleration factor) instead
@@ -36,8 +22,6 @@ import numpy as np
 from ..core.geometry import Path
 from ..machine import Machine
 from ..nc.program import Program
-from ..core.tolerances import MOVING_AXIS_TOL
-from .parameters import PlannerParameters
 
 
 @dataclass(frozen=True, slots=True)
@@ -159,52 +143,3 @@ def segment_modes(program: Program, path: Path, machine: Machine) -> SegmentMode
     stop_class = np.where(exact & stop, STOP_EXACT, np.where(stop, STOP_FORCED, STOP_NONE))
     return SegmentModes(mode=mode, stop=stop, stop_class=stop_class, mode_change=change,
                         exact_stop_block=es_block, default_mode=default)
-
-
-#: Exact-stop window per block-change criterion: AxisSettings field, or None (no wait).
-_CRITERION_WINDOW = {"G601": "stop_fine_mm", "G602": "stop_coarse_mm", "G603": None}
-
-
-def settle_times(program: Program, path: Path, machine: Machine, modes: SegmentModes,
-                 v_before_brake: np.ndarray, params: PlannerParameters) -> np.ndarray:
-    """Hold time at every break ending an exact-stop block (G601/G602 settling).
-
-    Parameters
-    ----------
-    program : Program
-    path : Path
-    machine : Machine
-        Axis settings: ``kv_per_s``, ``stop_fine_mm``, ``stop_coarse_mm``.
-    modes : SegmentModes
-    v_before_brake : numpy.ndarray, shape (m + 1,)
-        Path speed at the start of the final braking process into each break, mm/s.
-    params : PlannerParameters
-        ``settle_lag_factor`` (the e0 model).
-
-    Returns
-    -------
-    numpy.ndarray, shape (m + 1,)
-        Settle time per break, s (0 where no exact stop waits).
-    """
-    m = path.n_segments
-    out = np.zeros(m + 1)
-    ks = np.flatnonzero(modes.exact_stop_block >= 0)
-    if ks.size == 0 or params.settle_lag_factor == 0.0:
-        return out
-    settings = [machine.settings_of(a) for a in path.axes]
-    kv = np.array([st.kv_per_s for st in settings])
-    # axis tangents at the end of the segment before each exact-stop break
-    _, dq, _, _ = path.evaluate(path.s_breaks[ks], side="left")
-    for row, k in enumerate(ks):
-        blk = program.blocks[int(modes.exact_stop_block[k])]
-        field = _CRITERION_WINDOW.get(blk.exact_stop_criterion)
-        if field is None:
-            continue
-        window = np.array([getattr(st, field) for st in settings])
-        v_axis = np.abs(dq[row]) * v_before_brake[k]
-        moving = np.abs(dq[row]) > MOVING_AXIS_TOL
-        e0 = params.settle_lag_factor * v_axis / kv
-        with np.errstate(divide="ignore"):
-            t = np.where(moving & (e0 > window), np.log(e0 / window) / kv, 0.0)
-        out[k] = float(t.max()) if t.size else 0.0
-    return out

@@ -57,7 +57,7 @@ def fake_engines(monkeypatch):
             path = restrict_to_machine(prepare(program), machine.limits)
         return fake_plan(path, machine.limits)
 
-    def run_oracle(path, limits, bounds, progress=None, *, tol=None):
+    def run_oracle(path, limits, bounds, progress=None, *, tol=None, holds=None):
         return fake_solution(path, limits)
 
     monkeypatch.setattr(engines, "run_heuristic", run_heuristic)

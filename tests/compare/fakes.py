@@ -75,6 +75,7 @@ class FakePlan:
     bound_set: str = "acc"
     blocks: tuple = ()
     report: object = None
+    holds: object = None          # no holds checked (the fake profiles have none)
 
 
 @dataclass(frozen=True)

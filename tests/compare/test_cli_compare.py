@@ -94,7 +94,7 @@ def test_several_programs_one_table_one_index(fake_engines, tmp_path, capsys):
     lines = out.splitlines()
     assert lines[0].split()[:4] == ["program", "t_ref_s", "LB_s", "UB_s"]
     assert sum(str(p) in out for p in (a, b, c)) == 3
-    assert "gate: gap upper end t_ref/LB - 1 <= 50 %" in out
+    assert "gate: gap upper end (t_ref-H)/(LB-H) - 1 <= 50 %" in out
     assert f"report: {rep / 'index.html'}; open file://" in out
     index = (rep / "index.html").read_text()
     for stem in ("a_part", "b_part", "line"):                # colliding stems kept apart

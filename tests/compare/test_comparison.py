@@ -86,7 +86,7 @@ def test_soft_heuristic_against_acc_oracle_is_a_relaxation(small):
     program, path, plan, sol = small
     c = compare(replace(plan, bound_set="jerk", report=None), sol, program=program)
     assert not c.gap_lower_valid
-    assert any("relaxation" in n and "t_ref/LB - 1 is a valid upper end" in n for n in c.notes)
+    assert any("relaxation" in n and "the gap's upper end, with LB, is valid" in n for n in c.notes)
     # the jerk bound set judges the plan's jerk: the fake (BRISK-like) breaks it
     v = c.verdict(None)
     assert any(x.constraint == "jerk" for x in c.reference_violations)
@@ -148,7 +148,7 @@ def test_oracle_labels_map_to_the_shared_vocabulary():
     assert normalise_cause("feed") == "feed"
     assert normalise_cause("stop", span.stop_reason) == "exact stop"
     assert normalise_cause("dwell G4 0.2 s", idle.stop_reason,
-                           idle.n_segments == 0) == "forced stop"
+                           idle.n_segments == 0) == "dwell"
     assert normalise_cause("") == "-"
     assert normalise_cause("look-ahead horizon") == "look-ahead horizon"
 

@@ -51,8 +51,12 @@ def test_demo_compare_exit_0_report_and_valid_json(demo):
     ref, orc, gap = doc["reference"], doc["oracle"], doc["gap"]
     assert orc["status"] == "optimal"
     assert 0 < orc["lower_bound_s"] <= orc["upper_bound_s"] <= ref["time_s"]
-    assert gap["lower"] == pytest.approx(ref["time_s"] / orc["upper_bound_s"] - 1)
-    assert gap["upper"] == pytest.approx(ref["time_s"] / orc["lower_bound_s"] - 1)
+    # the gap compares motion times: the holds (the G9 settle, the G4 dwell) are in
+    # both totals and in no gap
+    H = sum(b["hold_s"] for b in doc["blocks"])
+    assert H == pytest.approx(gap["hold_s"], rel=1e-12) and H > 0.2      # dwell 0.2 s + settle
+    assert gap["lower"] == pytest.approx((ref["time_s"] - H) / (orc["upper_bound_s"] - H) - 1)
+    assert gap["upper"] == pytest.approx((ref["time_s"] - H) / (orc["lower_bound_s"] - H) - 1)
     assert ref["violations"] == [] and orc["violations"] == []
     # per-block accounting on both sides
     assert sum(b["t_reference_s"] for b in doc["blocks"]) == pytest.approx(ref["time_s"],
@@ -63,7 +67,10 @@ def test_demo_compare_exit_0_report_and_valid_json(demo):
         {b["limit_oracle"] for b in doc["blocks"]}
     assert causes <= {"feed", "axis velocity", "axis acceleration", "jerk", "frequency",
                       "corner rule", "look-ahead horizon", "IPO-cycle cap", "exact stop",
-                      "forced stop", "none", "-"}
+                      "forced stop", "dwell", "exact stop settle", "none", "-"}
+    holds = {b["line"]: (b["hold_cause"], b["hold_s"]) for b in doc["blocks"] if b["hold_s"]}
+    assert set(holds) == {24, 25}                     # N200 G9 and N210 G4 F0.2
+    assert holds[24][0] == "exact stop settle" and holds[25] == ("dwell", 0.2)
     html = (out / "rep" / "demo.html").read_text()
     assert html.count('<img class="plot"') == 4
     assert f"report: {out / 'rep' / 'demo.html'}" in r.stdout
@@ -75,7 +82,7 @@ def test_library_api_block_times_sum_to_totals():
     machine = load_machine(None)
     program = parse_file(DEMO)
     p = plan(program, machine)
-    sol = optimal.solve(p.path, machine.limits, bounds="acc")
+    sol = optimal.solve(p.path, machine.limits, bounds="acc", holds=p.holds)
     c = compare(p, sol, program=program)
     assert sum(r.t_reference_s for r in c.rows) == pytest.approx(p.profile.duration, rel=1e-12)
     assert sum(r.t_oracle_s for r in c.rows) == pytest.approx(sol.upper_bound_s, rel=1e-12)
@@ -91,7 +98,8 @@ def test_gate_fails_and_names_blocks(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 1
     assert f"FAIL {DEMO}: gap above gate" in err
-    assert "  line 24 N200 (G1):" in err
+    # the G9 block's settle is the machine's wait, not a gap: the largest gap is elsewhere
+    assert "  line 27 N230 (G2):" in err and "line 24 N200" not in err
 
 
 def test_heuristic_csv_read_back_reproduces_its_numbers(tmp_path, capsys):

@@ -74,15 +74,19 @@ def test_compare_program_runs_both_sides_on_one_path_object(small_program, monke
         seen["heuristic"] = path
         return real_h(program, machine, progress, path=path)
 
-    def oracle(path, limits, bounds, progress=None, *, tol=None):
+    def oracle(path, limits, bounds, progress=None, *, tol=None, holds=None):
         seen["oracle"] = path
-        return real_o(path, limits, bounds, progress, tol=tol)
+        seen["holds"] = holds
+        return real_o(path, limits, bounds, progress, tol=tol, holds=holds)
 
     monkeypatch.setattr(engines, "run_heuristic", heuristic)
     monkeypatch.setattr(engines, "run_oracle", oracle)
     c = pipeline.compare_program(small_program, "default")
     assert seen["heuristic"] is not None and seen["heuristic"] is seen["oracle"]
     assert c.path is seen["oracle"]
+    # the oracle waits where the heuristic waits (the small program has G9 and G4 F0.2)
+    h = seen["holds"]
+    assert h.cause == ("exact stop settle", "dwell") and h.duration_s[1] == 0.2
 
 
 def test_compare_program_passes_tol_and_reports_progress(small_program):

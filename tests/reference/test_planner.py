@@ -187,16 +187,18 @@ def test_settle_hold_is_attributed_to_its_block():
 
 def test_ideal_feed_forward_removes_the_settle_time():
     text = "G90 G60 {} SOFT F6000\nG1 X100\nM30\n"
-    params = PlannerParameters(settle_lag_factor=0.0)
-    assert run(text.format("G601"), parameters=params).time_s == pytest.approx(
+    ffw = machine(all_axes={"VELO_FFW_WEIGHT": 1.0})      # MD32610: ideal feed-forward
+    assert run(text.format("G601"), ffw).time_s == pytest.approx(
         run(text.format("G603")).time_s, rel=1e-12)
 
 
 def test_dwell_is_a_hold_of_its_block():
     p = run("G90 G64 SOFT F6000\nG1 X100\nG4 F0.5\nX200\nM30\n")
     assert p.blocks[2].time_s == pytest.approx(0.5, rel=1e-12)
-    assert p.blocks[2].cause == "forced stop"
+    assert p.blocks[2].cause == "dwell"
     assert p.corners[0].v == 0.0
+    row = to_json_dict(p)["blocks"][2]
+    assert row["hold_s"] == 0.5 and row["hold_cause"] == "dwell"
 
 
 # ----------------------------------------------------------------- IPO-cycle cap
@@ -365,8 +367,6 @@ def test_parameters_are_validated():
         PlannerParameters(arc_centripetal_share=1.0)
     with pytest.raises(MachineDataError, match="soft_merge_cap_ratio"):
         PlannerParameters(soft_merge_cap_ratio=0.0)
-    with pytest.raises(MachineDataError, match="settle_lag_factor"):
-        PlannerParameters(settle_lag_factor=-1.0)
 
 
 # ----------------------------------------------------------------- outputs
@@ -398,7 +398,7 @@ def test_to_json_dict_follows_the_contract():
     assert d["reference"]["violations"] == []
     row = d["blocks"][1]
     assert set(row) == {"block", "line", "label", "kind", "length_mm", "t_reference_s",
-                        "v_exit_reference", "limit_reference"}
+                        "v_exit_reference", "limit_reference", "hold_s", "hold_cause"}
     json.dumps(d)                                        # JSON-ready
     if SCHEMA.is_file():
         jsonschema = pytest.importorskip("jsonschema")
