@@ -100,7 +100,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .errors import ProfileError
-from .geometry import Path
+from .geometry import Path, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
 from .tolerances import POS_TOL_MM, RATIO_TOL, TANGENT_TOL_RAD, VEL_TOL_MM_S
@@ -481,7 +481,7 @@ def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
     vpk_all, _, _ = _speed_peak(ctx, k_all)
     n_uni = np.where(arc, np.maximum(
         MIN_ARC_SAMPLES,
-        np.ceil(np.abs(path.omega[ctx.seg[k_all]]) * vpk_all * ctx.h[k_all]
+        np.ceil(plane_amplitudes(path).omega_max[ctx.seg[k_all]] * vpk_all * ctx.h[k_all]
                 / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 0)
     # cost: one row per line interval; uniform + stationary + 3 refinement rows per arc
     cost = np.where(arc, n_uni + 4, 1)
