@@ -69,8 +69,9 @@ one segment (lines, arcs, helices).
   taken exactly at the interval ends and the stationary point of ``v`` (``s''= 0``).
 * **Arcs and helices**: dense samples, uniform in time, at an angular step of at most
   :data:`ARC_SAMPLE_STEP_RAD` (0.125 deg) *at the interval's peak speed* (so also where
-  the motion is fastest), at least :data:`MIN_ARC_SAMPLES` per sub-interval, plus the
-  stationary point of ``v``. A maximum of a cos-type function sampled at step
+  the motion is fastest; on a spiral at its largest angular rate
+  :attr:`~reference.core.geometry.PlaneAmplitudes.omega_max`), at least
+  :data:`MIN_ARC_SAMPLES` per sub-interval, plus the stationary point of ``v``. A maximum of a cos-type function sampled at step
   ``dphi`` is missed by at most ``1 - cos(dphi/2) <= dphi^2/8`` of its amplitude:
   **5.9e-7 relative** at 0.125 deg, below :data:`RATIO_TOL`. In general the deficit
   is at most ``sup|g''| dtau^2 / 8`` for a quantity ``g(tau)`` sampled at time step
