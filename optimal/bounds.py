@@ -22,6 +22,11 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 6 =: E_jk``. Hence the end values satisfy the
    linear rows ``sigma ([q'_j b]/2 + w0 b_k + w1 b_{k+1}) <= A_j D + E_jk`` with
    ``w0, w1 = int q''_j (1 - t/D) / 2, int q''_j (t/D) / 2`` (closed form on helices).
+   On spiral arcs (curvature varying along the arc) ``sup|q''_j|`` and ``sup|q'''_j|``
+   are the segment's worst values (:func:`reference.core.geometry.plane_amplitudes`) and
+   the weights come by parts, ``w0 = (dq/D - q'_j(s_k)) / 2``,
+   ``w1 = (q'_j(s_{k+1}) - dq/D) / 2`` (``dq`` the exact chord), whose round-off bound
+   times ``Bbar_k`` is added to ``E_jk``.
    On lines ``q'' = 0``: the row is the exact ``|q'_j (b_{k+1} - b_k)| / (2D) <= A_j``.
    Rows that are not in lattice form are relaxed further (one term dropped, ``b >= 0``).
 3. *Node caps* are those of the continuous problem at the nodes (velocity on both sides,
@@ -57,7 +62,7 @@ import numpy as np
 from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
                                         scale_time, time_scale_factor)
 from reference.core.errors import InternalError
-from reference.core.geometry import Path
+from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
 
@@ -113,6 +118,7 @@ class _IntervalData:
     b_static: np.ndarray      # (N,) a-priori bound of b on the interval
     node_mvc: np.ndarray      # (N + 1,) static maximum-velocity curve at the nodes
     axes_used: np.ndarray     # indices of moving axes
+    ierr: np.ndarray          # (N, n) round-off bound of |I0| + |I1| (spirals; else 0)
 
 
 def _pair_mvc(dq: np.ndarray, ddq: np.ndarray, a_max: np.ndarray) -> np.ndarray:
@@ -150,6 +156,11 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
     plane = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)          # (N, n)
     k2 = np.abs(r * w * w)[:, None] * plane                          # sup |q''_j|
     k3 = np.abs(r * w ** 3)[:, None] * plane                         # sup |q^(3)_j|
+    spi = np.flatnonzero(path.dradius[seg])            # spirals: worst over the segment
+    if spi.size:
+        amp = plane_amplitudes(path)
+        k2[spi] = amp.curvature[seg[spi], None] * plane[spi]
+        k3[spi] = np.hypot(amp.jerk_t, amp.jerk_n)[seg[spi], None] * plane[spi]
     half = 0.5 * ds[:, None]
     lo = np.maximum(np.abs(dqm) - half * k2, 0.0)                    # inf |q'_j| on I_k
     hi = np.abs(dqm) + half * k2                                     # sup |q'_j| on I_k
@@ -189,8 +200,34 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
     S1 = (-(r * w * w) * 2.0 * (0.5 * ds) ** 2 * g)[:, None] * along  # int u q'' du
     I0 = S0 / 4 - S1 / (2 * ds[:, None])
     I1 = S0 / 4 + S1 / (2 * ds[:, None])
+    ierr = np.zeros((N, n))
+    if spi.size:
+        I0[spi], I1[spi], ierr[spi] = _spiral_weights(path, grid, spi, dq0[spi], dq1[spi])
     return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
-                         moving_axes(dq0, ddq0, dq1, ddq1))
+                         moving_axes(dq0, ddq0, dq1, ddq1), ierr)
+
+
+def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
+                    dq1: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``I0, I1`` on spiral intervals ``iv`` by parts, and their round-off bound.
+
+    ``int_0^D q'' (1 - u/D) du = dq/D - q'(0)`` and ``int_0^D q'' u/D du = q'(D) - dq/D``
+    hold for every smooth curve; ``dq`` is the chord of the exact positions. Each position
+    carries at most ``16 eps (|o_j| + r_max (1 + t_end) + |d_j| L)`` of round-off (a few
+    operations on those magnitudes, and the angle to ``4 eps max(t_end, 1)``), so
+    ``|I0| + |I1|`` is off by at most twice that over ``D``. Shapes ``(K, n)``.
+    """
+    seg = grid.segment[iv]
+    D = (grid.s[iv + 1] - grid.s[iv])[:, None]
+    q0 = path.evaluate(grid.s[iv], segment=seg)[0]
+    q1 = path.evaluate(grid.s[iv + 1], segment=seg)[0]
+    chord = (q1 - q0) / D
+    t_end = np.abs(path.omega[seg]) * path.length[seg]
+    r_max = np.maximum(path.radius[seg], path.radius[seg] + path.dradius[seg] * t_end)
+    scale = (np.abs(path.origin[seg]) + (r_max * (1.0 + t_end))[:, None]
+             + np.abs(path.d[seg]) * path.length[seg][:, None])
+    err = 2.0 * 16.0 * np.finfo(np.float64).eps * scale / D
+    return 0.5 * (chord - dq0), 0.5 * (dq1 - chord), err
 
 
 def _slope_bound(geo: _IntervalData, lim: AxisArrays, B: np.ndarray) -> np.ndarray:
@@ -258,7 +295,8 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
         fin = np.isfinite(b_node)
         caps.add(np.flatnonzero(fin), np.maximum(b_node[fin], 0.0), CAP_BOUND)
     margin = np.where(good, slope, 0.0) * ds * ds / 6.0
-    E = np.where(good[:, None], geo.k2 * margin[:, None], np.inf)
+    E = np.where(good[:, None], geo.k2 * margin[:, None]
+                 + geo.ierr * np.where(good, B, 0.0)[:, None], np.inf)
     cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
     for j in geo.axes_used:
         hrow = lim.a_max[j] + E[:, j] / ds

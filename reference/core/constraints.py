@@ -69,8 +69,9 @@ one segment (lines, arcs, helices).
   taken exactly at the interval ends and the stationary point of ``v`` (``s''= 0``).
 * **Arcs and helices**: dense samples, uniform in time, at an angular step of at most
   :data:`ARC_SAMPLE_STEP_RAD` (0.125 deg) *at the interval's peak speed* (so also where
-  the motion is fastest), at least :data:`MIN_ARC_SAMPLES` per sub-interval, plus the
-  stationary point of ``v``. A maximum of a cos-type function sampled at step
+  the motion is fastest; on a spiral at its largest angular rate
+  :attr:`~reference.core.geometry.PlaneAmplitudes.omega_max`), at least
+  :data:`MIN_ARC_SAMPLES` per sub-interval, plus the stationary point of ``v``. A maximum of a cos-type function sampled at step
   ``dphi`` is missed by at most ``1 - cos(dphi/2) <= dphi^2/8`` of its amplitude:
   **5.9e-7 relative** at 0.125 deg, below :data:`RATIO_TOL`. In general the deficit
   is at most ``sup|g''| dtau^2 / 8`` for a quantity ``g(tau)`` sampled at time step
@@ -100,7 +101,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .errors import ProfileError
-from .geometry import Path
+from .geometry import Path, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
 from .rules import (axis_acceleration, axis_jerk, axis_velocity, axis_velocity_jumps,
@@ -462,7 +463,7 @@ def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
     vpk_all, _, _ = _speed_peak(ctx, k_all)
     n_uni = np.where(arc, np.maximum(
         MIN_ARC_SAMPLES,
-        np.ceil(np.abs(path.omega[ctx.seg[k_all]]) * vpk_all * ctx.h[k_all]
+        np.ceil(plane_amplitudes(path).omega_max[ctx.seg[k_all]] * vpk_all * ctx.h[k_all]
                 / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 0)
     # cost: one row per line interval; uniform + stationary + 3 refinement rows per arc
     cost = np.where(arc, n_uni + 4, 1)

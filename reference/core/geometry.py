@@ -15,6 +15,17 @@ extra axis (rotary axes move linearly with the path). The derivatives are exact:
 ``q' = r w (-e1 sin + e2 cos) + d``, ``q'' = -r w^2 (e1 cos + e2 sin)``,
 ``q''' = r w^3 (e1 sin - e2 cos)``.
 
+*Spiral arcs.* An arc whose programmed end radius differs from its start radius (within
+the control's tolerance) is a spiral: the radius changes linearly with the swept angle
+``t = |phi - theta0|``, ``r(t) = r0 + k t`` (``k = dradius``, mm/rad), so the arc ends
+exactly at the programmed point, while the helix axis and every extra axis still move
+as ``d s``. Its in-plane part has the constant speed ``g = |dp/ds|`` (``g^2 + |d_geo|^2
+= 1``) and the exact plane arc length of an Archimedean-type spiral
+(:func:`spiral_plane_length`); ``s -> t`` inverts it by Newton's method
+(:func:`spiral_angle`). ``omega`` then stores the mean rate ``sweep / length``, so
+``|omega| length`` is still the swept angle. A circle is the case ``k = 0`` and is
+evaluated by the closed forms above.
+
 A :class:`Path` stores all pieces as packed arrays (one row per segment) so that
 evaluation at 10^5 points is one vectorised numpy expression.
 
@@ -30,7 +41,7 @@ from typing import Literal
 import numpy as np
 
 from .errors import PathError
-from .tolerances import MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
+from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
 
 SegmentKind = Literal["line", "arc", "rounding", "trc", "tlift"]
 KIND_CODES: tuple[str, ...] = ("line", "arc", "rounding", "trc", "tlift")
@@ -63,6 +74,8 @@ class HelicalSegment:
         Index of the NC block this segment belongs to.
     kind : str
         ``"line"``, ``"arc"``, or the kind of an inserted block.
+    dradius : float
+        Spiral rate ``dr/dt``, mm per rad of swept angle; 0 for lines and circles.
     """
 
     origin: np.ndarray
@@ -75,6 +88,7 @@ class HelicalSegment:
     length: float
     source_block: int
     kind: str = "line"
+    dradius: float = 0.0
 
     def evaluate(self, s: np.ndarray | float) -> tuple[np.ndarray, ...]:
         """Position and its first three derivatives with respect to ``s``.
@@ -93,7 +107,8 @@ class HelicalSegment:
         return _eval_helical(
             self.origin[None], self.e1[None], self.e2[None], self.d[None],
             np.array([self.radius]), np.array([self.omega]), np.array([self.theta0]),
-            np.zeros(len(s), dtype=np.intp), s)
+            np.zeros(len(s), dtype=np.intp), s, np.array([self.dradius]),
+            np.array([self.length]))
 
     @property
     def start_tangent(self) -> np.ndarray:
@@ -126,20 +141,236 @@ class HelicalSegment:
         return self.evaluate(self.length)[0][0]
 
 
-def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s):
-    """Vectorised kernel: rows ``idx`` of the packed arrays at local positions ``s``."""
-    r = radius[idx][:, None]
-    w = omega[idx][:, None]
-    phi = theta0[idx][:, None] + w * s[:, None]
-    c, sn = np.cos(phi), np.sin(phi)
+def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None,
+                  length=None):
+    """Vectorised kernel: rows ``idx`` of the packed arrays at local positions ``s``.
+
+    ``dradius`` and ``length`` (shape ``(m,)``) are needed only when some row is a
+    spiral; without spirals the circle/line closed forms run alone, as fast as before.
+    """
+    r = radius[idx]
+    w = omega[idx]
+    sp = np.flatnonzero(dradius[idx]) if dradius is not None else np.zeros(0, np.intp)
+    if sp.size == 0:
+        rc, wc = r[:, None], w[:, None]
+        phi = theta0[idx][:, None] + wc * s[:, None]
+        c, sn = np.cos(phi), np.sin(phi)
+        E1, E2 = e1[idx], e2[idx]
+        radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
+        along = E2 * c - E1 * sn           # unit tangential direction of the circle
+        q = origin[idx] + rc * radial + d[idx] * s[:, None]
+        dq = (rc * wc) * along + d[idx]
+        ddq = -(rc * wc * wc) * radial
+        dddq = -(rc * wc * wc * wc) * along
+        return q, dq, ddq, dddq
+    # With spirals: q = o + A R + d s, q' = B T + C R + d, q'' = D R + E T,
+    # q''' = F T + G R, per-point coefficients (circle values, spiral rows overwritten).
+    phi = theta0[idx] + w * s
+    A, B, C = r.copy(), r * w, np.zeros_like(r)
+    D, E = -(r * w * w), np.zeros_like(r)
+    F, G = -(r * w * w * w), np.zeros_like(r)
+    rows = idx[sp]
+    ts, phs, (A[sp], B[sp], C[sp], D[sp], E[sp], F[sp], G[sp]) = _spiral_coefficients(
+        radius[rows], omega[rows], theta0[rows], dradius[rows], length[rows], s[sp])
+    phi[sp] = phs
+    c, sn = np.cos(phi)[:, None], np.sin(phi)[:, None]
     E1, E2 = e1[idx], e2[idx]
-    radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
-    along = E2 * c - E1 * sn           # unit tangential direction of the circle
-    q = origin[idx] + r * radial + d[idx] * s[:, None]
-    dq = (r * w) * along + d[idx]
-    ddq = -(r * w * w) * radial
-    dddq = -(r * w * w * w) * along
+    radial = E1 * c + E2 * sn
+    along = E2 * c - E1 * sn
+    q = origin[idx] + A[:, None] * radial + d[idx] * s[:, None]
+    dq = B[:, None] * along + C[:, None] * radial + d[idx]
+    ddq = D[:, None] * radial + E[:, None] * along
+    dddq = F[:, None] * along + G[:, None] * radial
     return q, dq, ddq, dddq
+
+
+def spiral_plane_length(r0: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Exact plane arc length of the spiral ``r = r0 + k tau`` over ``0 <= tau <= t``.
+
+    ``sigma(t) = int_0^t sqrt((r0 + k tau)^2 + k^2) dtau`` has the closed form
+    ``(F(r1) - F(r0)) / k`` with ``F(u) = (u sqrt(u^2 + k^2) + k^2 asinh(u / |k|)) / 2``
+    and ``r1 = r0 + k t``. Both differences are rewritten without cancellation
+    (``u1 S1 - u0 S0 = k t (u0 + u1)(u0^2 + u1^2 + k^2) / (u1 S1 + u0 S0)`` and
+    ``asinh a - asinh b = asinh(a sqrt(1 + b^2) - b sqrt(1 + a^2))``), giving
+
+    ``sigma = [t (u0 + u1)(u0^2 + u1^2 + k^2) / (u1 S1 + u0 S0)
+    + k asinh(k t (u0 + u1) / (u1 S0 + u0 S1))] / 2``, ``S = sqrt(u^2 + k^2)``.
+
+    Every quantity in the first term is a sum, product or quotient of positive numbers
+    and the second term is non-negative (``k asinh(k x)``) and small, so the result has a
+    relative error of a few units of float64 round-off (bound: 20 eps = 4.4e-15, checked
+    against ``scipy.integrate.quad`` in the tests) for every ``k``, also ``k -> 0``,
+    where it tends to ``r0 t``.
+
+    Parameters
+    ----------
+    r0 : numpy.ndarray, shape (N,)
+        Start radius, mm (> 0).
+    k : numpy.ndarray, shape (N,)
+        Radius change per rad of swept angle, mm/rad; ``r0 + k t > 0``.
+    t : numpy.ndarray, shape (N,)
+        Swept angle, rad (>= 0).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Plane arc length, mm.
+    """
+    u0 = r0
+    u1 = r0 + k * t
+    kk = k * k
+    s0 = np.sqrt(u0 * u0 + kk)
+    s1 = np.sqrt(u1 * u1 + kk)
+    ssum = u0 + u1
+    first = t * ssum * (u0 * u0 + u1 * u1 + kk) / (u1 * s1 + u0 * s0)
+    second = k * np.arcsinh(k * t * ssum / (u1 * s0 + u0 * s1))
+    return 0.5 * (first + second)
+
+
+#: Newton steps of :func:`spiral_angle` at most. From its start (error about
+#: (k/r)^2 t) Newton converges quadratically: two or three steps reach round-off.
+_SPIRAL_NEWTON_MAX = 8
+
+
+def spiral_angle(r0: np.ndarray, k: np.ndarray, sigma: np.ndarray,
+                 t_end: np.ndarray) -> np.ndarray:
+    """Swept angle ``t`` at plane arc length ``sigma`` on the spiral ``r = r0 + k t``.
+
+    Inverts :func:`spiral_plane_length` by Newton's method (``dsigma/dt =
+    sqrt(r^2 + k^2) > 0``), started from the root of ``r0 t + k t^2 / 2 = sigma`` (exact
+    up to ``(k/r)^2``), clipped to ``[0, t_end]``. It stops when every step is below four
+    units of round-off of ``max(t_end, 1)``, so ``s -> t`` is consistent with the length
+    to float64 precision: ``|sigma(t) - sigma| <= 4 eps max(t_end, 1) sqrt(r^2 + k^2)``
+    plus the round-off of :func:`spiral_plane_length` (about 1e-15 relative), far below
+    the 1e-9 mm continuity of the path.
+
+    Parameters
+    ----------
+    r0, k : numpy.ndarray, shape (N,)
+        Start radius (mm) and radius change per rad (mm/rad).
+    sigma : numpy.ndarray, shape (N,)
+        Plane arc lengths, mm.
+    t_end : numpy.ndarray, shape (N,)
+        Swept angle of the whole arc, rad.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Swept angles, rad.
+    """
+    disc = np.maximum(r0 * r0 + 2.0 * k * sigma, 0.0)
+    t = np.clip(2.0 * sigma / (r0 + np.sqrt(disc)), 0.0, t_end)
+    stop = 4.0 * np.finfo(np.float64).eps * np.maximum(t_end, 1.0)
+    for _ in range(_SPIRAL_NEWTON_MAX):
+        r = r0 + k * t
+        step = (spiral_plane_length(r0, k, t) - sigma) / np.sqrt(r * r + k * k)
+        t = np.clip(t - step, 0.0, t_end)
+        if np.all(np.abs(step) <= stop):
+            break
+    return t
+
+
+def _spiral_speed(r0, k, omega, length):
+    """In-plane speed ``g = |dp/ds|`` and swept angle of spiral rows, shape (N,)."""
+    t_end = np.abs(omega) * length
+    return spiral_plane_length(r0, k, t_end) / length, t_end
+
+
+def _spiral_coefficients(r0, omega, theta0, k, length, s):
+    """Swept angle, angle and derivative coefficients of spiral rows, each shape (N,).
+
+    With ``p(t) = r(t) R``, ``R = e1 cos phi + e2 sin phi``, ``T = dR/dphi``,
+    ``phi = theta0 + e t`` (``e = sign(omega)``) and the arc-length map ``t(s)``
+    (``t1 = dt/ds = g / S``, ``S = sqrt(r^2 + k^2)``, ``t2 = -g^2 r k / S^4``,
+    ``t3 = -g^3 k^2 (k^2 - 3 r^2) / S^7``), from ``p_t = k R + e r T``,
+    ``p_tt = 2 e k T - r R`` and ``p_ttt = -3 k R - e r T``:
+    ``q' = p_t t1 + d``, ``q'' = p_tt t1^2 + p_t t2``,
+    ``q''' = p_ttt t1^3 + 3 p_tt t1 t2 + p_t t3``. Returned as the coefficients
+    ``A .. G`` of :func:`_eval_helical`.
+    """
+    g, t_end = _spiral_speed(r0, k, omega, length)
+    e = np.where(omega < 0, -1.0, 1.0)
+    t = spiral_angle(r0, k, g * s, t_end)
+    r = r0 + k * t
+    kk = k * k
+    S2 = r * r + kk
+    S = np.sqrt(S2)
+    t1 = g / S
+    t2 = -(g * g) * r * k / (S2 * S2)
+    t3 = -(g * g * g) * kk * (kk - 3.0 * r * r) / (S2 * S2 * S2 * S)
+    t11 = t1 * t1
+    t111 = t11 * t1
+    A = r
+    B, C = e * r * t1, k * t1
+    D, E = -r * t11 + k * t2, e * (2.0 * k * t11 + r * t2)
+    F = e * (-r * t111 + 6.0 * k * t1 * t2 + r * t3)
+    G = -3.0 * k * t111 - 3.0 * r * t1 * t2 + k * t3
+    return t, theta0 + e * t, (A, B, C, D, E, F, G)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlaneAmplitudes:
+    """Per segment, suprema over the segment of the in-plane (rotating) motion.
+
+    For an axis ``j`` with plane weight ``rho_j = sqrt(e1_j^2 + e2_j^2)``:
+    ``|q'_j| <= |d_j| + rho_j speed``, ``|q''_j| <= rho_j curvature`` and
+    ``|q'''_j| <= rho_j hypot(jerk_t, jerk_n)``. The in-plane tangent has the constant
+    length ``speed``, ``q''`` is normal to it, ``jerk_t`` bounds the tangential and
+    ``jerk_n`` the normal part of ``q'''``. On circles these are the exact constants
+    ``r|w|``, ``r w^2``, ``r|w|^3``, 0 and ``omega_max = |w|``. On spirals (``r`` from
+    ``r_min`` to ``r_max``; the plane curvature ``kappa(r) = (r^2 + 2k^2) /
+    (r^2 + k^2)^{3/2}`` falls as ``r`` grows): ``speed = g``, ``curvature =
+    g^2 kappa(r_min)``, ``jerk_t = g^3 kappa(r_min)^2``, ``jerk_n = g^3 |k| r_max
+    (r_max^2 + 4k^2) / (r_min^2 + k^2)^3 >= g^3 |dkappa/dsigma|`` and ``omega_max =
+    g / sqrt(r_min^2 + k^2) >= |dphi/ds|``. Lines have zeros.
+
+    Attributes
+    ----------
+    speed, curvature, jerk_t, jerk_n : numpy.ndarray, shape (m,)
+        1, 1/mm, 1/mm^2, 1/mm^2.
+    omega_max : numpy.ndarray, shape (m,)
+        Largest angular rate ``|dphi/ds|``, rad/mm.
+    """
+
+    speed: np.ndarray
+    curvature: np.ndarray
+    jerk_t: np.ndarray
+    jerk_n: np.ndarray
+    omega_max: np.ndarray
+
+
+def plane_amplitudes(path: "Path") -> PlaneAmplitudes:
+    """Suprema of the in-plane motion of every segment (see :class:`PlaneAmplitudes`).
+
+    Parameters
+    ----------
+    path : Path
+
+    Returns
+    -------
+    PlaneAmplitudes
+    """
+    r, w = path.radius, path.omega
+    speed = np.abs(r * w)
+    curvature = np.abs(r * w * w)
+    jerk_t = np.abs(r * w ** 3)
+    jerk_n = np.zeros_like(r)
+    omega_max = np.abs(w)
+    sp = np.flatnonzero(path.dradius)
+    if sp.size:
+        r0, k = r[sp], path.dradius[sp]
+        g, t_end = _spiral_speed(r0, k, w[sp], path.length[sp])
+        r1 = r0 + k * t_end
+        rmin, rmax = np.minimum(r0, r1), np.maximum(r0, r1)
+        kk = k * k
+        smin2 = rmin * rmin + kk
+        kappa = (rmin * rmin + 2.0 * kk) / (smin2 * np.sqrt(smin2))
+        speed[sp] = g
+        curvature[sp] = g * g * kappa
+        jerk_t[sp] = g ** 3 * kappa * kappa
+        jerk_n[sp] = g ** 3 * np.abs(k) * rmax * (rmax * rmax + 4.0 * kk) / smin2 ** 3
+        omega_max[sp] = g / np.sqrt(smin2)
+    return PlaneAmplitudes(speed, curvature, jerk_t, jerk_n, omega_max)
 
 
 def _path_length(delta: np.ndarray, geometry: np.ndarray) -> np.ndarray:
@@ -178,14 +409,20 @@ def line_segments(starts: np.ndarray, ends: np.ndarray, geometry: np.ndarray,
     return dict(origin=starts, e1=zeros, e2=zeros.copy(), d=d, radius=np.zeros(m),
                 omega=np.zeros(m), theta0=np.zeros(m), length=length,
                 block=np.asarray(blocks, dtype=np.int64),
-                kind=np.zeros(m, dtype=np.int8))
+                kind=np.zeros(m, dtype=np.int8), dradius=np.zeros(m))
 
 
 def arc_segments(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray,
                  e1: np.ndarray, e2: np.ndarray, clockwise: np.ndarray, turns: np.ndarray,
                  geometry: np.ndarray, blocks: np.ndarray, radius_tol: np.ndarray
                  ) -> dict[str, np.ndarray]:
-    """Packed parameters of many circular arcs or helices at once (vectorised).
+    """Packed parameters of many circular or spiral arcs or helices at once (vectorised).
+
+    An arc whose end radius differs from its start radius by more than
+    :data:`ARC_SPIRAL_MIN_MM` (and at most ``radius_tol``) becomes a spiral whose radius
+    changes linearly with the swept angle, so it ends exactly at ``ends`` (as the controls
+    interpolate it); see the module docstring. Otherwise it is the circle on the start
+    radius.
 
     Parameters
     ----------
@@ -209,7 +446,7 @@ def arc_segments(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray,
     Returns
     -------
     dict
-        Packed arrays for the ``m`` arcs.
+        Packed arrays for the ``m`` arcs (``dradius`` non-zero on spirals).
 
     Raises
     ------
@@ -232,9 +469,14 @@ def arc_segments(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray,
             f"arc start radius {r0[i]:.6g} mm and end radius {r1[i]:.6g} mm differ by "
             f"{abs(r1[i] - r0[i]):.3g} mm (> {radius_tol[i]:.3g} mm)", int(blocks[i]))
     th0, th1 = np.arctan2(sv, su), np.arctan2(ev, eu)
+    spiral = np.abs(r1 - r0) > ARC_SPIRAL_MIN_MM
     # Direction decides the sweep; an arc ending where it started (in the plane) is a
     # full turn, as both dialects define it.
     closed = np.hypot(eu - su, ev - sv) <= POS_TOL_MM
+    if spiral.any():
+        # a spiral that ends on its start ray (only the radius differs) is a full turn too
+        turn = np.abs(np.remainder(th1 - th0 + np.pi, 2 * np.pi) - np.pi)
+        closed |= spiral & (r0 * turn <= POS_TOL_MM)
     two_pi = 2 * np.pi
     sweep = np.where(clockwise, np.where(closed, -two_pi, -((th0 - th1) % two_pi)),
                      np.where(closed, two_pi, (th1 - th0) % two_pi))
@@ -243,19 +485,27 @@ def arc_segments(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray,
     lin = (delta - np.sum(delta * e1, axis=1)[:, None] * e1
            - np.sum(delta * e2, axis=1)[:, None] * e2)
     geo_lin = np.sqrt(np.sum(lin[:, geometry] ** 2, axis=1))
-    length = np.hypot(r0 * sweep, geo_lin)
+    plane_len = r0 * sweep
+    dradius = np.zeros(r0.size)
+    if spiral.any():
+        i = np.flatnonzero(spiral)
+        t_end = np.abs(sweep[i])
+        dradius[i] = (r1[i] - r0[i]) / t_end
+        plane_len[i] = spiral_plane_length(r0[i], dradius[i], t_end)
+    length = np.hypot(plane_len, geo_lin)
     origin = starts - r0[:, None] * (np.cos(th0)[:, None] * e1 + np.sin(th0)[:, None] * e2)
     return dict(origin=origin, e1=np.array(e1, dtype=np.float64),
                 e2=np.array(e2, dtype=np.float64), d=lin / length[:, None], radius=r0,
                 omega=sweep / length, theta0=th0, length=length,
                 block=np.asarray(blocks, dtype=np.int64),
-                kind=np.full(r0.size, KIND_CODES.index("arc"), dtype=np.int8))
+                kind=np.full(r0.size, KIND_CODES.index("arc"), dtype=np.int8),
+                dradius=dradius)
 
 
 def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
                 plane, clockwise: bool, turns: int,
                 geometry: np.ndarray, block: int, radius_tol: float) -> dict[str, np.ndarray]:
-    """Packed parameters of one circular arc or helix (see :func:`arc_segments`).
+    """Packed parameters of one circular or spiral arc or helix (see :func:`arc_segments`).
 
     Parameters
     ----------
@@ -283,7 +533,8 @@ def arc_segment(start: np.ndarray, end: np.ndarray, center: np.ndarray,
     Raises
     ------
     PathError
-        Zero radius, or start and end radius differing by more than ``radius_tol``.
+        Zero radius, or start and end radius differing by more than ``radius_tol``
+        (a smaller difference gives a spiral ending at ``end``).
     """
     start = np.asarray(start, dtype=np.float64)
     n = start.size
@@ -362,7 +613,8 @@ class Path:
     origin, e1, e2, d : numpy.ndarray, shape (m, n)
         Packed helical parameters (see module docstring).
     radius, omega, theta0, length : numpy.ndarray, shape (m,)
-        Packed helical parameters; ``length`` in mm.
+        Packed helical parameters; ``length`` in mm. On spirals ``radius`` is the start
+        radius and ``omega`` the mean angular rate ``sweep / length``.
     block : numpy.ndarray of int, shape (m,)
         Source NC block of each segment.
     kind : numpy.ndarray of int8, shape (m,)
@@ -380,6 +632,9 @@ class Path:
         One span per NC block of the program, in program order (zero-length blocks too).
     source : str
         Program file the path was built from.
+    dradius : numpy.ndarray, shape (m,)
+        Spiral rate ``dr/dt``, mm per rad of swept angle (0 for lines and circles; the
+        default ``None`` means all zero).
     """
 
     axes: tuple[str, ...]
@@ -401,11 +656,14 @@ class Path:
     stop_reason: tuple[str, ...]
     blocks: tuple[BlockSpan, ...]
     source: str = ""
+    dradius: np.ndarray | None = None
     s_breaks: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
+        if self.dradius is None:
+            object.__setattr__(self, "dradius", np.zeros(np.shape(self.length)))
         for name in ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length",
-                     "feed"):
+                     "feed", "dradius"):
             object.__setattr__(self, name, _readonly(getattr(self, name)))
         for name in ("geometry", "rotary", "rapid", "stop"):
             a = np.ascontiguousarray(getattr(self, name), dtype=bool)
@@ -449,7 +707,8 @@ class Path:
             origin=self.origin[i], e1=self.e1[i], e2=self.e2[i], d=self.d[i],
             radius=float(self.radius[i]), omega=float(self.omega[i]),
             theta0=float(self.theta0[i]), length=float(self.length[i]),
-            source_block=int(self.block[i]), kind=KIND_CODES[int(self.kind[i])])
+            source_block=int(self.block[i]), kind=KIND_CODES[int(self.kind[i])],
+            dradius=float(self.dradius[i]))
 
     @property
     def segments(self) -> tuple[HelicalSegment, ...]:
@@ -499,7 +758,7 @@ class Path:
         idx = self.segment_index(s, side) if segment is None else np.asarray(segment)
         local = s - self.s_breaks[idx]
         return _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                             self.omega, self.theta0, idx, local)
+                             self.omega, self.theta0, idx, local, self.dradius, self.length)
 
     def junction_tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """Tangents on both sides of every interior break.
@@ -516,9 +775,11 @@ class Path:
         idx_in = np.arange(m - 1)
         idx_out = idx_in + 1
         _, t_in, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                      self.omega, self.theta0, idx_in, self.length[:-1])
+                                      self.omega, self.theta0, idx_in, self.length[:-1],
+                                      self.dradius, self.length)
         _, t_out, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                       self.omega, self.theta0, idx_out, np.zeros(m - 1))
+                                       self.omega, self.theta0, idx_out, np.zeros(m - 1),
+                                       self.dradius, self.length)
         return t_in, t_out
 
     def junction_curvatures(self) -> tuple[np.ndarray, np.ndarray]:
@@ -529,9 +790,11 @@ class Path:
             return z, z
         idx_in = np.arange(m - 1)
         _, _, k_in, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                      self.omega, self.theta0, idx_in, self.length[:-1])
+                                      self.omega, self.theta0, idx_in, self.length[:-1],
+                                      self.dradius, self.length)
         _, _, k_out, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                       self.omega, self.theta0, idx_in + 1, np.zeros(m - 1))
+                                       self.omega, self.theta0, idx_in + 1, np.zeros(m - 1),
+                                       self.dradius, self.length)
         return k_in, k_out
 
     def block_of(self, s: np.ndarray | float) -> np.ndarray:
@@ -572,10 +835,12 @@ def path_from_pieces(axes: tuple[str, ...], pieces: list[dict[str, np.ndarray]],
     -------
     Path
     """
-    keys = ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length", "block", "kind")
+    keys = ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length", "block", "kind",
+            "dradius")
     n = len(axes)
     if pieces:
-        packed = {k: np.concatenate([p[k] for p in pieces]) for k in keys}
+        packed = {k: np.concatenate([p[k] if k in p else np.zeros(p["length"].shape)
+                                     for p in pieces]) for k in keys}
     else:
         packed = {k: np.zeros((0, n)) if k in ("origin", "e1", "e2", "d") else np.zeros(0)
                   for k in keys}

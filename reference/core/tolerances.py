@@ -32,6 +32,14 @@ ARC_RADIUS_TOL_MM = 0.002
 #: the accepted difference is max(ARC_RADIUS_TOL_MM, ARC_RADIUS_REL_TOL * radius).
 ARC_RADIUS_REL_TOL = 1e-3
 
+#: An arc whose start and end radius differ by more than this (and within the tolerance
+#: above) is built as a spiral ending at the programmed point; below it, as the circle on
+#: the start radius, which then ends at most this far off, mm. 1e-10 mm is ten times
+#: below the 1e-9 mm to which consecutive segments must meet, and above the float64
+#: round-off of a radius computed from coordinates of up to 10 m (about 1e-11 mm), so
+#: exact arcs stay circles.
+ARC_SPIRAL_MIN_MM = 1e-10
+
 #: A constraint counts as violated when value/limit exceeds 1 + RATIO_TOL. 1e-6 is
 #: above the float64 round-off of the checker's own arithmetic (about 1e-12) and of
 #: solvers' primal feasibility (1e-8 scaled) yet small enough that no real excess hides.

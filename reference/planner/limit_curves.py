@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.geometry import Path
+from ..core.geometry import Path, plane_amplitudes
 from ..machine import Machine
 from . import causes as C
 from ..core.tolerances import MOVING_AXIS_TOL
@@ -77,7 +77,14 @@ class SegmentLimits:
 
 
 def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
-    """(D, P, Q, R), each shape (m, n): constant tangent part and rotating amplitudes."""
+    """(D, P, Q, R, Rn), each shape (m, n): constant tangent part and rotating amplitudes.
+
+    ``P``, ``Q``: in-plane tangent and curvature; ``R``, ``Rn``: tangential and normal
+    parts of the third derivative. On circles they are constant (``Rn = 0``); on spirals
+    the curvature varies along the arc and these are its worst values over the segment
+    (:func:`~reference.core.geometry.plane_amplitudes`), so every cap derived from them
+    holds on the whole spiral.
+    """
     rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
     rw = np.abs(path.radius * path.omega)[:, None]
     w = np.abs(path.omega)[:, None]
@@ -85,7 +92,15 @@ def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
     P = rho * rw
     Q = P * w
     R = Q * w
-    return D, P, Q, R
+    Rn = np.zeros_like(R)
+    sp = np.flatnonzero(path.dradius)
+    if sp.size:
+        amp = plane_amplitudes(path)
+        P[sp] = rho[sp] * amp.speed[sp, None]
+        Q[sp] = rho[sp] * amp.curvature[sp, None]
+        R[sp] = rho[sp] * amp.jerk_t[sp, None]
+        Rn[sp] = rho[sp] * amp.jerk_n[sp, None]
+    return D, P, Q, R, Rn
 
 
 def _axis_factors(path: Path, machine: Machine, modes: SegmentModes):
@@ -120,10 +135,11 @@ def _accel_at(cap, A, D, P, Q, moving):
     return a.min(axis=1)
 
 
-def _jerk_at(cap, acc, J, D, P, Q, R, moving):
-    """Largest j with D j + sqrt((P j + M)^2 + N^2) <= J, M = R cap^3, N = 3 Q cap acc."""
+def _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving):
+    """Largest j with D j + sqrt((P j + M)^2 + N^2) <= J, M = R cap^3,
+    N = 3 Q cap acc + Rn cap^3 (``Rn``: normal jerk from a spiral's varying curvature)."""
     M = R * (cap ** 3)[:, None]
-    N = 3.0 * Q * (cap * acc)[:, None]
+    N = 3.0 * Q * (cap * acc)[:, None] + Rn * (cap ** 3)[:, None]
     rest = np.maximum(J * J - M * M - N * N, 0.0)
     b = P * M + J * D
     disc = np.maximum(b * b + (P * P - D * D) * rest, 0.0)
@@ -153,7 +169,7 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     """
     m = path.n_segments
     lim, A, J = _axis_factors(path, machine, modes)
-    D, P, Q, R = axis_amplitudes(path)
+    D, P, Q, R, Rn = axis_amplitudes(path)
     moving = (D + P) > MOVING_AXIS_TOL
     inf = np.full(m, np.inf)
     soft = modes.jerk_limited
@@ -161,8 +177,9 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
         v_axis = np.where(moving, lim.v_max[None, :] / (D + P), np.inf).min(axis=1)
         v_cent = np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A / np.where(
             Q > 0, Q, 1.0)), np.inf).min(axis=1)
-        v_jerk = np.where(R > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
-            R > 0, R, 1.0)), np.inf).min(axis=1)
+        R3 = np.hypot(R, Rn)            # third-derivative amplitude (= R on circles)
+        v_jerk = np.where(R3 > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
+            R3 > 0, R3, 1.0)), np.inf).min(axis=1)
     v_jerk = np.where(soft, v_jerk, inf)
     v_ipo = path.length / machine.limits.t_ipo_s
     cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
@@ -175,7 +192,7 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
             3.0 * np.where(Q > 0, Q, 1.0) * np.maximum(cap, 1e-300)[:, None]), np.inf
         ).min(axis=1)
     acc = np.where(soft, np.minimum(acc, a_j), acc)
-    jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, moving), inf)
+    jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving), inf)
     freq = np.where(moving, lim.frequency_hz[None, :], np.inf).min(axis=1)
     return SegmentLimits(cap=cap, cap_cause=cause, accel=acc, jerk=jerk, frequency=freq,
                          moving=moving)

@@ -9,8 +9,9 @@ from reference.core import AxisLimits, MachineLimits, Profile, path_from_pieces
 from reference.core.constraints import check_profile
 from reference.core.errors import NCSyntaxError, PathError
 from reference.core.geometry import arc_segment, line_segments
-from reference.core.tolerances import (ARC_RADIUS_TOL_MM, MIN_SEGMENT_LENGTH_MM, RATIO_TOL,
-                                       TANGENT_TOL_RAD, VEL_TOL_MM_S)
+from reference.core.tolerances import (ARC_RADIUS_TOL_MM, ARC_SPIRAL_MIN_MM,
+                                       MIN_SEGMENT_LENGTH_MM, RATIO_TOL, TANGENT_TOL_RAD,
+                                       VEL_TOL_MM_S)
 from reference.nc import parse_text
 from reference.prepare import prepare
 
@@ -36,6 +37,18 @@ def test_arc_radius_tolerance(factor, ok):
     else:
         with pytest.raises(NCSyntaxError, match="differ by"):
             parse_text(text, "t.mpf")
+
+
+@pytest.mark.parametrize("factor, spiral", [(0.5, False), (1.5, True)])
+def test_spiral_threshold(factor, spiral):
+    r = 1.0
+    end = np.array([0.0, r + factor * ARC_SPIRAL_MIN_MM, 0.0])
+    p = path_from_pieces(AX, [arc_segment(np.array([r, 0, 0.0]), end, np.zeros(3), (0, 1),
+                                          False, 0, GEO, 0, ARC_RADIUS_TOL_MM)])
+    assert bool(p.dradius[0] != 0) is spiral
+    # a circle ends at most ARC_SPIRAL_MIN_MM off; a spiral ends on the point
+    gap = np.abs(p.segment(0).end - end).max()
+    assert gap <= (1e-15 if spiral else ARC_SPIRAL_MIN_MM)
 
 
 @pytest.mark.parametrize("factor, segments", [(0.5, 1), (1.5, 2)])
