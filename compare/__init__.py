@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 #: Public name -> module that defines it.
 _EXPORTS = {
-    "BlockRow": "compare.comparison", "Comparison": "compare.comparison",
+    "ComparedBlock": "compare.comparison", "Comparison": "compare.comparison",
     "OracleResult": "compare.comparison", "Side": "compare.comparison",
     "Verdict": "compare.comparison", "compare": "compare.comparison",
     "compare_profiles": "compare.comparison", "format_interval": "compare.comparison",
@@ -56,7 +56,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for type checkers and editors; at run time names load on first use
     from .cli import main
-    from .comparison import (BlockRow, Comparison, OracleResult, Side, Verdict, compare,
+    from .comparison import (ComparedBlock, Comparison, OracleResult, Side, Verdict, compare,
                              compare_profiles, format_interval, oracle_result)
     from .export import blocks_csv, comparison_dict, write_json
     from .pipeline import (Inputs, OptimizeResult, check_trajectory, compare_program,

@@ -20,7 +20,7 @@ Per program
     :func:`check_profile` finds in either profile under the bound set that side
     declares. A program whose optimal motion time is 0 (only holds) has gap 0 when the
     planner adds no motion time either.
-Per NC block (one :class:`BlockRow` per :class:`~reference.core.geometry.BlockSpan`,
+Per NC block (one :class:`ComparedBlock` per :class:`~reference.core.geometry.BlockSpan`,
 inserted blocks on their own rows, attributed to the corner they replace)
     length, time on each side (holds included), the block's hold and its cause
     (``dwell``, ``exact stop settle``), entry/exit/peak speeds, the gap
@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 import numpy as np
 
@@ -53,9 +53,15 @@ from reference.core.geometry import BlockSpan, Path
 from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
+from reference.core.rows import BlockMotion, BlockRow, block_motion
 from reference.core.tolerances import RATIO_TOL
 
 from .causes import derive_causes
+
+if TYPE_CHECKING:                 # annotations only: the heuristic and oracle stay unloaded
+    from optimal import OptimalSolution
+    from reference.nc.program import Program
+    from reference.planner import ReferencePlan
 
 #: Kinds of blocks the planner inserts (they have no NC line of their own).
 INSERTED_KINDS = ("rounding", "trc", "tlift")
@@ -132,72 +138,66 @@ class OracleResult:
 
 
 @dataclass(frozen=True, slots=True)
-class BlockRow:
-    """One NC block (or inserted block) of the comparison.
+class ComparedBlock:
+    """One NC block (or inserted block) of the comparison: the two sides' rows of the one
+    row model (:class:`reference.core.rows.BlockRow`) side by side, and what relates them.
 
     Attributes
     ----------
-    block : int
-        Block index (``BlockSpan.block``).
-    line : int
-        1-based source line (for an inserted block: the line of the block ending at
-        its corner).
-    label : str
-        Block number or label as written, ``""`` if none.
-    kind : str
-        ``"G0"``, ``"G1"``, ``"G2"``, ``"G3"``, ``"none"`` or an inserted kind.
+    reference, oracle : BlockRow
+        Each side's row (the oracle's with ``nan`` speeds and times when it has no
+        profile). Both carry the block's identity (``block``, ``line``: for an inserted
+        block the line of the block ending at its corner, ``label``, ``kind``,
+        ``length_mm``), its time with the imposed hold included, speeds and cause.
     source : str
         Source text of the line (``""`` for inserted blocks).
     corner : tuple[int, int] or None
         For an inserted block: the source lines of the two blocks whose corner it
         replaces; ``None`` otherwise.
-    s_start, length_mm : float
-        Path position of the block start and its length, mm.
-    t_reference_s, t_oracle_s : float
-        Time spent in the block, s (its hold included).
-    v_entry_reference, v_exit_reference, v_peak_reference : float
-        Path speeds, mm/s.
-    v_entry_oracle, v_exit_oracle, v_peak_oracle : float
-        Path speeds, mm/s.
-    limit_reference, limit_oracle : str
-        Limiting cause on each side (see :data:`reference.core.causes.CAUSES`).
+    s_start : float
+        Path position of the block start, mm.
     ratio_reference, ratio_oracle : float
         Worst ratio value/limit in the block over the side's declared constraints.
     stop_reason : str
         Why the motion rests at the block end (``""`` if it need not).
     note : str
         Explanation of a negative or unresolved gap, ``""`` otherwise.
-    hold_s : float
-        The block's imposed hold (dwell, exact-stop settle), s: part of both block
-        times, not of the gap.
     hold_cause : str
         ``"dwell"``, ``"exact stop settle"`` or ``""`` (no hold).
+
+    The flat names of the JSON and CSV contract (``t_reference_s``, ``v_exit_oracle``,
+    ``limit_reference``, ``hold_s``, ...) are properties reading the two rows.
     """
 
-    block: int
-    line: int
-    label: str
-    kind: str
+    reference: BlockRow
+    oracle: BlockRow
     source: str
     corner: tuple[int, int] | None
     s_start: float
-    length_mm: float
-    t_reference_s: float
-    t_oracle_s: float
-    v_entry_reference: float
-    v_exit_reference: float
-    v_peak_reference: float
-    v_entry_oracle: float
-    v_exit_oracle: float
-    v_peak_oracle: float
-    limit_reference: str
-    limit_oracle: str
     ratio_reference: float
     ratio_oracle: float
     stop_reason: str = ""
     note: str = ""
-    hold_s: float = 0.0
     hold_cause: str = ""
+
+    # identity and the contract's flat names
+    block = property(lambda self: self.reference.block, doc="Block index.")
+    line = property(lambda self: self.reference.line, doc="1-based source line.")
+    label = property(lambda self: self.reference.label, doc="Block number or label.")
+    kind = property(lambda self: self.reference.kind, doc="G0, G1, ... or inserted kind.")
+    length_mm = property(lambda self: self.reference.length_mm, doc="Block length, mm.")
+    hold_s = property(lambda self: self.reference.hold_s,
+                      doc="Imposed hold in the block, s (in both times, never in the gap).")
+    t_reference_s = property(lambda self: self.reference.time_s, doc="s")
+    t_oracle_s = property(lambda self: self.oracle.time_s, doc="s")
+    v_entry_reference = property(lambda self: self.reference.v_entry, doc="mm/s")
+    v_exit_reference = property(lambda self: self.reference.v_exit, doc="mm/s")
+    v_peak_reference = property(lambda self: self.reference.v_peak, doc="mm/s")
+    v_entry_oracle = property(lambda self: self.oracle.v_entry, doc="mm/s")
+    v_exit_oracle = property(lambda self: self.oracle.v_exit, doc="mm/s")
+    v_peak_oracle = property(lambda self: self.oracle.v_peak, doc="mm/s")
+    limit_reference = property(lambda self: self.reference.cause, doc="cause word")
+    limit_oracle = property(lambda self: self.oracle.cause, doc="cause word")
 
     @property
     def inserted(self) -> bool:
@@ -240,7 +240,7 @@ class Comparison:
         The machine limits.
     reference_profile : Profile
         The planner's motion.
-    rows : tuple[BlockRow, ...]
+    rows : tuple[ComparedBlock, ...]
         One per block span, in path order.
     reference_report, oracle_report : ConstraintReport or None
         ``check_profile`` of each profile (``None`` for a missing oracle profile).
@@ -260,7 +260,7 @@ class Comparison:
     path: Path
     limits: MachineLimits
     reference_profile: Profile
-    rows: tuple[BlockRow, ...]
+    rows: tuple[ComparedBlock, ...]
     reference_report: ConstraintReport
     oracle_report: ConstraintReport | None
     notes: tuple[str, ...] = ()
@@ -335,7 +335,7 @@ class Comparison:
             return ()
         return self.oracle_report.violations(BOUND_SETS[self.oracle.bounds])
 
-    def worst_blocks(self, n: int = 5) -> tuple[BlockRow, ...]:
+    def worst_blocks(self, n: int = 5) -> tuple[ComparedBlock, ...]:
         """The ``n`` rows with the largest positive block gap, largest first."""
         rows = [r for r in self.rows if r.gap_s > GAP_ABS_TOL_S]
         return tuple(sorted(rows, key=lambda r: -r.gap_s)[:n])
@@ -454,47 +454,6 @@ def block_span(path: Path, block: int) -> BlockSpan | None:
     return None
 
 
-def block_speeds(path: Path, profile: Profile) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Entry, exit and peak path speed of every block span.
-
-    Parameters
-    ----------
-    path : Path
-    profile : Profile
-
-    Returns
-    -------
-    v_entry, v_exit, v_peak : numpy.ndarray, shape (len(path.blocks),)
-        mm/s, in ``path.blocks`` order. Entry is the speed on leaving the block start
-        (after any hold there), exit the speed on arriving at its end.
-    """
-    spans = path.blocks
-    cuts = [b.s_end for b in spans if b.s_end > b.s_start]
-    prof = profile.split_at(cuts)
-    s0 = np.array([b.s_start for b in spans])
-    s1 = np.array([b.s_end for b in spans])
-    K = prof.n_intervals
-    k_dep = np.clip(np.searchsorted(prof.s, s0, side="right") - 1, 0, prof.s.size - 1)
-    k_arr = np.clip(np.searchsorted(prof.s, s1, side="left"), 0, prof.s.size - 1)
-    v_entry, v_exit = prof.v[k_dep], prof.v[k_arr]
-    # peak: knots and stationary points of v inside each interval, per block
-    h = np.diff(prof.t)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ts = np.where(prof.j != 0, -prof.a / np.where(prof.j != 0, prof.j, 1.0), -1.0)
-    inside = (ts > 0) & (ts < h)
-    ts = np.where(inside, ts, 0.0)
-    v_in = np.where(inside, prof.v[:-1] + prof.a * ts + prof.j * ts ** 2 / 2, 0.0)
-    v_int = np.maximum(np.maximum(prof.v[:-1], prof.v[1:]), v_in) if K else np.zeros(0)
-    blk = prof.interval_blocks(path)
-    n_blocks = max(b.block for b in spans) + 1 if spans else 0
-    peak = np.zeros(n_blocks)
-    if K:
-        np.maximum.at(peak, blk, v_int)
-    idx = np.array([b.block for b in spans], dtype=np.int64)
-    v_peak = np.maximum(peak[idx], np.maximum(v_entry, v_exit))
-    return v_entry, v_exit, v_peak
-
-
 def _corners(path: Path) -> dict[int, tuple[int, int]]:
     """Inserted spans -> (line before, line after) of the corner they replace."""
     spans = path.blocks
@@ -582,13 +541,14 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
 
     spans = path.blocks
     idx = np.array([b.block for b in spans], dtype=np.int64)
-    t_ref = ref_prof.block_times(path)[idx] if spans else np.zeros(0)
-    ve_r, vx_r, vp_r = block_speeds(path, ref_prof) if spans else (np.zeros(0),) * 3
-    if opt_prof is not None and spans:
-        t_opt = opt_prof.block_times(path)[idx]
-        ve_o, vx_o, vp_o = block_speeds(path, opt_prof)
+    mot_r = block_motion(path, ref_prof)
+    if opt_prof is not None:
+        mot_o = block_motion(path, opt_prof)
     else:
-        t_opt = ve_o = vx_o = vp_o = np.full(len(spans), math.nan)
+        nan = np.full(len(spans), math.nan)
+        mot_o = BlockMotion(nan, nan, nan, nan)
+    t_ref, t_opt = mot_r.time_s, mot_o.time_s
+    ve_r, vx_r, ve_o, vx_o = mot_r.v_entry, mot_r.v_exit, mot_o.v_entry, mot_o.v_exit
 
     by_block = {b.block: b for b in spans}
     jerk_ref = "jerk" in BOUND_SETS[reference.bound_set]
@@ -630,16 +590,18 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         if hold_cause and sp.n_segments == 0:
             # a block that only waits: its time is the hold on every side
             lim_r = lim_o = hold_cause
-        rows.append(BlockRow(
-            block=sp.block, line=max(1, line), label=sp.label, kind=sp.kind,
+        ident = dict(block=sp.block, line=max(1, line), label=sp.label, kind=sp.kind,
+                     length_mm=sp.length, hold_s=hold)
+        rows.append(ComparedBlock(
+            reference=BlockRow(**ident, time_s=float(mot_r.time_s[i]),
+                               v_entry=float(mot_r.v_entry[i]), v_exit=float(mot_r.v_exit[i]),
+                               v_peak=float(mot_r.v_peak[i]), cause=lim_r),
+            oracle=BlockRow(**ident, time_s=float(mot_o.time_s[i]),
+                            v_entry=float(mot_o.v_entry[i]), v_exit=float(mot_o.v_exit[i]),
+                            v_peak=float(mot_o.v_peak[i]), cause=lim_o),
             source=source.strip(), corner=corner, s_start=sp.s_start,
-            length_mm=sp.length, t_reference_s=float(t_ref[i]), t_oracle_s=float(t_opt[i]),
-            v_entry_reference=float(ve_r[i]), v_exit_reference=float(vx_r[i]),
-            v_peak_reference=float(vp_r[i]), v_entry_oracle=float(ve_o[i]),
-            v_exit_oracle=float(vx_o[i]), v_peak_oracle=float(vp_o[i]),
-            limit_reference=lim_r, limit_oracle=lim_o,
             ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
-            stop_reason=sp.stop_reason, note=note, hold_s=hold, hold_cause=hold_cause))
+            stop_reason=sp.stop_reason, note=note, hold_cause=hold_cause))
 
     all_notes = list(notes)
     if not set(BOUND_SETS[reference.bound_set]) <= set(BOUND_SETS.get(oracle.bounds, ())):
@@ -680,37 +642,26 @@ def _block_cause(label: str, span: BlockSpan | None = None) -> str:
                       span is not None and span.n_segments == 0)
 
 
-def oracle_result(solution, bounds: str = "acc") -> OracleResult:
-    """The :class:`OracleResult` of an ``optimal.OptimalSolution``."""
-    status = getattr(solution.status, "value", solution.status)
-    causes = {int(b.block): str(b.limit_oracle) for b in getattr(solution, "blocks", ())}
-    total = getattr(solution, "total_time_s", None)
-    return OracleResult(status=str(status), profile=solution.profile,
+def oracle_result(solution: OptimalSolution, bounds: str = "acc") -> OracleResult:
+    """The :class:`OracleResult` of an :class:`optimal.OptimalSolution`."""
+    causes = {int(b.block): str(b.cause) for b in solution.blocks}
+    return OracleResult(status=str(solution.status.value), profile=solution.profile,
                         lower_bound_s=float(solution.lower_bound_s),
                         upper_bound_s=float(solution.upper_bound_s), bounds=bounds,
-                        solve_time_s=float(total if total is not None else solution.solve_time_s),
+                        solve_time_s=float(solution.total_time_s),
                         grid_points=int(solution.grid_points), causes=causes or None,
-                        holds=getattr(solution, "holds", NO_HOLDS))
+                        holds=solution.holds)
 
 
-def reference_side(plan) -> Side:
-    """The :class:`Side` of a ``reference.planner.ReferencePlan``."""
-    causes = {}
-    for row in getattr(plan, "blocks", ()) or ():
-        blk = getattr(row, "block", None)
-        cause = None
-        for name in ("limit", "limit_cause", "cause", "limit_reference"):
-            cause = getattr(row, name, None)
-            if cause:
-                break
-        if blk is not None and cause:
-            causes[int(blk)] = str(cause)
-    return Side(name="reference", profile=plan.profile,
-                bound_set=str(getattr(plan, "bound_set", "acc")), causes=causes or None,
-                report=getattr(plan, "report", None))
+def reference_side(plan: ReferencePlan) -> Side:
+    """The :class:`Side` of a :class:`reference.planner.ReferencePlan`."""
+    causes = {int(row.block): str(row.cause) for row in plan.blocks if row.cause}
+    return Side(name="reference", profile=plan.profile, bound_set=plan.bound_set,
+                causes=causes or None, report=plan.report)
 
 
-def compare(plan, solution, *, limits: MachineLimits | None = None, program=None,
+def compare(plan: ReferencePlan, solution: OptimalSolution, *,
+            limits: MachineLimits | None = None, program: Program | None = None,
             machine: str = "") -> Comparison:
     """Compare the heuristic's plan with the oracle's solution on the plan's path.
 
@@ -721,7 +672,7 @@ def compare(plan, solution, *, limits: MachineLimits | None = None, program=None
     solution : optimal.OptimalSolution
         The oracle solved on ``plan.path``.
     limits : MachineLimits, optional
-        Machine limits; taken from the plan when it carries them.
+        Machine limits (default: the plan's).
     program : reference.nc.Program, optional
         The program (for source lines in the rows and reports).
     machine : str
@@ -732,16 +683,11 @@ def compare(plan, solution, *, limits: MachineLimits | None = None, program=None
     Comparison
     """
     if limits is None:
-        limits = getattr(plan, "limits", None) or getattr(getattr(plan, "machine", None),
-                                                          "limits", None)
-    if limits is None:
-        raise ValueError("compare() needs the machine limits: pass limits=machine.limits")
-    plan_holds = getattr(plan, "holds", None)
-    sol_holds = getattr(solution, "holds", NO_HOLDS)
-    if plan_holds is not None and not plan_holds.same_as(sol_holds):
+        limits = plan.limits
+    if not plan.holds.same_as(solution.holds):
         raise ValueError("compare(): the oracle was solved with other holds than the plan's; "
                          "pass holds=plan.holds to optimal.solve")
-    lines = tuple(getattr(program, "lines", ()) or ())
-    name = getattr(program, "file", "") if program is not None else ""
+    lines = tuple(program.lines) if program is not None else ()
+    name = program.file if program is not None else ""
     return compare_profiles(plan.path, limits, reference_side(plan), oracle_result(solution),
                             program=name, machine=machine, program_lines=lines)

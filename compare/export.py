@@ -24,7 +24,7 @@ from reference.core.geometry import Path
 from reference.core.jsonio import JSON_INF, dumps, json_ready, write_json
 from reference.core.profile import Profile
 
-from .comparison import BlockRow, Comparison, block_span
+from .comparison import Comparison, ComparedBlock, block_span
 
 __all__ = ["CSV_COLUMNS", "JSON_INF", "blocks_csv", "comparison_dict", "dumps", "json_ready",
            "profile_samples", "schema", "violation_dict", "write_json",
@@ -56,7 +56,7 @@ def violation_dict(v: ConstraintResult, path: Path | None = None) -> dict:
     return d
 
 
-def _row_dict(r: BlockRow) -> dict:
+def _row_dict(r: ComparedBlock) -> dict:
     d = {"block": r.block, "line": r.line, "label": r.label, "kind": r.kind,
          "length_mm": r.length_mm, "t_reference_s": r.t_reference_s,
          "t_oracle_s": r.t_oracle_s, "hold_s": r.hold_s, "hold_cause": r.hold_cause,

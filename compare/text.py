@@ -12,7 +12,7 @@ from typing import Any, Iterable, Mapping, Sequence, TextIO
 
 from reference.core.constraints import BOUND_SETS
 
-from .comparison import BlockRow, Comparison, describe_violation, format_interval
+from .comparison import ComparedBlock, Comparison, describe_violation, format_interval
 
 
 def num(x: float, nd: int = 3) -> str:
@@ -28,7 +28,7 @@ def _ms(x: float) -> str:
     return "-" if not math.isfinite(x) else f"{1e3 * x:+.1f}"
 
 
-def block_table(rows: Iterable[BlockRow], out: TextIO, limit: int | None = None) -> None:
+def block_table(rows: Iterable[ComparedBlock], out: TextIO, limit: int | None = None) -> None:
     """Comparison rows: times and exit speeds of both sides, the gap, both causes."""
     out.write(f"    {'line':>5} {'label':<8} {'kind':<8} {'length_mm':>9} {'t_ref_s':>8} "
               f"{'t_opt_s':>8} {'gap_ms':>8} {'v_exit ref/opt mm/s':>19}  limit (ref / opt)\n")

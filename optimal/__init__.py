@@ -16,10 +16,10 @@ from .grid import Grid, initial_grid
 from .json_out import to_json_dict
 from .problem import DiscreteProblem, DiscreteResult, build_grid_problem
 from .oracle import SUPPORTED_BOUNDS, solve
-from .solution import BlockResult, IterationRecord, OptimalSolution
+from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
 
-__all__ = ["SUPPORTED_BOUNDS", "BlockResult", "DiscreteProblem", "DiscreteResult", "Grid",
+__all__ = ["SUPPORTED_BOUNDS", "DiscreteProblem", "DiscreteResult", "Grid",
            "IterationRecord", "OptimalSolution", "SolveStatus", "available_backends",
            "build_grid_problem", "initial_grid", "known_backends", "solve", "solve_discrete",
            "to_json_dict"]

@@ -38,8 +38,8 @@ def to_json_dict(solution: OptimalSolution) -> dict:
             "grid_points": int(solution.grid_points),
         },
         "blocks": [
-            {"block": int(b.block), "t_oracle_s": _num(b.t_oracle_s),
-             "v_exit_oracle": _num(b.v_exit_oracle), "limit_oracle": str(b.limit_oracle)}
+            {"block": int(b.block), "t_oracle_s": _num(b.time_s),
+             "v_exit_oracle": _num(b.v_exit), "limit_oracle": str(b.cause)}
             for b in solution.blocks
         ],
     }

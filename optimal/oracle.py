@@ -31,13 +31,14 @@ from reference.core.geometry import Path
 from reference.core.holds import DWELL_CAUSE, NO_HOLDS, Holds, dwell_holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
+from reference.core.rows import BlockRow, block_motion, block_rows
 
 from .backends import DEFAULT_BACKEND, get_backend
 from .bounds import lower_bound, node_bounds_on, verified_profile
 from .grid import Grid, initial_grid, split
 from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, DiscreteProblem,
                       DiscreteResult, build_grid_problem, check_feed, interval_times)
-from .solution import BlockResult, IterationRecord, OptimalSolution
+from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS)
@@ -47,7 +48,7 @@ SUPPORTED_BOUNDS = ("acc",)
 ProgressFn = Callable[[str, float], None]
 
 # the result types live in optimal.solution; re-exported here for existing imports
-__all__ = ["BlockResult", "IterationRecord", "OptimalSolution", "SUPPORTED_BOUNDS",
+__all__ = ["BlockRow", "IterationRecord", "OptimalSolution", "SUPPORTED_BOUNDS",
            "active_labels", "solve"]
 
 
@@ -217,9 +218,8 @@ def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str,
     prof = with_holds(Profile(t=[0.0], s=[0.0], v=[0.0], a=[], j=[], block=[]), path, holds)
     n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
     bt = prof.block_times(path) if path.blocks else np.zeros(0)
-    rows = tuple(BlockResult(b.block, b.line, b.label, b.kind, b.length,
-                             float(bt[b.block]) if b.block < bt.size else 0.0, 0.0,
-                             b.stop_reason) for b in path.blocks)
+    rows = block_rows(path, block_motion(path, prof), [b.stop_reason for b in path.blocks],
+                      _hold_per_span(path, holds))
     return OptimalSolution(
         status=SolveStatus.OPTIMAL, profile=prof, lower_bound_s=total, upper_bound_s=total,
         objective_s=total, gap=0.0, time_scale=1.0, segment_times_s=np.zeros(0),
@@ -412,7 +412,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
     labels = active_labels(best.problem, best.result.b)
-    rows = _block_rows(path, g, prof_h, blk_t, labels, lam * best.interval_times_s)
+    rows = _block_rows(path, g, prof_h, labels, lam * best.interval_times_s, holds)
     gap = (ub - best_lb) / best_lb if best_lb > 0 else math.inf
     if status == SolveStatus.SOLVER_ERROR:
         message = msg
@@ -457,25 +457,30 @@ def _first_blocked_interval(problem: DiscreteProblem, res: DiscreteResult) -> in
     return int(bad[0]) if bad.size else 0
 
 
-def _block_rows(path: Path, grid: Grid, prof: Profile, blk_t: np.ndarray,
-                labels: tuple[str, ...], t_int: np.ndarray) -> tuple[BlockResult, ...]:
+def _block_rows(path: Path, grid: Grid, prof: Profile, labels: tuple[str, ...],
+                t_int: np.ndarray, holds: Holds) -> tuple[BlockRow, ...]:
+    """The oracle's rows: the motion measured on its verified profile (holds included),
+    the cause the constraint active for most of the block's grid time."""
     blk_of_int = path.block[grid.segment]
     lab_arr = np.asarray(labels, dtype=object)
-    rows = []
+    causes = []
     for b in path.blocks:
-        i = int(np.clip(np.searchsorted(prof.s, b.s_end, side="left"), 0, prof.s.size - 1))
-        v_exit = float(prof.v[i])
         if b.n_segments > 0:
             sel = blk_of_int == b.block
             if np.any(sel):
                 uniq, inv = np.unique(lab_arr[sel].astype(str), return_inverse=True)
                 w = np.bincount(inv, weights=t_int[sel])
-                limit = str(uniq[int(np.argmax(w))])
+                causes.append(str(uniq[int(np.argmax(w))]))
             else:
-                limit = "none"
+                causes.append("none")
         else:
-            limit = b.stop_reason
-        t_b = float(blk_t[b.block]) if b.block < blk_t.size else 0.0
-        rows.append(BlockResult(b.block, b.line, b.label, b.kind, float(b.length), t_b,
-                                v_exit, limit))
-    return tuple(rows)
+            causes.append(b.stop_reason)
+    return block_rows(path, block_motion(path, prof), causes, _hold_per_span(path, holds))
+
+
+def _hold_per_span(path: Path, holds: Holds) -> np.ndarray:
+    """Imposed hold of every entry of ``path.blocks``, s."""
+    if not path.blocks:
+        return np.zeros(0)
+    idx = np.array([b.block for b in path.blocks], dtype=np.int64)
+    return holds.per_block(int(idx.max()) + 1)[idx]

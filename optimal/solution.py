@@ -14,47 +14,11 @@ import numpy as np
 from reference.core.constraints import ConstraintReport
 from reference.core.holds import NO_HOLDS, Holds
 from reference.core.profile import Profile
+from reference.core.rows import BlockRow
 
 from .status import SolveStatus
 
-__all__ = ["BlockResult", "IterationRecord", "OptimalSolution"]
-
-
-@dataclass(frozen=True, slots=True)
-class BlockResult:
-    """The oracle's numbers for one NC block.
-
-    Attributes
-    ----------
-    block : int
-        Block index in the program.
-    line : int
-        1-based source line.
-    label : str
-        Block number or label.
-    kind : str
-        ``"G0"``, ``"G1"``, ... (from the path's block table).
-    length_mm : float
-        Path length of the block, mm.
-    t_oracle_s : float
-        Time the verified (upper-bound) profile spends in the block, s (its holds, dwell
-        or exact-stop settle, included).
-    v_exit_oracle : float
-        Path speed at the block end, mm/s.
-    limit_oracle : str
-        Constraint active over most of the block's time: ``"feed"``,
-        ``"velocity <axis>"``, ``"acceleration <axis>"``, ``"velocity_jump"``,
-        ``"stop"``; for blocks without motion the stop reason (or ``""``).
-    """
-
-    block: int
-    line: int
-    label: str
-    kind: str
-    length_mm: float
-    t_oracle_s: float
-    v_exit_oracle: float
-    limit_oracle: str
+__all__ = ["IterationRecord", "OptimalSolution"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,13 +61,13 @@ class OptimalSolution:
         Time spent moving through each segment, s.
     block_times_s : numpy.ndarray, shape (max block index + 1,)
         Time spent in each NC block (by block index), s.
-    blocks : tuple[BlockResult, ...]
+    blocks : tuple[BlockRow, ...]
         One row per block of ``path.blocks``.
     grid : numpy.ndarray, shape (N + 1,)
         Final grid nodes, mm.
     active : tuple[str, ...]
         Active constraint on each final grid interval (labels as in
-        :class:`BlockResult`).
+        :class:`~reference.core.rows.BlockRow` ``cause``).
     grid_points : int
         ``N + 1``.
     iterations : int
@@ -134,7 +98,7 @@ class OptimalSolution:
     time_scale: float
     segment_times_s: np.ndarray
     block_times_s: np.ndarray
-    blocks: tuple[BlockResult, ...]
+    blocks: tuple[BlockRow, ...]
     grid: np.ndarray
     active: tuple[str, ...]
     grid_points: int

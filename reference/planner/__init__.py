@@ -13,7 +13,7 @@ from .engine import plan
 from .export import to_json_dict
 from .ipo import ipo_samples
 from .parameters import DEFAULT_PARAMETERS, PlannerParameters
-from .result import BlockRow, CornerRow, ReferencePlan, TraceEntry
+from .result import CornerRow, PlannedBlock, ReferencePlan, TraceEntry
 
-__all__ = ["BlockRow", "CornerRow", "DEFAULT_PARAMETERS", "PlannerParameters",
+__all__ = ["CornerRow", "PlannedBlock", "DEFAULT_PARAMETERS", "PlannerParameters",
            "ReferencePlan", "TraceEntry", "ipo_samples", "plan", "to_json_dict"]

@@ -40,7 +40,7 @@ from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planni
 from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
 from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
                        unit_profiles)
-from .result import (BlockRow, BlockTable, CornerRow, CornerTable, ReferencePlan,
+from .result import (BlockTable, CornerRow, CornerTable, ReferencePlan,
                      TraceEntry)
 from .smoothing import smooth_velocity
 from .stops import ACCEL_MODES, SegmentModes, segment_modes
@@ -195,7 +195,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     report_progress("assemble", 0.85)
     profile = with_holds(_assemble(path, units, prof), path, holds)
     rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
-                          horizon)
+                          horizon, holds)
     bound_set = modes.bound_set
     report = None
     if check:
@@ -263,7 +263,7 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
 # ----------------------------------------------------------------- rows
 def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits, junc,
           units: Units, speeds: NodeSpeeds, prof: UnitProfiles, profile: Profile,
-          horizon: np.ndarray) -> tuple[BlockTable, CornerTable]:
+          horizon: np.ndarray, holds: Holds) -> tuple[BlockTable, CornerTable]:
     """Per-block and per-corner rows with speeds and limiting causes."""
     m = path.n_segments
     tol = CAUSE_REL_TOL
@@ -350,7 +350,8 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
         label=tuple(sp.label for sp in spans), kind=tuple(sp.kind for sp in spans),
         length_mm=np.array([sp.s_end - sp.s_start for sp in spans], dtype=np.float64),
         v_entry=v_entry, v_exit=v_exit, v_peak=v_pk, time_s=t_blk, cause_code=cause_code,
-        mode_code=mode_code, case_code=case_code)
+        mode_code=mode_code, case_code=case_code,
+        hold_s=holds.per_block(int(ids.max()) + 1)[ids] if nb else np.zeros(0))
     k = np.arange(1, m) if m >= 2 else np.zeros(0, dtype=np.int64)
     own = np.minimum(junc.cap, horizon)
     corners = CornerTable(
@@ -380,5 +381,5 @@ def _node_cause(units: Units, speeds: NodeSpeeds, prof: UnitProfiles) -> np.ndar
                     np.where(speeds.accel_limited, behind, speeds.origin_cause))
 
 
-__all__ = ["BlockRow", "BlockTable", "CornerRow", "CornerTable", "ReferencePlan", "TraceEntry",
+__all__ = ["BlockTable", "CornerRow", "CornerTable", "ReferencePlan", "TraceEntry",
            "plan"]

@@ -38,13 +38,11 @@ def to_json_dict(plan: ReferencePlan) -> dict:
         for r in plan.report.violations(BOUND_SETS[plan.bound_set]):
             viol.append({"constraint": r.constraint, "axis": r.axis, "ratio": _num(r.ratio),
                          "s": _num(r.s), "block": int(r.block)})
-    n_blocks = max((int(b.block) for b in plan.blocks), default=-1) + 1
-    hold = plan.holds.per_block(n_blocks)
     blocks = [{"block": int(b.block), "line": max(1, int(b.line)), "label": b.label,
                "kind": b.kind, "length_mm": max(0.0, _num(b.length_mm)),
                "t_reference_s": max(0.0, _num(b.time_s)),
                "v_exit_reference": max(0.0, _num(b.v_exit)),
-               "limit_reference": b.cause, "hold_s": float(hold[int(b.block)]),
+               "limit_reference": b.cause, "hold_s": b.hold_s,
                "hold_cause": plan.holds.cause_of(int(b.block))} for b in plan.blocks]
     return {"program": plan.program, "machine": plan.machine, "bounds": plan.bound_set,
             "reference": {"time_s": _num(plan.time_s), "violations": viol},

@@ -19,12 +19,13 @@ from ..core.geometry import Path
 from ..core.holds import Holds
 from ..core.limits import MachineLimits
 from ..core.profile import Profile
+from ..core.rows import BlockRow
 from . import causes as C
 from .parameters import PlannerParameters
 from .profiles import case_name
 from .stops import ACCEL_MODES
 
-__all__ = ["BlockRow", "BlockTable", "CornerRow", "CornerTable", "ReferencePlan",
+__all__ = ["PlannedBlock", "BlockTable", "CornerRow", "CornerTable", "ReferencePlan",
            "TraceEntry"]
 
 
@@ -43,42 +44,22 @@ class TraceEntry(NamedTuple):
     note: str
 
 
-class BlockRow(NamedTuple):
-    """One NC block of the plan (an immutable named tuple: cheap for 10^5 blocks).
+@dataclass(frozen=True, slots=True)
+class PlannedBlock(BlockRow):
+    """One NC block of the plan: the shared row (:class:`reference.core.rows.BlockRow`,
+    whose ``cause`` is ``""`` for blocks that neither move nor wait) plus what only the
+    heuristic knows.
 
     Attributes
     ----------
-    block, line : int
-        Block index and 1-based source line.
-    label, kind : str
-        Block number/label and ``"G0"``/``"G1"``/``"G2"``/``"G3"``/``"none"``.
-    length_mm : float
-        Path length, mm.
-    v_entry, v_exit, v_peak : float
-        Speed at the block start and end and the largest speed inside, mm/s.
-    time_s : float
-        Time spent in the block (holds included), s.
-    cause : str
-        Limiting cause (:data:`reference.planner.causes.CAUSES`); ``""`` for blocks
-        that neither move nor wait.
     mode : str
         Acceleration mode (``"BRISK"``, ``"SOFT"``, ``"DRIVE"``; ``""`` without motion).
     case : str
         Profile case of the planning unit the block lies in (``RISE_ACC+CRUISE+...``).
     """
 
-    block: int
-    line: int
-    label: str
-    kind: str
-    length_mm: float
-    v_entry: float
-    v_exit: float
-    v_peak: float
-    time_s: float
-    cause: str
-    mode: str
-    case: str
+    mode: str = ""
+    case: str = ""
 
 
 class CornerRow(NamedTuple):
@@ -167,20 +148,21 @@ class _Table(Sequence):
 
 
 class BlockTable(_Table):
-    """The per-block rows of a plan (a read-only sequence of :class:`BlockRow`)."""
+    """The per-block rows of a plan (a read-only sequence of :class:`PlannedBlock`)."""
 
     __slots__ = ()
 
-    def _make(self, i: int) -> BlockRow:
+    def _make(self, i: int) -> PlannedBlock:
         c = self._cols
         cause = int(c["cause_code"][i])
         mode = int(c["mode_code"][i])
         case = int(c["case_code"][i])
-        return BlockRow(block=int(c["block"][i]), line=int(c["line"][i]), label=c["label"][i],
+        return PlannedBlock(block=int(c["block"][i]), line=int(c["line"][i]), label=c["label"][i],
                         kind=c["kind"][i], length_mm=float(c["length_mm"][i]),
                         v_entry=float(c["v_entry"][i]), v_exit=float(c["v_exit"][i]),
                         v_peak=float(c["v_peak"][i]), time_s=float(c["time_s"][i]),
                         cause=C.CAUSES[cause] if cause >= 0 else "",
+                        hold_s=float(c["hold_s"][i]),
                         mode=ACCEL_MODES[mode].name if mode >= 0 else "",
                         case=case_name(case) if case >= 0 else "")
 
@@ -215,7 +197,7 @@ class ReferencePlan:
     profile : Profile
         The planned motion.
     blocks : BlockTable
-        One :class:`BlockRow` per NC block (in ``path.blocks`` order); a read-only
+        One :class:`PlannedBlock` per NC block (in ``path.blocks`` order); a read-only
         sequence, columns via ``blocks.column(name)``.
     corners : CornerTable
         One :class:`CornerRow` per interior segment break.

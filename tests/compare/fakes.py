@@ -13,7 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from optimal import SolveStatus
 from reference.core.constraints import check_profile
+from reference.core.holds import NO_HOLDS, Holds
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
@@ -64,7 +66,7 @@ def toy_profile(path: Path, limits: MachineLimits, scale: float = 1.0,
 @dataclass(frozen=True)
 class FakeRow:
     block: int
-    limit: str
+    cause: str
 
 
 @dataclass(frozen=True)
@@ -75,19 +77,20 @@ class FakePlan:
     bound_set: str = "acc"
     blocks: tuple = ()
     report: object = None
-    holds: object = None          # no holds checked (the fake profiles have none)
+    holds: Holds = NO_HOLDS       # the fake profiles have none
 
 
 @dataclass(frozen=True)
 class FakeSolution:
-    status: str
+    status: SolveStatus
     profile: Profile | None
     lower_bound_s: float
     upper_bound_s: float
-    solve_time_s: float = 0.01
+    total_time_s: float = 0.01
     grid_points: int = 100
     bounds: str = "acc"
     blocks: tuple = ()
+    holds: Holds = NO_HOLDS
 
 
 def fake_plan(path: Path, limits: MachineLimits, scale: float = 0.7,
@@ -101,4 +104,4 @@ def fake_plan(path: Path, limits: MachineLimits, scale: float = 0.7,
 def fake_solution(path: Path, limits: MachineLimits, rel_gap: float = 0.002) -> FakeSolution:
     prof = toy_profile(path, limits, 1.0)
     ub = prof.duration
-    return FakeSolution("optimal", prof, ub / (1 + rel_gap), ub)
+    return FakeSolution(SolveStatus.OPTIMAL, prof, ub / (1 + rel_gap), ub)

@@ -11,7 +11,8 @@ import pytest
 from conftest import SMALL, path_of
 from fakes import FakeSolution, fake_plan, fake_solution, toy_profile
 
-from compare.comparison import BlockRow, OracleResult, Side, compare, compare_profiles
+from optimal import SolveStatus
+from compare.comparison import ComparedBlock, OracleResult, Side, compare, compare_profiles
 from reference.core.causes import normalise_cause
 from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
 
@@ -62,7 +63,7 @@ def test_negative_block_gap_gets_a_note(small, machine):
     program, path, plan, sol = small
     # an "oracle" that is slower than the plan in the first moving block only
     slow = toy_profile(path, machine.limits, 0.35)
-    fake = FakeSolution("optimal", slow, slow.duration / 1.002, slow.duration)
+    fake = FakeSolution(SolveStatus.OPTIMAL, slow, slow.duration / 1.002, slow.duration)
     c = compare(plan, fake, program=program)
     neg = [r for r in c.rows if r.gap_s < -1e-6]
     assert neg and all("negative by" in r.note for r in neg)
@@ -73,7 +74,7 @@ def test_negative_block_gap_gets_a_note(small, machine):
 
 def test_jerk_bounded_oracle_explains_negative_gaps_differently(small):
     program, path, plan, sol = small
-    c = compare(plan, FakeSolution("optimal", plan.profile, 1.0, 2.0), program=program)
+    c = compare(plan, FakeSolution(SolveStatus.OPTIMAL, plan.profile, 1.0, 2.0), program=program)
     note_rows = [r for r in c.rows if r.note]
     assert not note_rows                                  # identical profiles: no gap
     # a jerk oracle explains a negative gap by the global optimum
@@ -107,7 +108,7 @@ def test_verdict_gate_uses_the_upper_end(small):
 
 def test_oracle_without_certificate_fails(small):
     program, path, plan, sol = small
-    bad = FakeSolution("solver_error", None, math.nan, math.nan)
+    bad = FakeSolution(SolveStatus.SOLVER_ERROR, None, math.nan, math.nan)
     c = compare(plan, bad, program=program)
     assert not c.certified
     v = c.verdict(None)
@@ -160,5 +161,5 @@ def test_compare_profiles_accepts_any_side(small, machine):
     c = compare_profiles(path, machine.limits, side, oracle, program="x.mpf")
     assert c.reference_name == "recorded"
     assert "recorded trajectory" in c.verdict(None).text
-    assert all(isinstance(r, BlockRow) for r in c.rows)
+    assert all(isinstance(r, ComparedBlock) for r in c.rows)
     assert all(r.limit_reference for r in c.rows)            # derived causes

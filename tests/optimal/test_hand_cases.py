@@ -57,7 +57,7 @@ def test_diagonal_line_uses_per_axis_projection():
     sol = optimal.solve(p, lim, tol=1e-4)
     assert_brackets(sol, exact)
     assert sol.upper_bound_s == pytest.approx(exact, rel=1e-4)
-    assert sol.blocks[0].limit_oracle in ("velocity X", "acceleration X", "acceleration Y",
+    assert sol.blocks[0].cause in ("velocity X", "acceleration X", "acceleration Y",
                                           "velocity Y")
 
 
@@ -68,7 +68,7 @@ def test_feed_limits_path_speed():
     sol = optimal.solve(p, lim)
     assert_brackets(sol, exact)
     assert sol.upper_bound_s == pytest.approx(exact, rel=1e-3)
-    assert sol.blocks[0].limit_oracle == "feed"
+    assert sol.blocks[0].cause == "feed"
     assert "feed" in sol.active
 
 
@@ -79,7 +79,7 @@ def test_rapid_moves_at_axis_limits():
     sol = optimal.solve(p, lim)
     assert_brackets(sol, exact)
     assert sol.upper_bound_s == pytest.approx(exact, rel=1e-3)
-    assert sol.blocks[0].limit_oracle == "velocity X"
+    assert sol.blocks[0].cause == "velocity X"
 
 
 def test_exact_stop_inside_a_straight_line():
@@ -88,7 +88,7 @@ def test_exact_stop_inside_a_straight_line():
     exact = 2 * rest_to_rest(30.0, 200.0, 1000.0)
     sol = optimal.solve(p, lim)
     assert_brackets(sol, exact)
-    assert sol.blocks[0].v_exit_oracle == 0.0
+    assert sol.blocks[0].v_exit == 0.0
     assert sol.upper_bound_s == pytest.approx(exact, rel=1e-3)
 
 
@@ -121,9 +121,9 @@ def test_line_arc_line_tangent():
     assert sol.upper_bound_s >= exact
     assert sol.upper_bound_s <= exact * (1 + 2e-3)
     # speed at the arc entry: the centripetal cap
-    assert sol.blocks[0].v_exit_oracle == pytest.approx(ve, rel=1e-3)
-    assert sol.blocks[0].v_exit_oracle <= ve * (1 + 1e-9)
-    assert sum(b.t_oracle_s for b in sol.blocks) == pytest.approx(sol.upper_bound_s)
+    assert sol.blocks[0].v_exit == pytest.approx(ve, rel=1e-3)
+    assert sol.blocks[0].v_exit <= ve * (1 + 1e-9)
+    assert sum(b.time_s for b in sol.blocks) == pytest.approx(sol.upper_bound_s)
 
 
 @pytest.mark.parametrize("ovl", [1.0, 1.2])
@@ -146,12 +146,12 @@ def test_corner_90_degrees(ovl):
     sol = optimal.solve(p, lim)
     assert_brackets(sol, exact)
     assert sol.upper_bound_s == pytest.approx(exact, rel=1e-3)
-    v_corner = sol.blocks[0].v_exit_oracle
+    v_corner = sol.blocks[0].v_exit
     if ovl == 1.0:
         assert v_corner == 0.0
     else:
         assert v_corner == pytest.approx(vc, rel=1e-9)
-        assert sol.blocks[0].limit_oracle.startswith("acceleration")
+        assert sol.blocks[0].cause.startswith("acceleration")
     assert_accepted(p, lim, sol)
 
 
@@ -170,7 +170,7 @@ def test_dwell_adds_time_to_its_block():
     assert_brackets(sol, exact)
     assert sol.dwell_s == 0.5
     assert sol.block_times_s[1] == pytest.approx(0.5)
-    assert sol.blocks[1].limit_oracle == "dwell G4 0.5 s"
+    assert sol.blocks[1].cause == "dwell G4 0.5 s"
     assert sol.profile.duration == pytest.approx(sol.upper_bound_s)
     assert sol.block_times_s.sum() == pytest.approx(sol.upper_bound_s)
 

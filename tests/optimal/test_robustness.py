@@ -19,7 +19,7 @@ from reference.core.tolerances import VEL_TOL_MM_S
 def all_finite(sol) -> bool:
     arrays = [sol.segment_times_s, sol.block_times_s, sol.grid, sol.profile.t, sol.profile.v]
     nums = [sol.lower_bound_s, sol.upper_bound_s, sol.objective_s, sol.gap, sol.time_scale]
-    nums += [b.t_oracle_s for b in sol.blocks] + [b.v_exit_oracle for b in sol.blocks]
+    nums += [b.time_s for b in sol.blocks] + [b.v_exit for b in sol.blocks]
     return all(np.all(np.isfinite(a)) for a in arrays) and all(np.isfinite(nums))
 
 
@@ -62,7 +62,7 @@ def test_reversal_of_180_degrees(ovl):
     lim = machine(200.0, A, ovl=ovl, t_ipo=t_ipo)
     p = line_path([[0, 0, 0], [10, 0, 0], [0, 0, 0]])
     sol = optimal.solve(p, lim)
-    v = sol.blocks[0].v_exit_oracle
+    v = sol.blocks[0].v_exit
     vc = A * (ovl - 1.0) * t_ipo / 2.0         # |t_out - t_in| = 2 on X
     assert v == pytest.approx(vc, rel=1e-9, abs=0.0)
     assert sol.status == optimal.SolveStatus.OPTIMAL
@@ -137,8 +137,8 @@ def test_arc_limit_labels():
     lim = machine(500.0, 1000.0)
     p = line_arc_line(5.0, 20.0)
     sol = optimal.solve(p, lim)
-    assert sol.blocks[1].limit_oracle.startswith("acceleration")
-    assert sol.blocks[-1].v_exit_oracle == 0.0
+    assert sol.blocks[1].cause.startswith("acceleration")
+    assert sol.blocks[-1].v_exit == 0.0
     assert set(sol.active) <= {"feed", "stop", "velocity_jump", "none"} | {
         f"{k} {a}" for k in ("velocity", "acceleration") for a in XYZ}
 
@@ -190,5 +190,5 @@ def test_junction_label_at_a_corner_with_overload():
     # the interval ending at the corner is a deceleration ramp to the junction cap
     k = int(np.searchsorted(sol.grid, 5.0))
     assert sol.active[k - 1].startswith("acceleration")
-    assert sol.blocks[0].v_exit_oracle == pytest.approx(2000.0 * 0.5 * 0.004, rel=1e-9)
+    assert sol.blocks[0].v_exit == pytest.approx(2000.0 * 0.5 * 0.004, rel=1e-9)
     del build_grid_problem
