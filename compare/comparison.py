@@ -54,7 +54,8 @@ from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import BlockMotion, BlockRow, block_motion
-from reference.core.tolerances import RATIO_TOL
+from reference.core.errors import InternalError
+from reference.core.tolerances import RATIO_TOL, ROUNDOFF_MARGIN_REL
 
 from .causes import derive_causes
 
@@ -568,6 +569,7 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     r_opt = _row_ratios(opt_report, BOUND_SETS.get(oracle.bounds, ()), idx) \
         if opt_report is not None else np.full(len(spans), math.nan)
     lb, ub = oracle.lower_bound_s, oracle.upper_bound_s
+    _check_certificate(path, ref_prof, ref_report, oracle)
     n_blocks = int(idx.max()) + 1 if idx.size else 0
     hold_blk = oracle.holds.per_block(n_blocks)[idx] if idx.size else np.zeros(0)
     H = oracle.holds.total_s
@@ -633,6 +635,29 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                       rows=tuple(rows), reference_report=ref_report, oracle_report=opt_report,
                       notes=tuple(all_notes), program_lines=tuple(program_lines),
                       reference_ratio_tol=reference.ratio_tol)
+
+
+def _check_certificate(path: Path, profile: Profile, report: ConstraintReport,
+                       oracle: OracleResult) -> None:
+    """A profile the checker accepts under the oracle's bound set is never faster than
+    the oracle's certified lower bound; if it is, the certificate is broken (a rule
+    written twice, a relaxation that is not one): a bug, reported as such (exit 3),
+    never printed as a negative gap with the verdict "ok".
+
+    The comparison is exact up to :data:`ROUNDOFF_MARGIN_REL` (the bound and the profile's
+    duration are sums of different round-off).
+    """
+    lb = oracle.lower_bound_s
+    if not (math.isfinite(lb) and lb > 0) or oracle.status not in ("optimal", "gap_not_met"):
+        return
+    if report.violations(BOUND_SETS.get(oracle.bounds, ()), RATIO_TOL):
+        return                  # the profile breaks a limit the oracle keeps: no claim
+    t = profile.duration
+    if t < lb * (1.0 - ROUNDOFF_MARGIN_REL):
+        raise InternalError(
+            f"certificate broken on {path.source or 'the path'}: a profile the checker "
+            f"accepts under the {oracle.bounds!r} bounds takes {t:.9g} s, below the oracle's "
+            f"lower bound {lb:.9g} s")
 
 
 def _block_cause(label: str, span: BlockSpan | None = None) -> str:

@@ -14,6 +14,7 @@ from fakes import FakeSolution, fake_plan, fake_solution, toy_profile
 from optimal import SolveStatus
 from compare.comparison import ComparedBlock, OracleResult, Side, compare, compare_profiles
 from reference.core.causes import normalise_cause
+from reference.core.errors import InternalError
 from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
 
 
@@ -63,7 +64,8 @@ def test_negative_block_gap_gets_a_note(small, machine):
     program, path, plan, sol = small
     # an "oracle" that is slower than the plan in the first moving block only
     slow = toy_profile(path, machine.limits, 0.35)
-    fake = FakeSolution(SolveStatus.OPTIMAL, slow, slow.duration / 1.002, slow.duration)
+    # (its lower bound stays below the plan's time, as every certified bound must)
+    fake = FakeSolution(SolveStatus.OPTIMAL, slow, 0.99 * plan.profile.duration, slow.duration)
     c = compare(plan, fake, program=program)
     neg = [r for r in c.rows if r.gap_s < -1e-6]
     assert neg and all("negative by" in r.note for r in neg)
@@ -163,3 +165,16 @@ def test_compare_profiles_accepts_any_side(small, machine):
     assert "recorded trajectory" in c.verdict(None).text
     assert all(isinstance(r, ComparedBlock) for r in c.rows)
     assert all(r.limit_reference for r in c.rows)            # derived causes
+
+
+def test_a_lower_bound_above_an_accepted_profile_is_a_bug_not_a_gap(small):
+    """The certificate: a profile the checker accepts is never below LB. A comparison
+    that finds one raises InternalError (exit 3), never prints a negative gap as ok."""
+    program, path, plan, sol = small
+    t = plan.profile.duration
+    bad = FakeSolution(SolveStatus.OPTIMAL, plan.profile, t * (1 + 1e-6), t * 1.01)
+    with pytest.raises(InternalError, match="certificate broken"):
+        compare(plan, bad, program=program)
+    # at the bound itself (round-off below it) the claim holds
+    ok = FakeSolution(SolveStatus.OPTIMAL, plan.profile, t * (1 + 1e-12), t * 1.01)
+    assert compare(plan, ok, program=program).gap_upper == pytest.approx(0.0, abs=1e-9)
