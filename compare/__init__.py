@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING, Any
 
 #: Public name -> module that defines it.
 _EXPORTS = {
-    "ComparedBlock": "compare.comparison", "Comparison": "compare.comparison",
-    "OracleResult": "compare.comparison", "Side": "compare.comparison",
-    "Verdict": "compare.comparison", "compare": "compare.comparison",
-    "compare_profiles": "compare.comparison", "format_interval": "compare.comparison",
+    "ComparedBlock": "compare.result", "Comparison": "compare.result",
+    "OracleResult": "compare.result", "Side": "compare.result",
+    "Verdict": "compare.result", "compare": "compare.comparison",
+    "compare_profiles": "compare.comparison", "format_interval": "compare.result",
     "oracle_result": "compare.comparison",
     "Inputs": "compare.pipeline", "OptimizeResult": "compare.pipeline",
     "check_trajectory": "compare.pipeline", "compare_program": "compare.pipeline",
@@ -56,8 +56,9 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for type checkers and editors; at run time names load on first use
     from .cli import main
-    from .comparison import (ComparedBlock, Comparison, OracleResult, Side, Verdict, compare,
-                             compare_profiles, format_interval, oracle_result)
+    from .comparison import compare, compare_profiles, oracle_result
+    from .result import (ComparedBlock, Comparison, OracleResult, Side, Verdict,
+                         format_interval)
     from .export import blocks_csv, comparison_dict, write_json
     from .pipeline import (Inputs, OptimizeResult, check_trajectory, compare_program,
                            load_inputs, optimize_program, plan_program)
