@@ -27,8 +27,8 @@ import numpy as np
 from .core.errors import MachineDataError, PathError
 from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segments, line_segments
 from .core.limits import MachineLimits
-from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM,
-                              TANGENT_TOL_RAD)
+from .core.rules import is_tangential
+from .core.tolerances import ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 
@@ -204,9 +204,7 @@ def _exact_path_stops(path: Path, program: Program) -> Path:
     if not modes.any():
         return path
     t_in, t_out = path.junction_tangents()
-    cosang = np.sum(t_in * t_out, axis=1) / np.maximum(
-        np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1), 1e-300)
-    kink = np.arccos(np.clip(cosang, -1.0, 1.0)) > TANGENT_TOL_RAD
+    kink = ~is_tangential(t_in, t_out)
     reasons = list(path.stop_reason)
     for k in np.flatnonzero(modes & kink):
         reasons[k + 1] = reasons[k + 1] or "exact path G61 corner"

@@ -284,3 +284,26 @@ def test_pipeline_is_free_of_the_cli() -> None:
     calls = {n.func.id for n in ast.walk(ast.parse(py.read_text(encoding="utf-8")))
              if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
     assert "print" not in calls
+
+
+#: Thresholds that only the rulebook's functions may read: everyone else asks
+#: ``is_tangential``, ``curvature_jumps``, ``junction_speed_cap`` (a module that reads the
+#: number itself is a module about to write the rule a second time).
+RULE_THRESHOLDS = ("TANGENT_TOL_RAD", "CURVATURE_JUMP_TOL_PER_MM")
+
+
+@pytest.mark.parametrize("folder", CONSUMERS)
+def test_rule_thresholds_are_read_only_by_the_rulebook(folder: str) -> None:
+    allowed = {ROOT / "reference/core/rules.py", ROOT / "reference/core/tolerances.py"}
+    problems = []
+    for py in _files(folder):
+        if py in allowed:
+            continue
+        for node in ast.walk(ast.parse(py.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.ImportFrom)
+                     else [node.id] if isinstance(node, ast.Name)
+                     else [node.attr] if isinstance(node, ast.Attribute) else [])
+            hit = sorted(set(names) & set(RULE_THRESHOLDS))
+            if hit:
+                problems.append(f"{py.relative_to(ROOT)}:{node.lineno} uses {hit[0]}")
+    assert not problems, "\n".join(problems)
