@@ -19,7 +19,7 @@ from pathlib import Path as FsPath
 from typing import Callable, Sequence, TextIO
 
 from reference.core.constraints import BOUND_SETS
-from reference.core.errors import FeedOracleError
+from reference.core.errors import FeedOracleError, PathError
 from reference.machine import load_machine
 from reference.nc import parse_file
 from reference.prepare import unmodelled_features
@@ -146,6 +146,26 @@ def _load(program_file: str, args: argparse.Namespace):
     return program, machine
 
 
+def _require_motion(program, path) -> None:
+    """A program whose path has no segment is rejected (exit 2) before any result.
+
+    An empty file, comments only or settings only (``G90`` alone) move nothing: the time
+    is 0 s for every planner and the gap ``t_ref/LB - 1`` is 0/0. A CI gate that passed it
+    with "0 s, ok" would hide the usual cause, a wrong or truncated file; so it is bad
+    input, naming the file, like any other program nothing can be said about.
+
+    Raises
+    ------
+    PathError
+        The path has no segment.
+    """
+    if path.n_segments == 0:
+        n = len(program.blocks)
+        raise PathError(f"{program.file}: the program has no motion ({n} block"
+                        f"{'' if n == 1 else 's'}, none moves an axis): nothing to plan, "
+                        "optimize or compare")
+
+
 def _prefixed(progress, prefix: str):
     """A progress callback that prefixes messages (``None``-safe)."""
     if progress is None:
@@ -221,6 +241,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from reference.planner import ipo_samples, to_json_dict
     program, machine = _load(args.program, args)
     plan = engines.run_heuristic(program, machine, progress=args.progress)
+    _require_motion(program, plan.path)
     args.progress.done()
     doc = to_json_dict(plan)
     if args.json:
@@ -248,6 +269,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     bounds, _ = engines.resolve_bounds(args.bounds, None)
     program, machine = _load(args.program, args)
     plan = engines.run_heuristic(program, machine, progress=_prefixed(args.progress, "path: "))
+    _require_motion(program, plan.path)
     sol = engines.run_oracle(plan.path, machine.limits, bounds,
                              progress=_prefixed(args.progress, "oracle: "))
     args.progress.done()
@@ -299,6 +321,7 @@ def compare_program(program_file: str, args: argparse.Namespace, prefix: str = "
     program, machine = _load(program_file, args)
     plan = engines.run_heuristic(program, machine,
                                  progress=_prefixed(args.progress, f"{prefix}heuristic: "))
+    _require_motion(program, plan.path)
     bounds, notes = engines.resolve_bounds(args.bounds, getattr(plan, "bound_set", None))
     sol = engines.run_oracle(plan.path, machine.limits, bounds,
                              progress=_prefixed(args.progress, f"{prefix}oracle: "))
@@ -394,8 +417,10 @@ def _write_program_report(folder: FsPath, stem: str, c: Comparison, doc: dict,
 # --------------------------------------------------------------------- check
 def cmd_check(args: argparse.Namespace) -> int:
     """``feedoracle check``: a recorded trajectory against limits and the oracle."""
+    from reference.prepare import prepare
     from .recorded import check_recorded
     program, machine = _load(args.program, args)
+    _require_motion(program, prepare(program))
     smoothing = args.smoothing
     if smoothing != "auto":
         try:

@@ -15,6 +15,14 @@ from .frames import _Frame
 from .lines import Stmt
 from .program import DEFAULT_MODAL, ProgramWarning, Tangential
 
+#: Largest position magnitude accepted, mm (degrees for rotary axes), also for arc
+#: centres. No machine tool travels a kilometre (large gantries: tens of metres), and
+#: below it float64 resolves a position to 1e6 * 2.2e-16 = 2e-10 mm, four decades under
+#: POS_TOL_MM (1e-6 mm) that every geometric test relies on. A position beyond it is a
+#: typing error (X123456789012345678901234567890) and would otherwise overflow into inf
+#: or lose all precision downstream.
+MAX_COORDINATE_MM = 1e6
+
 #: M codes that end the program (M17 only on SINUMERIK, M99 only on NGC: checked there).
 _END_M = frozenset({2.0, 30.0, 17.0, 99.0})
 GEOMETRY = ("X", "Y", "Z")
@@ -146,7 +154,7 @@ class _Interp:
                 and name not in ("I", "J", "K", "F", "S", "T", "D", "H", "M", "G", "N", "P"))
 
     def program_pos(self) -> dict:
-        if self.frame.theta_deg == 0.0 and not self.frame.offset:
+        if self.frame.identity:
             return dict(self.pos)
         return self.frame.to_program(self.pos)
 
