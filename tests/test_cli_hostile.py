@@ -141,3 +141,13 @@ def test_real_program_features_compare_and_validate(tmp_path, capsys, name, text
     jsonschema.validate(doc, schema())
     assert doc["oracle"]["status"] == "optimal"
     assert doc["oracle"]["lower_bound_s"] <= doc["oracle"]["upper_bound_s"]
+
+
+def test_check_against_a_program_without_motion_is_bad_input(tmp_path, capsys):
+    prog = tmp_path / "g90.mpf"
+    prog.write_text("G90\n")
+    traj = tmp_path / "t.csv"
+    traj.write_text("t,X,Y,Z\n0,0,0,0\n0.004,0,0,0\n")
+    code, out, err = _run(["check", str(traj), "--program", str(prog), "--quiet"], capsys)
+    assert code == 2
+    assert err.strip().startswith(f"feedoracle: {prog}: the program has no motion")

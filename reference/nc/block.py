@@ -19,7 +19,7 @@ from .lines import Stmt, Word
 from .program import NO_EXTRA, Block, BlockExtra, Modal, Tangential
 from .state import (_G_GROUPS_NGC, _G_GROUPS_SIN, _IGNORED_G_NGC, _IGNORED_G_SIN,
                     _IGNORED_WHY, _MODES10_SIN, _NGC_CS, _PLANE_AXES, _UNSUPPORTED_G,
-                    MAX_COORDINATE_MM, ROTARY, _Interp)
+                    MAX_COORDINATE_MM, MAX_DWELL_S, MAX_FEED_MM_MIN, ROTARY, _Interp)
 
 
 def _block(ip: _Interp, st: Stmt) -> bool:
@@ -377,6 +377,9 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             raise ip.err(st, 1, "G4 needs F (seconds) or S (spindle revolutions)")
         if dwell is not None and dwell < 0:
             raise ip.err(st, 1, f"negative dwell time {dwell:g} s")
+        if dwell is not None and dwell > MAX_DWELL_S:
+            raise ip.err(st, 1, f"dwell time {dwell:g} s is above {MAX_DWELL_S:g} s "
+                                f"({MAX_DWELL_S / 86400:.1f} days): check the number")
         feed_word = None
     else:
         for a in aux:
@@ -386,7 +389,11 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         f, col = feed_word
         if f < 0:
             raise ip.err(st, col, f"negative feed F{f:g}")
-        ip.feed = f * (MM_PER_INCH if ip.feed_inch else 1.0) / 60.0
+        mm_min = f * (MM_PER_INCH if ip.feed_inch else 1.0)
+        if mm_min > MAX_FEED_MM_MIN:
+            raise ip.err(st, col, f"feed F{f:g} is above {MAX_FEED_MM_MIN:g} mm/min, faster "
+                                  "than any machine by orders of magnitude: check the number")
+        ip.feed = mm_min / 60.0
     # --- motion ------------------------------------------------------------------------
     start = tuple(ip.pos[a] for a in ip.axes)
     centre_out = None
@@ -430,6 +437,11 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         machine = target if (g53 or identity) else ip.frame.to_machine(target)
         _check_range(ip, st, machine, axis_words, "position", motion_word_col)
         if motion in ("G2", "G3"):
+            for word, rad in (("CR", named.get("CR")), ("R", r_word)):
+                if rad is not None and not abs(rad[0] * ip.lin("X")) <= MAX_COORDINATE_MM:
+                    raise ip.err(st, rad[1], f"arc radius {word}{'=' if len(word) > 1 else ''}"
+                                             f"{rad[0]:g} is beyond {MAX_COORDINATE_MM:g} mm, "
+                                             "larger than any machine: check the number")
             centre_out, plane_basis, turns = _arc(ip, st, motion, prog, target, centre,
                                                   named, r_word, p_word, motion_word_col)
             if ip.frame.tilt is not None and not g53:

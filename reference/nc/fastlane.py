@@ -12,9 +12,10 @@ from ..core.units import MM_PER_INCH
 from .arcs import _fast_arc_centre
 from .lines import Stmt
 from .program import NO_EXTRA, Block, BlockExtra
-from .state import _END_M, _PLANE_AXES, MAX_COORDINATE_MM, _Interp
+from .state import _END_M, _PLANE_AXES, MAX_COORDINATE_MM, MAX_FEED_MM_MIN, _Interp
 
 _INF = float("inf")
+_MAX_F = MAX_FEED_MM_MIN / MM_PER_INCH     # in either unit: the full path checks exactly
 
 
 def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
@@ -62,7 +63,7 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
             if f is not None:
                 return False
             f = float(text)
-            if not 0.0 < f < _INF:             # F0, overflow: the full path says why
+            if not 0.0 < f < _MAX_F:           # F0, too large: the full path says why
                 return False
         elif letter == "I":
             if ci is not None:

@@ -22,6 +22,15 @@ from .program import DEFAULT_MODAL, ProgramWarning, Tangential
 #: typing error (X123456789012345678901234567890) and would otherwise overflow into inf
 #: or lose all precision downstream.
 MAX_COORDINATE_MM = 1e6
+#: Largest programmed feed, mm/min. CAM writes "as fast as possible" as F99999 or so,
+#: and a feed above the axis limits is simply capped by them, so the bound is generous:
+#: 1e9 mm/min (1000 km/min) is five decades above the fastest axes (MAX_AX_VELO <= 1e7
+#: by the machine-data rules) and keeps v^2 far from float overflow (a feed of 1e300
+#: overflowed in the planners).
+MAX_FEED_MM_MIN = 1e9
+#: Longest dwell, s: 1e6 s (11.6 days) is no machining dwell, and keeps the program's
+#: times at magnitudes where float64 still resolves a microsecond.
+MAX_DWELL_S = 1e6
 
 #: M codes that end the program (M17 only on SINUMERIK, M99 only on NGC: checked there).
 _END_M = frozenset({2.0, 30.0, 17.0, 99.0})

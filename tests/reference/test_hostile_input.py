@@ -14,7 +14,7 @@ import pytest
 from reference.core.errors import NCSyntaxError
 from reference.nc import parse_text
 from reference.nc.expr import MAX_EXPR_DEPTH, NGC_MAX_PARAMETER
-from reference.nc.state import MAX_COORDINATE_MM
+from reference.nc.state import MAX_COORDINATE_MM, MAX_DWELL_S, MAX_FEED_MM_MIN
 from reference.prepare import prepare
 
 SIN, NGC = "sinumerik", "ngc"
@@ -104,6 +104,35 @@ def test_an_arc_centre_beyond_the_limit_is_an_error():
 def test_an_overflowing_spindle_or_tool_word_is_an_error_not_a_crash():
     _err("G1 F100 X1 S" + "9" * 400 + "\n", SIN, 1, 12, r"the value of S is too large")
     _err("T" + "9" * 400 + "\n", SIN, 1, 1, r"the value of T is too large")
+
+
+@pytest.mark.parametrize("dialect", [SIN, NGC])
+def test_an_absurd_feed_is_an_error_at_the_f_word(dialect):
+    _err("G1 F" + "9" * 300 + " X10\n", dialect, 1, 4, r"feed F1e\+300 is above 1e\+09 mm/min")
+
+
+def test_a_feed_at_the_limit_and_a_usual_rapid_feed_are_accepted():
+    p = parse_text(f"G1 F{MAX_FEED_MM_MIN:.0f} X10\nG1 F99999 X20\n", "p", SIN)
+    assert p.blocks[0].feed_mm_s == pytest.approx(MAX_FEED_MM_MIN / 60.0)
+
+
+def test_an_inch_feed_is_checked_in_mm_per_min():
+    # 5e8 inch/min = 1.27e10 mm/min: above the limit although the number is below it
+    _err("G20 G1 F500000000 X1\n", NGC, 1, 8, r"feed F5e\+08 is above 1e\+09 mm/min")
+
+
+def test_an_absurd_dwell_is_an_error_at_the_line():
+    _err("G1 F100 X1\nG4 F" + "9" * 300 + "\n", SIN, 2, 1, r"dwell time 1e\+300 s is above "
+                                                          r"1e\+06 s")
+    assert parse_text(f"G4 F{MAX_DWELL_S:.0f}\n", "p", SIN).blocks[0].dwell_s == MAX_DWELL_S
+
+
+@pytest.mark.parametrize("text, dialect, col, word", [
+    ("G1 F100 X10\nG2 X0 CR=1EX300\n", SIN, 7, r"CR=1e\+300"),
+    ("G1 F100 X10\nG2 X0 R" + "9" * 300 + "\n", NGC, 7, r"R1e\+300"),
+])
+def test_an_absurd_arc_radius_is_an_error_at_the_radius_word(text, dialect, col, word):
+    _err(text, dialect, 2, col, rf"arc radius {word} is beyond 1e\+06 mm")
 
 
 # ----------------------------------------------------------------- SINUMERIK exponents
