@@ -51,6 +51,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     seen: dict[str, float] = {}
     m98_col = 0
     positioning: list[tuple[str, float, str, int]] = []   # POS[axis]=value
+    block_feed: float | None = None             # a feed of this block only (POS with FA)
 
     def once(name: str, val: float, col: int) -> None:
         """A word may repeat in a block only with the same value."""
@@ -76,6 +77,16 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             if name.startswith("POSA"):
                 ip.warn(st, f"{name}: POSA is modelled as POS (the block waits until the "
                             "axis is in position)")
+            continue
+        if not ngc and name.startswith("FA["):       # positioning-axis feed (modal)
+            axis = name[3:-1].strip()
+            if not axis or not ip.is_axis_name(axis):
+                raise ip.err(st, w.col, f"{name}: '{axis}' is not an axis name")
+            val = ip.ev(st, w.value, w.col)
+            if not 0.0 < val * ip.lin(axis) <= MAX_FEED_MM_MIN:
+                raise ip.err(st, w.col, f"{name}={val:g}: the positioning feed must be > 0 "
+                                        f"and at most {MAX_FEED_MM_MIN:g} mm/min")
+            ip.fa[axis] = val * ip.lin(axis) / 60.0
             continue
         if not ngc and "[" in name:                  # R[i]=, ATOL[X]=, ARRAY[i]=
             _indexed_assignment(ip, st, w)
@@ -402,7 +413,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     turns = 0
     if positioning:
         # A positioning axis moves on its own and the block waits for it. Modelled as
-        # its own block: the axis alone at rapid (its MAX_AX_VELO), the path at rest
+        # its own block: the axis alone at its FA feed or at rapid, the path at rest
         # before and after (prepare stops at both ends); a path move in the same block
         # would run concurrently, which this path model cannot express.
         if axis_words or motion_set or centre:
@@ -412,11 +423,18 @@ def _block(ip: _Interp, st: Stmt) -> bool:
                                   "in a block of its own")
         axis_words = positioning
         aux.append(("POS", " ".join(a[0] for a in positioning)))
+        # one axis with its FA moves at that feed; otherwise (no FA, or several axes,
+        # which the control moves independently) at rapid, each axis at its own limits
+        if len(positioning) == 1 and positioning[0][0] in ip.fa:
+            block_feed = ip.fa[positioning[0][0]]
+        elif any(a[0] in ip.fa for a in positioning):
+            ip.warn(st, "several positioning axes in one block are modelled as one rapid "
+                        "move; their FA feeds are not applied")
     if axis_words or (motion_set and ip.motion in ("G2", "G3") and centre):
         if ip.motion is None and not positioning:
             raise ip.err(st, axis_words[0][3] if axis_words else 1,
                          "axis move without a motion command (G0/G1/G2/G3)")
-        motion = "G0" if positioning else ip.motion
+        motion = ("G1" if block_feed is not None else "G0") if positioning else ip.motion
         if motion != "G0" and ip.feed is None:
             col = motion_word_col if motion_set else (axis_words[0][3] if axis_words else 1)
             raise ip.err(st, col, f"{motion} with no feed: program F before or in this block")
@@ -475,7 +493,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
                            message=message, comment=st.comment, kept_unmodelled=tuple(kept),
                            column_of_motion=motion_word_col, plane_basis=plane_basis)
     ip.last_end = end
-    ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end, ip.feed,
+    ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end,
+                        ip.feed if block_feed is None else block_feed,
                         (ip.mode10 == "G60") or g9, modal, extra))
     if ngc and ("M", 99.0) in aux:
         ip.warn(st, "M99 in the main program repeats it on the control; taken as the end of "

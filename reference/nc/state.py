@@ -111,6 +111,7 @@ class _Interp:
         self.g92: dict[str, float] = {}  # NGC G92 offsets, program units converted to mm
         self.tang_defs: dict[str, Tangential] = {}
         self.tang_active: str | None = None
+        self.fa: dict[str, float] = {}   # FA[axis]: positioning-axis feed, mm/s or deg/s
         self.out: list = []
         self.warnings: list[ProgramWarning] = []
         self.warned: set[str] = set()

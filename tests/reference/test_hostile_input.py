@@ -251,6 +251,20 @@ def test_pos_axis_is_its_own_rapid_block_with_stops_before_and_after():
     assert path.stop_reason[1] == "positioning axis POS[A]"
 
 
+@pytest.mark.parametrize("text", ["FA[A]=3600\nPOS[A]=90\n", "POS[A]=90 FA[A]=3600\n"])
+def test_pos_axis_with_fa_moves_at_that_feed(text):
+    p = parse_text("G1 F1000 X10\n" + text + "G1 X20\n", "p", SIN)
+    pos = next(b for b in p.blocks if b.end[3] == 90.0 and b.start[3] == 0.0)
+    assert pos.motion == "G1" and pos.feed_mm_s == pytest.approx(60.0)   # 3600 deg/min
+    assert p.blocks[-1].feed_mm_s == pytest.approx(1000.0 / 60.0)        # path feed kept
+    path = prepare(p)
+    assert path.feed.tolist() == pytest.approx([1000.0 / 60.0, 60.0, 1000.0 / 60.0])
+
+
+def test_fa_must_be_positive():
+    _err("FA[A]=0\n", SIN, 1, 1, r"FA\[A\]=0: the positioning feed must be > 0")
+
+
 def test_pos_axis_with_path_motion_in_the_same_block_is_an_error():
     _err("G1 F1000 X10 POS[A]=90\n", SIN, 1, 10, r"POS\[A\] with path motion in the same "
                                                  r"block is not supported")
