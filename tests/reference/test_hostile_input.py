@@ -302,6 +302,14 @@ def test_atrans_in_a_tilted_frame_moves_along_the_tilted_axes():
     assert ends[2] == pytest.approx((-5.0, 0.0, 0.0))
 
 
+def test_incremental_moves_in_a_tilted_and_shifted_frame():
+    # machine = R (program + shift), R = Ry(-90): program +X is machine +Z
+    ends = _ends("ROT Y-90\nATRANS X3 Y4 Z5\nG1 F1000 X0 Y0 Z0\nG91 X1\nY2\n")
+    assert ends[2] == pytest.approx((-5.0, 4.0, 3.0))
+    assert ends[3] == pytest.approx((-5.0, 4.0, 4.0))
+    assert ends[4] == pytest.approx((-5.0, 6.0, 4.0))
+
+
 def test_g17_arc_in_a_tilted_frame_lies_in_the_tilted_plane():
     p = parse_text("ROT Y-90\nG1 F1000 X10 Y10\nG2 X0 Y0 I-5 J-5\n", "p", SIN)
     arc = p.blocks[2]
