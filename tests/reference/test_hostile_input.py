@@ -328,5 +328,16 @@ def test_g17_arc_in_a_tilted_frame_lies_in_the_tilted_plane():
     assert np.hypot(q[:, 1] - 5.0, q[:, 2] - 5.0) == pytest.approx(np.full(4, r))
 
 
+def test_helix_in_a_tilted_frame_rises_along_the_tilted_axis():
+    # program: half turn clockwise about (5, 0) from (0, 0, 0) to (10, 0, 5); the
+    # midpoint is (5, 5, 2.5), in the machine R (5, 5, 2.5) = (-2.5, 5, 5)
+    p = parse_text("ROT Y-90\nG1 F1000 X0 Y0 Z0\nG2 X10 Y0 Z5 I5 J0\n", "p", SIN)
+    assert p.blocks[-1].end == pytest.approx((-5.0, 0.0, 10.0))
+    path = prepare(p)
+    assert path.length[-1] == pytest.approx(math.hypot(math.pi * 5.0, 5.0))
+    s_mid = path.total_length - 0.5 * path.length[-1]
+    assert path.evaluate(s_mid)[0][0] == pytest.approx([-2.5, 5.0, 5.0])
+
+
 def test_rotation_about_a_rotary_axis_is_an_error():
     _err("ROT A30\n", SIN, 1, 5, r"ROT A: rotations are about the geometry axes X, Y and Z")
