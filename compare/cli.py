@@ -58,6 +58,10 @@ def cmd_inspect(args: argparse.Namespace) -> int:
                   f"{stop[:30]:<30} {src}\n")
     for w in inputs.warnings:
         print(str(w), file=sys.stderr)
+    if path.n_segments == 0:
+        # a listing of nothing is a valid answer here; plan, optimize and compare reject it
+        print(f"{program.file}: note: the program has no motion (no block moves an axis)",
+              file=sys.stderr)
     return EXIT_OK
 
 

@@ -21,13 +21,14 @@ import os
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Callable, Union
 
+from reference.core.errors import PathError
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.machine import Machine, load_machine
 from reference.nc import parse_file
 from reference.nc.program import Program, ProgramWarning
 from reference.holds import imposed_holds
-from reference.prepare import build_path, unmodelled_features
+from reference.prepare import build_path, prepare, unmodelled_features
 
 from . import engines
 from .comparison import Comparison, compare
@@ -120,7 +121,32 @@ def plan_program(program: ProgramLike, machine: MachineLike = None, *,
         Profile, per-block rows (``to_json_dict`` gives the JSON), the own check.
     """
     inp = load_inputs(program, machine, dialect=dialect)
-    return engines.run_heuristic(inp.program, inp.machine, progress=progress)
+    path = build_path(inp.program, inp.machine)
+    require_motion(inp.program, path)
+    require_motion(inp.program, path)
+    return engines.run_heuristic(inp.program, inp.machine, path=path, progress=progress)
+
+
+def require_motion(program: Program, path: Path) -> None:
+    """A program whose path has no segment is rejected (exit 2) before any result.
+
+    An empty file, comments only or settings only (``G90`` alone) move nothing: the time
+    is 0 s for every planner and the gap ``t_ref/LB - 1`` is 0/0. A CI gate that passed it
+    with "0 s, ok" would hide the usual cause, a wrong or truncated file; so it is bad
+    input, naming the file, like any other program nothing can be said about. (The
+    library's :func:`optimal.solve` and :func:`reference.planner.plan` still answer such a
+    path with zero times.)
+
+    Raises
+    ------
+    PathError
+        The path has no segment.
+    """
+    if path.n_segments == 0:
+        n = len(program.blocks)
+        raise PathError(f"{program.file}: the program has no motion ({n} block"
+                        f"{'' if n == 1 else 's'}, none moves an axis): nothing to plan, "
+                        "optimize or compare")
 
 
 # --------------------------------------------------------------------- optimize
@@ -209,6 +235,7 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     bounds, _ = engines.resolve_bounds(bounds, None)
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
+    require_motion(inp.program, path)
     # the waits the program and machine impose (dwell, exact-stop settle): the same the
     # heuristic would contain, computed without it
     holds = imposed_holds(inp.program, path, inp.machine)
@@ -250,6 +277,7 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     """
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
+    require_motion(inp.program, path)
     plan = engines.run_heuristic(inp.program, inp.machine, path=path,
                                  progress=_prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
@@ -304,6 +332,7 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
     if not isinstance(smoothing, str) and not (math.isfinite(smoothing) and smoothing >= 0):
         raise ValueError(f"smoothing {smoothing!r}: must be >= 0 mm")
     inp = load_inputs(program, machine, dialect=dialect)
+    require_motion(inp.program, prepare(inp.program))
     return check_recorded(trajectory, inp.program, inp.machine, bounds=bounds,
                           path_kind=path_kind, smoothing=smoothing,
                           max_deviation=max_deviation, progress=progress)
@@ -311,4 +340,4 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
 
 __all__ = ["Inputs", "MachineLike", "OptimizeResult", "ProgramLike", "ProgressFn",
            "check_trajectory", "compare_program", "load_inputs", "optimize_program",
-           "plan_program"]
+           "plan_program", "require_motion"]

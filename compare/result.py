@@ -347,6 +347,11 @@ class Verdict:
                        f"the oracle's verified profile breaks a limit (an oracle bug): "
                        f"{describe_violation(v, c)}", max_gap)
         if not c.certified:
+            if c.oracle.status in ("optimal", "gap_not_met") and c.oracle.lower_bound_s == 0:
+                # solved, but a zero lower bound certifies nothing (no motion): say so
+                return cls(False, "no certificate",
+                           "the oracle's lower bound is 0 s (the path has no motion), so "
+                           "the gap t_ref/LB - 1 is undefined", max_gap)
             return cls(False, "no certificate",
                        f"the oracle gave no certified bounds (status {c.oracle.status})",
                        max_gap)

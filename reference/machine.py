@@ -33,14 +33,22 @@ class _Key:
     lo: float | None = None       # exclusive lower bound (None: no check)
     hi: float | None = None       # inclusive upper bound: above it the unit is likely wrong
     doc: str = ""
+    low: float | None = None      # plausible minimum: below it the unit is likely wrong
 
 
 # Plausible ranges cover real machines from small routers to large gantries; a value
 # outside is almost always a unit error (m/min for mm/min, mm/s^2 for m/s^2), so it is
-# rejected with the unit named instead of silently giving a 1000x wrong answer.
+# rejected with the unit named instead of silently giving a 1000x wrong answer. Every
+# number key has both ends: a plausible maximum ``hi`` and, for the keys a planner divides
+# by or multiplies a limit with, a plausible minimum ``low`` (a value such as 1e-300 is a
+# unit or typing error, and would otherwise divide by zero or stretch a profile to
+# astronomical times). The minima sit one to three decades below the smallest value of
+# real machine data (a hobby router accelerates with about 0.1 m/s^2, jerks with about
+# 1 m/s^3, samples at 10 Hz; tolerances are at least 1 um).
 _MACHINE_KEYS: dict[str, _Key] = {
     "name": _Key(str, ""),
-    "ipo_cycle_ms": _Key((int, float), "ms", 0.0, 100.0, "IPO cycle (MD10050 x MD10070)"),
+    "ipo_cycle_ms": _Key((int, float), "ms", 0.0, 100.0, "IPO cycle (MD10050 x MD10070)",
+                         0.01),
 }
 
 _CHANNEL_KEYS: dict[str, _Key] = {
@@ -49,33 +57,43 @@ _CHANNEL_KEYS: dict[str, _Key] = {
     "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0, "MD20460"),
     "ADAPT_PATH_DYNAMIC": _Key(list, "", doc="MD20465 [BRISK, SOFT], each >= 1"),
     "lookahead_blocks": _Key(int, "blocks", 0, 100000, "LookAhead horizon"),
-    "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465"),
-    "SMOOTH_ORI_TOL": _Key((int, float), "deg", 0.0, 90.0, "SD42466"),
-    "CUTCOM_CORNER_LIMIT": _Key((int, float), "deg", 0.0, 180.0, "MD20210"),
+    "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465", 1e-6),
+    "SMOOTH_ORI_TOL": _Key((int, float), "deg", 0.0, 90.0, "SD42466", 1e-6),
+    "CUTCOM_CORNER_LIMIT": _Key((int, float), "deg", 0.0, 180.0, "MD20210", 1e-3),
     "acceleration_mode": _Key(str, "", doc="BRISK | SOFT"),
-    "MAX_PATH_JERK": _Key((int, float), "m/s^3", 0.0, 1e6, "MD20600"),
-    "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560"),
-    "rounding_length_clamp": _Key((int, float), "", 0.0, 0.5, "block-length clamp c"),
+    "MAX_PATH_JERK": _Key((int, float), "m/s^3", 0.0, 1e6, "MD20600", 1e-3),
+    "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560", 1e-3),
+    "rounding_length_clamp": _Key((int, float), "", 0.0, 0.5, "block-length clamp c", 1e-3),
 }
 
 _AXIS_KEYS: dict[str, _Key] = {
     "type": _Key(str, "", doc="linear | rotary"),
     "MAX_AX_VELO": _Key((int, float), "mm/min", 1.0, 1e7, "MD32000 (rotary: rev/min)"),
-    "MAX_AX_ACCEL": _Key((int, float), "m/s^2", 0.0, 200.0, "MD32300 (rotary: rev/s^2)"),
-    "MAX_AX_JERK": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32431 (rotary: rev/s^3)"),
+    "MAX_AX_ACCEL": _Key((int, float), "m/s^2", 0.0, 200.0, "MD32300 (rotary: rev/s^2)",
+                         1e-4),
+    "MAX_AX_JERK": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32431 (rotary: rev/s^3)",
+                        1e-3),
     "MAX_ACCEL_OVL_FACTOR": _Key((int, float), "", None, 10.0, "MD32310, >= 1"),
-    "LOOKAH_FREQUENCY": _Key((int, float), "Hz", 0.0, 1000.0, "MD32440"),
-    "PATH_TRANS_JERK_LIM": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32432"),
-    "COMPRESS_POS_TOL": _Key((int, float), "mm", 0.0, 100.0, "MD33100"),
-    "EPS_TLIFT_TANG_STEP": _Key((int, float), "deg", 0.0, 180.0, "MD37400"),
-    "POSCTRL_GAIN": _Key((int, float), "(m/min)/mm", 0.0, 100.0, "MD32200"),
-    "STOP_LIMIT_FINE": _Key((int, float), "mm", 0.0, 10.0, "MD36010"),
-    "STOP_LIMIT_COARSE": _Key((int, float), "mm", 0.0, 10.0, "MD36000"),
+    "LOOKAH_FREQUENCY": _Key((int, float), "Hz", 0.0, 1000.0, "MD32440", 1e-2),
+    "PATH_TRANS_JERK_LIM": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32432", 1e-3),
+    "COMPRESS_POS_TOL": _Key((int, float), "mm", 0.0, 100.0, "MD33100", 1e-6),
+    "EPS_TLIFT_TANG_STEP": _Key((int, float), "deg", 0.0, 180.0, "MD37400", 1e-3),
+    "POSCTRL_GAIN": _Key((int, float), "(m/min)/mm", 0.0, 100.0, "MD32200", 1e-3),
+    "STOP_LIMIT_FINE": _Key((int, float), "mm", 0.0, 10.0, "MD36010", 1e-6),
+    "STOP_LIMIT_COARSE": _Key((int, float), "mm", 0.0, 10.0, "MD36000", 1e-6),
     "VELO_FFW_WEIGHT": _Key((int, float), "", -1e-12, 1.0, "MD32610 (0..1)"),
-    "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433"),
-    "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434"),
-    "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435"),
+    "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433", 1e-3),
+    "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434", 1e-3),
+    "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435", 1e-3),
 }
+
+
+#: Plausible maximum of each ADAPT_PATH_DYNAMIC factor: the control divides the path
+#: acceleration and jerk by it; real data use 1..4, and 10 (like the other factor keys)
+#: still leaves room while rejecting inf or a value typed in the wrong field.
+_ADAPT_MAX = 10.0
+#: Longest machine name: it heads tables and report titles.
+_NAME_MAX = 200
 
 
 @dataclass(frozen=True, slots=True)
@@ -207,6 +225,11 @@ def _check(section: str, key: str, value: Any, spec: _Key, source: str) -> None:
         if spec.lo is not None and not value > spec.lo:
             raise MachineDataError(dotted, value, f"must be > {spec.lo:g} {spec.unit}".rstrip(),
                                    source)
+        if spec.low is not None and value < spec.low:
+            raise MachineDataError(
+                dotted, value, f"is below the plausible minimum {spec.low:g} {spec.unit}; "
+                f"check the unit ({spec.doc} is given in {spec.unit})".replace(" ;", ";")
+                .replace("( is given in )", "(a factor)"), source)
         if spec.hi is not None and value > spec.hi:
             raise MachineDataError(
                 dotted, value, f"is above the plausible maximum {spec.hi:g} {spec.unit}; "
@@ -244,6 +267,10 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         if sec not in ("machine", "channel", "axis"):
             raise MachineDataError(sec, data[sec], "unknown section; expected [machine], "
                                    "[channel] and [axis.<NAME>]", source)
+    for sec in ("machine", "channel"):
+        if sec in data and not isinstance(data[sec], dict):
+            raise MachineDataError(sec, data[sec], f"must be a table: a [{sec}] section with "
+                                   "keys, not a value", source)
     mach = data.get("machine", {})
     for k, v in mach.items():
         if k not in _MACHINE_KEYS:
@@ -254,6 +281,10 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
                                source)
     t_ipo = mach["ipo_cycle_ms"] / 1000.0
     name = mach.get("name", FsPath(source).stem)
+    if not name.strip() or not name.isprintable() or len(name) > _NAME_MAX:
+        # the name goes into one-line messages, tables and report titles (escaped there)
+        raise MachineDataError("machine.name", name, f"must be one line of printable text, "
+                               f"1 to {_NAME_MAX} characters", source)
 
     ch = data.get("channel", {})
     for k, v in ch.items():
@@ -262,9 +293,11 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         _check("channel", k, v, _CHANNEL_KEYS[k], source)
     adapt = ch.get("ADAPT_PATH_DYNAMIC", [1.0, 1.0])
     if (len(adapt) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
-                                   and x >= 1.0 for x in adapt)):
+                                   and 1.0 <= x <= _ADAPT_MAX for x in adapt)):
         raise MachineDataError("channel.ADAPT_PATH_DYNAMIC", adapt,
-                               "must be two numbers >= 1.0 ([BRISK, SOFT]; 1.0 = off)", source)
+                               f"must be two numbers >= 1.0 and <= {_ADAPT_MAX:g} "
+                               "([BRISK, SOFT]; 1.0 = off; it divides the path dynamics, "
+                               "so a larger factor is a typing error)", source)
     mode = ch.get("acceleration_mode", "SOFT")
     if mode not in ("BRISK", "SOFT"):
         raise MachineDataError("channel.acceleration_mode", mode, "must be BRISK or SOFT",
@@ -337,6 +370,25 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
                    axis_settings=tuple(settings))
 
 
+def _decode(data: bytes, source: str) -> str:
+    """Machine-data bytes as text: UTF-8 (TOML's encoding, with or without a BOM), or
+    UTF-16 with a byte-order mark (what some Windows editors write). Anything else, e.g.
+    Latin-1 umlauts in a comment, is rejected naming the file, never guessed."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise MachineDataError("<file>", source, f"is not valid UTF-16 text despite its "
+                                   f"byte-order mark (byte {exc.start})", source) from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise MachineDataError("<file>", source, f"is not UTF-8 text (byte {exc.start}, line "
+                               f"{line}): TOML files must be UTF-8; save the file as UTF-8",
+                               source) from None
+
+
 def load_machine(path: str | FsPath | None = None) -> Machine:
     """Load machine data from a TOML file, or a bundled machine by name.
 
@@ -364,8 +416,8 @@ def load_machine(path: str | FsPath | None = None) -> Machine:
         if not p.is_file():
             raise MachineDataError("--machine", str(path), "file not found (bundled machines: "
                                    + ", ".join(BUNDLED_MACHINES) + ")")
-        text = p.read_text(encoding="utf-8")
         source = str(path)
+        text = _decode(p.read_bytes(), source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

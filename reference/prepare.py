@@ -14,6 +14,7 @@ LookAhead (sinumerik-model sections 3 and 5.2). Model choices, each a documented
   blocks are handled in block preparation and do not stop the path;
 * M0, M1 (programmed stop), M2, M30 (end) in a moving block -> rest at its end;
   M6 (tool change) in a moving block -> rest at its start (aux output before motion);
+  a positioning-axis block (SINUMERIK ``POS[A]=...``) -> rest at its start and its end;
   other M, S, T, D, H words in a moving block are output during motion: no stop.
 
 Stops that only the heuristic makes (BRISK/SOFT change, geometry axes appearing) belong
@@ -42,6 +43,9 @@ def _aux_stops(block: Block) -> tuple[str, str]:
     """(reason at block start, reason at block end) caused by M words of a moving block."""
     start = end = ""
     for letter, value in block.aux:
+        if letter == "POS":      # positioning axes: the path rests while they move
+            start = end = f"positioning axis POS[{value}]"
+            continue
         if letter != "M" or value != int(value):
             continue
         code = int(value)
@@ -62,7 +66,8 @@ def _idle_stop(block: Block) -> str:
         if letter == "M" and value == int(value) and int(value) in _STOP_AT_START_M:
             return _STOP_AT_START_M[int(value)]
     if block.aux:
-        words = " ".join(f"{l}{v:g}" for l, v in block.aux)
+        words = " ".join(f'{l}="{v}"' if isinstance(v, str) else f"{l}{v:g}"
+                         for l, v in block.aux)
         return f"block without path motion ({words})"
     if block.message is not None:
         return "block without path motion (MSG)"

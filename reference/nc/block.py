@@ -9,14 +9,17 @@ tangential control, cycles), frames, feed and dwell, motion (arcs by
 
 from __future__ import annotations
 
+import math
+
 from ..core.units import MM_PER_INCH
 from .arcs import _arc
-from .expr import Cursor, ExprError, parse_expr
+from .expr import Cursor, ExprError, ngc_parameter_name, parse_expr
 from .frames import _apply_frame, _apply_g10, _apply_g92, _ngc_frame
 from .lines import Stmt, Word
 from .program import NO_EXTRA, Block, BlockExtra, Modal, Tangential
 from .state import (_G_GROUPS_NGC, _G_GROUPS_SIN, _IGNORED_G_NGC, _IGNORED_G_SIN,
-                    _IGNORED_WHY, _MODES10_SIN, _NGC_CS, _UNSUPPORTED_G, _Interp)
+                    _IGNORED_WHY, _MODES10_SIN, _NGC_CS, _PLANE_AXES, _UNSUPPORTED_G,
+                    MAX_COORDINATE_MM, MAX_DWELL_S, MAX_FEED_MM_MIN, ROTARY, _Interp)
 
 
 def _block(ip: _Interp, st: Stmt) -> bool:
@@ -27,7 +30,13 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     pending: list[tuple[str, float]] = []
     for target, node, col in st.assigns:
         if ngc:
-            key = target[1] if target[0] == "var" else f"#{int(ip.ev(st, target[1], col + 1))}"
+            if target[0] == "var":
+                key = target[1]
+            else:
+                try:
+                    key = ngc_parameter_name(ip.ev(st, target[1], col + 1), 0)
+                except ExprError as exc:
+                    raise ip.err(st, col + 1, str(exc)) from None
             pending.append((key, ip.ev(st, node, col + 1)))
         else:                                  # pragma: no cover - SINUMERIK uses words
             ip.vars[target] = ip.ev(st, node, col + 1)
@@ -40,6 +49,9 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     feed_word: tuple[float, int] | None = None
     p_word = q_word = r_word = l_word = None
     seen: dict[str, float] = {}
+    m98_col = 0
+    positioning: list[tuple[str, float, str, int]] = []   # POS[axis]=value
+    block_feed: float | None = None             # a feed of this block only (POS with FA)
 
     def once(name: str, val: float, col: int) -> None:
         """A word may repeat in a block only with the same value."""
@@ -52,6 +64,30 @@ def _block(ip: _Interp, st: Stmt) -> bool:
 
     for w in st.words:
         name = w.name
+        if not ngc and name.startswith(("POS[", "POSA[")):   # positioning axis
+            axis = name[name.index("[") + 1:-1].strip()
+            if not axis or not ip.is_axis_name(axis):
+                raise ip.err(st, w.col, f"{name}: '{axis}' is not an axis name")
+            val = ip.ev(st, w.value, w.col)
+            if not math.isfinite(val):
+                raise ip.err(st, w.col, f"the value of {name} is too large to be a number")
+            once(name.replace("POSA[", "POS["), val, w.col)
+            ip.add_axis(axis)
+            positioning.append((axis, val, w.mode, w.col))
+            if name.startswith("POSA"):
+                ip.warn(st, f"{name}: POSA is modelled as POS (the block waits until the "
+                            "axis is in position)")
+            continue
+        if not ngc and name.startswith("FA["):       # positioning-axis feed (modal)
+            axis = name[3:-1].strip()
+            if not axis or not ip.is_axis_name(axis):
+                raise ip.err(st, w.col, f"{name}: '{axis}' is not an axis name")
+            val = ip.ev(st, w.value, w.col)
+            if not 0.0 < val * ip.lin(axis) <= MAX_FEED_MM_MIN:
+                raise ip.err(st, w.col, f"{name}={val:g}: the positioning feed must be > 0 "
+                                        f"and at most {MAX_FEED_MM_MIN:g} mm/min")
+            ip.fa[axis] = val * ip.lin(axis) / 60.0
+            continue
         if not ngc and "[" in name:                  # R[i]=, ATOL[X]=, ARRAY[i]=
             _indexed_assignment(ip, st, w)
             continue
@@ -81,12 +117,23 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             ip.warn(st, f"variable {name} is assigned without DEF; taken as a REAL variable",
                     once_key=f"undeclared {name}")
             continue
+        if w.value[0] == "str":                      # T="DRILL 8.5": a tool by name
+            once(name, hash(w.value[1]), w.col)
+            aux.append(("T", w.value[1]))
+            ip.tool = w.value[1]
+            continue
         val = ip.ev(st, w.value, w.col)
+        if not math.isfinite(val):
+            # 400 nines, 1e308*10: float overflow, never a value a control accepts
+            raise ip.err(st, w.col, f"the value of {name} is too large to be a number "
+                                    f"({val:g})")
         if name == "G":
             g_codes.append((val, w.col))
             continue
         if name == "M":
             aux.append(("M", val))
+            if ngc and val == 98.0:
+                m98_col = w.col
             continue
         if name != "N":
             once(name, val, w.col)
@@ -185,8 +232,15 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             ip.mode10 = "G60"
         elif ngc and gi == 64:
             ip.mode10 = "G64"
-            ip.ctol = p_word[0] * ip.lin("X") if p_word else None
-            ip.naive_cam = (q_word[0] * ip.lin("X") if q_word else ip.ctol)
+            for word, letter in ((p_word, "P"), (q_word, "Q")):
+                if word is not None and word[0] < 0:
+                    # LinuxCNC passes a negative tolerance on as "no tolerance" (G64 alone)
+                    ip.warn(st, f"G64 {letter}{word[0]:g}: a negative tolerance means no "
+                                f"tolerance on LinuxCNC (as G64 without {letter}); taken so")
+            p_tol = p_word[0] if p_word is not None and p_word[0] >= 0 else None
+            q_tol = q_word[0] if q_word is not None and q_word[0] >= 0 else None
+            ip.ctol = p_tol * ip.lin("X") if p_tol is not None else None
+            ip.naive_cam = (q_tol * ip.lin("X") if q_tol is not None else ip.ctol)
             p_word = None
         elif gi in (40, 41, 42):
             ip.trc = f"G{int(gi)}"
@@ -229,6 +283,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             ip.warn(st, f"G{gi:g} is kept without effect on the motion model: {why}")
         else:
             raise ip.err(st, col, f"unknown G code G{gi:g}")
+    if m98_col:
+        _m98(ip, st, m98_col, p_word)
     # --- flags (SINUMERIK keywords) ------------------------------------------------
     frame_cmd = None
     for flag, col in st.flags:
@@ -282,6 +338,10 @@ def _block(ip: _Interp, st: Stmt) -> bool:
                 message = a[a.find('"') + 1:a.rfind('"')]
         elif name in ("TANG", "TANGON", "TANGOF", "TLIFT", "TANGDEL"):
             _tangential(ip, st, name, args, col)
+        elif not ngc and name in _UNSUPPORTED_MOTION_SIN and not args:
+            raise ip.err(st, col + 1, f"{name} ({_UNSUPPORTED_MOTION_SIN[name]}) is not "
+                                      "supported: its points would not be on the modelled "
+                                      "path; convert it into G1/G2/G3 blocks")
         elif name.startswith("$"):
             kept.append(args)
             ip.warn(st, f"system variable statement '{args}' needs a real control; kept "
@@ -328,6 +388,9 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             raise ip.err(st, 1, "G4 needs F (seconds) or S (spindle revolutions)")
         if dwell is not None and dwell < 0:
             raise ip.err(st, 1, f"negative dwell time {dwell:g} s")
+        if dwell is not None and dwell > MAX_DWELL_S:
+            raise ip.err(st, 1, f"dwell time {dwell:g} s is above {MAX_DWELL_S:g} s "
+                                f"({MAX_DWELL_S / 86400:.1f} days): check the number")
         feed_word = None
     else:
         for a in aux:
@@ -337,32 +400,79 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         f, col = feed_word
         if f < 0:
             raise ip.err(st, col, f"negative feed F{f:g}")
-        ip.feed = f * (MM_PER_INCH if ip.feed_inch else 1.0) / 60.0
+        mm_min = f * (MM_PER_INCH if ip.feed_inch else 1.0)
+        if mm_min > MAX_FEED_MM_MIN:
+            raise ip.err(st, col, f"feed F{f:g} is above {MAX_FEED_MM_MIN:g} mm/min, faster "
+                                  "than any machine by orders of magnitude: check the number")
+        ip.feed = mm_min / 60.0
     # --- motion ------------------------------------------------------------------------
     start = tuple(ip.pos[a] for a in ip.axes)
     centre_out = None
     plane_basis = None
     motion = None
     turns = 0
+    if positioning:
+        # A positioning axis moves on its own and the block waits for it. Modelled as
+        # its own block: the axis alone at its FA feed or at rapid, the path at rest
+        # before and after (prepare stops at both ends); a path move in the same block
+        # would run concurrently, which this path model cannot express.
+        if axis_words or motion_set or centre:
+            col = (axis_words[0][3] if axis_words else motion_word_col)
+            raise ip.err(st, col, f"POS[{positioning[0][0]}] with path motion in the same "
+                                  "block is not supported: program the positioning axis "
+                                  "in a block of its own")
+        axis_words = positioning
+        aux.append(("POS", " ".join(a[0] for a in positioning)))
+        # one axis with its FA moves at that feed; otherwise (no FA, or several axes,
+        # which the control moves independently) at rapid, each axis at its own limits
+        if len(positioning) == 1 and positioning[0][0] in ip.fa:
+            block_feed = ip.fa[positioning[0][0]]
+        elif any(a[0] in ip.fa for a in positioning):
+            ip.warn(st, "several positioning axes in one block are modelled as one rapid "
+                        "move; their FA feeds are not applied")
     if axis_words or (motion_set and ip.motion in ("G2", "G3") and centre):
-        if ip.motion is None:
+        if ip.motion is None and not positioning:
             raise ip.err(st, axis_words[0][3] if axis_words else 1,
                          "axis move without a motion command (G0/G1/G2/G3)")
-        motion = ip.motion
+        motion = ("G1" if block_feed is not None else "G0") if positioning else ip.motion
         if motion != "G0" and ip.feed is None:
             col = motion_word_col if motion_set else (axis_words[0][3] if axis_words else 1)
             raise ip.err(st, col, f"{motion} with no feed: program F before or in this block")
+        if motion != "G0" and ip.feed == 0.0:
+            # both controls refuse a feed move at F0 (it would never end); F0 alone is a
+            # setting and only the move that uses it is an error
+            col = feed_word[1] if feed_word is not None else (
+                motion_word_col if motion_set else (axis_words[0][3] if axis_words else 1))
+            raise ip.err(st, col, f"{motion} with feed F0: the move would never end; "
+                                  "program a feed > 0")
         prog = ip.program_pos() if not g53 else dict(ip.pos)
         target = dict(prog)
         for name, val, mode, col in axis_words:
             v = val * ip.lin(name)
             incremental = (mode == "IC") or (mode != "AC" and not ip.absolute)
             target[name] = prog.get(name, 0.0) + v if incremental else v
-        identity = ip.frame.theta_deg == 0.0 and not ip.frame.offset
+        identity = ip.frame.identity
         machine = target if (g53 or identity) else ip.frame.to_machine(target)
+        _check_range(ip, st, machine, axis_words, "position", motion_word_col)
         if motion in ("G2", "G3"):
+            for word, rad in (("CR", named.get("CR")), ("R", r_word)):
+                if rad is not None and not abs(rad[0] * ip.lin("X")) <= MAX_COORDINATE_MM:
+                    raise ip.err(st, rad[1], f"arc radius {word}{'=' if len(word) > 1 else ''}"
+                                             f"{rad[0]:g} is beyond {MAX_COORDINATE_MM:g} mm, "
+                                             "larger than any machine: check the number")
             centre_out, plane_basis, turns = _arc(ip, st, motion, prog, target, centre,
                                                   named, r_word, p_word, motion_word_col)
+            if ip.frame.tilt is not None and not g53:
+                # a tilted frame tilts the working plane: the arc lies in R * (plane)
+                u, v, _ = _PLANE_AXES[ip.plane]
+                unit = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+                plane_basis = (ip.frame.rotate_vec(unit[u]), ip.frame.rotate_vec(unit[v]))
+            if centre_out is not None:
+                cols = [c[2] for c in centre.values()] + (
+                    [named["CR"][1]] if "CR" in named else []) + (
+                    [r_word[1]] if r_word is not None else [])
+                col = min(cols, default=motion_word_col)
+                _check_range(ip, st, dict(zip(ip.axes, centre_out)), (), "arc centre", col)
         ip.pos.update(machine)
     end = tuple(ip.pos[a] for a in ip.axes)
     tang = ip.tang_defs.get(ip.tang_active) if ip.tang_active else None
@@ -383,7 +493,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
                            message=message, comment=st.comment, kept_unmodelled=tuple(kept),
                            column_of_motion=motion_word_col, plane_basis=plane_basis)
     ip.last_end = end
-    ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end, ip.feed,
+    ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end,
+                        ip.feed if block_feed is None else block_feed,
                         (ip.mode10 == "G60") or g9, modal, extra))
     if ngc and ("M", 99.0) in aux:
         ip.warn(st, "M99 in the main program repeats it on the control; taken as the end of "
@@ -391,6 +502,46 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         return True
     return program_end or any(a == ("M", 2.0) or a == ("M", 30.0) or
                               (not ngc and a == ("M", 17.0)) for a in aux)
+
+
+#: SINUMERIK motion commands (G group 1) besides G0..G3 that the model does not
+#: interpolate; a block under them would silently become a straight line.
+_UNSUPPORTED_MOTION_SIN = {"ASPLINE": "Akima spline", "BSPLINE": "B spline",
+                           "CSPLINE": "cubic spline", "POLY": "polynomial interpolation",
+                           "CIP": "circle through an intermediate point",
+                           "CT": "circle with tangential transition"}
+
+
+def _m98(ip: _Interp, st: Stmt, col: int, p_word) -> None:
+    """NGC ``M98 P<n>``: a Fanuc-style subprogram call, which the model does not run.
+
+    LinuxCNC calls the subprogram ``O<n>`` of the same file (M98/M99) and refuses the
+    block when there is none; either way the moves of the call would be missing here,
+    so it is an error naming which of the two it is.
+    """
+    if p_word is None:
+        raise ip.err(st, col, "M98 needs P (the number of the subprogram O<n> to call)")
+    num = p_word[0]
+    label = f"O{int(num)}" if num == int(num) else ""
+    if label and any(s.label == label for s in ip.stmts):
+        raise ip.err(st, col, f"M98 P{num:g}: Fanuc-style subprogram calls (M98/M99) are "
+                              "not supported; write the subprogram as an O-word sub "
+                              f"(o{int(num)} sub ... o{int(num)} endsub, o{int(num)} call)")
+    raise ip.err(st, p_word[1], f"M98 P{num:g}: there is no subprogram O{num:g} in this "
+                                "file")
+
+
+def _check_range(ip: _Interp, st: Stmt, where: dict, axis_words, what: str,
+                 col: int) -> None:
+    """Every coordinate within :data:`MAX_COORDINATE_MM` (else an error at the word)."""
+    for name, v in where.items():
+        if not -MAX_COORDINATE_MM <= v <= MAX_COORDINATE_MM:
+            c = next((w[3] for w in axis_words if w[0] == name),
+                     axis_words[0][3] if axis_words else col)
+            unit = "deg" if name in ROTARY else "mm"
+            raise ip.err(st, c, f"{what} {name} = {v:g} {unit} is beyond "
+                                f"+-{MAX_COORDINATE_MM:g} {unit}, farther than any machine "
+                                "travels: check the number")
 
 
 def _indexed_assignment(ip: _Interp, st: Stmt, w: Word) -> None:

@@ -25,8 +25,21 @@ import re
 from typing import Callable, Mapping
 
 NUMBER = re.compile(r"\d+\.?\d*|\.\d+")
+#: Deepest expression accepted: brackets, function calls, unary signs, ``#`` indirections
+#: and chained binary operators together. Hand-written macros nest a handful of levels
+#: and CAM writes plain numbers, so 100 leaves a wide margin; the bound keeps the
+#: recursive parser and evaluator (at most three Python frames per level) far inside
+#: Python's recursion limit of 1000 frames, so a hostile line gets a message at its
+#: column instead of a RecursionError.
+MAX_EXPR_DEPTH = 100
 NAME = re.compile(r"[A-Z_$][A-Z0-9_$]*")
+#: SINUMERIK exponent notation glued to a number: ``EX`` is the control's (1.5EX-3 =
+#: 0.0015); a bare ``E`` (Python's 1e-3) is not, see :func:`sin_exponent`.
+_EXPONENT = re.compile(r"E(X?)([-+]?\d+)")
 _DIGITS = re.compile(r"\d+")
+#: Numbered parameters of LinuxCNC: #1..#5602 (RS274NGC_MAX_PARAMETERS); anything else
+#: is "parameter number out of range" on the control.
+NGC_MAX_PARAMETER = 5602
 
 _D = math.pi / 180.0
 FUNCS1: dict[str, Callable[[float], float]] = {
@@ -89,12 +102,13 @@ class ExprError(Exception):
 class Cursor:
     """A position in one (upper-cased) source line."""
 
-    __slots__ = ("text", "pos", "ngc")
+    __slots__ = ("text", "pos", "ngc", "depth")
 
     def __init__(self, text: str, pos: int = 0, ngc: bool = False) -> None:
         self.text = text
         self.pos = pos
         self.ngc = ngc
+        self.depth = 0          # nesting of the expression being parsed (MAX_EXPR_DEPTH)
 
     def ws(self) -> None:
         t, p = self.text, self.pos
@@ -115,21 +129,43 @@ class Cursor:
 
 
 def parse_expr(cur: Cursor, min_prec: int = 0):
-    """Parse an expression at the cursor (precedence climbing). Returns an AST."""
-    left = _atom(cur)
-    table = _PREC_NGC if cur.ngc else _PREC_SIN
-    while True:
-        cur.ws()
-        op = _peek_op(cur)
-        if op is None or op not in table:
-            return left
-        prec = table[op]
-        if prec < min_prec:
-            return left
-        op_pos = cur.pos
-        cur.pos += len(op)
-        right = parse_expr(cur, prec + 1)         # all operators group left to right
-        left = ("bin", op, left, right, op_pos)
+    """Parse an expression at the cursor (precedence climbing). Returns an AST.
+
+    Raises
+    ------
+    ExprError
+        Malformed, or nested deeper than :data:`MAX_EXPR_DEPTH` (at the column where the
+        limit is crossed).
+    """
+    entry = cur.depth
+    try:
+        left = _atom(cur)
+        table = _PREC_NGC if cur.ngc else _PREC_SIN
+        while True:
+            cur.ws()
+            op = _peek_op(cur)
+            if op is None or op not in table:
+                return left
+            prec = table[op]
+            if prec < min_prec:
+                return left
+            op_pos = cur.pos
+            cur.pos += len(op)
+            # each operator of a chain deepens the (left-leaning) tree the evaluator walks
+            _deeper(cur)
+            right = parse_expr(cur, prec + 1)         # all operators group left to right
+            left = ("bin", op, left, right, op_pos)
+    finally:
+        cur.depth = entry
+
+
+def _deeper(cur: Cursor) -> None:
+    """One level deeper; past :data:`MAX_EXPR_DEPTH` an error at the cursor."""
+    cur.depth += 1
+    if cur.depth > MAX_EXPR_DEPTH:
+        raise ExprError(f"expression nested too deeply (more than {MAX_EXPR_DEPTH} levels "
+                        "of brackets, functions, signs and operators): split it with "
+                        "variables", cur.pos)
 
 
 def _peek_op(cur: Cursor) -> str | None:
@@ -147,6 +183,15 @@ def _peek_op(cur: Cursor) -> str | None:
 
 
 def _atom(cur: Cursor):
+    entry = cur.depth
+    try:
+        _deeper(cur)
+        return _atom_body(cur)
+    finally:
+        cur.depth = entry
+
+
+def _atom_body(cur: Cursor):
     cur.ws()
     start = cur.pos
     ch = cur.peek()
@@ -174,6 +219,8 @@ def _atom(cur: Cursor):
         return _ngc_param(cur)
     m = cur.match(NUMBER)
     if m:
+        if not cur.ngc:
+            return ("num", float(m.group() + sin_exponent(cur.text, cur)))
         return ("num", float(m.group()))
     m = cur.match(NAME)
     if not m:
@@ -217,6 +264,30 @@ def _atom(cur: Cursor):
     return ("var", name, start)
 
 
+def sin_exponent(text: str, cur: Cursor) -> str:
+    """The SINUMERIK exponent glued to the number that ends at ``cur.pos``, as Python text.
+
+    ``EX`` is the control's exponent notation (``1.5EX-3``): returned as ``"E-3"`` and
+    consumed. A bare ``E`` with digits (``1E308``, Python's notation) is no NC number on
+    the control: read as ``1`` plus an axis ``E308`` it would silently move an axis, so
+    it is an error at the ``E``. Returns ``""`` when no exponent follows.
+
+    Raises
+    ------
+    ExprError
+        A bare ``E`` exponent.
+    """
+    e = _EXPONENT.match(text, cur.pos)
+    if e is None:
+        return ""
+    if not e.group(1):
+        raise ExprError(f"'E{e.group(2)}' glued to a number: SINUMERIK writes exponents "
+                        f"with EX (EX{e.group(2)}); for an axis E separate the words with "
+                        "a blank", cur.pos)
+    cur.pos = e.end()
+    return "E" + e.group(2)
+
+
 def _ngc_param(cur: Cursor):
     start = cur.pos
     cur.pos += 1
@@ -233,7 +304,28 @@ def _ngc_param(cur: Cursor):
     m = cur.match(_DIGITS)
     if not m:
         raise ExprError("parameter number expected after '#'", start)
-    return ("var", f"#{int(m.group())}", start)
+    num = int(m.group())
+    _check_parameter(num, start)
+    return ("var", f"#{num}", start)
+
+
+def _check_parameter(num: float, col: int) -> None:
+    """An NGC parameter number within #1..#NGC_MAX_PARAMETER, else an error at ``col``."""
+    if not (1 <= num <= NGC_MAX_PARAMETER and num == int(num)):
+        raise ExprError(f"parameter number #{num:g} is out of range (LinuxCNC has "
+                        f"#1..#{NGC_MAX_PARAMETER} and named parameters #<name>)", col)
+
+
+def ngc_parameter_name(num: float, col: int) -> str:
+    """``"#<n>"`` for a computed parameter number (``#[expr]``), checked like a literal.
+
+    Raises
+    ------
+    ExprError
+        Out of range or not a whole number.
+    """
+    _check_parameter(num, col)
+    return f"#{int(num)}"
 
 
 def evaluate(node, env: Mapping[str, float]) -> float:
@@ -258,7 +350,7 @@ def evaluate(node, env: Mapping[str, float]) -> float:
         raise ExprError(f"unknown variable {key}", node[3])
     if kind == "pidx":
         i = evaluate(node[1], env)
-        return env.get(f"#{int(i)}", 0.0)
+        return env.get(ngc_parameter_name(i, node[2]), 0.0)
     if kind == "neg":
         return -evaluate(node[1], env)
     if kind == "not":

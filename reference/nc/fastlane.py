@@ -12,7 +12,10 @@ from ..core.units import MM_PER_INCH
 from .arcs import _fast_arc_centre
 from .lines import Stmt
 from .program import NO_EXTRA, Block, BlockExtra
-from .state import _END_M, _PLANE_AXES, _Interp
+from .state import _END_M, _PLANE_AXES, MAX_COORDINATE_MM, MAX_FEED_MM_MIN, _Interp
+
+_INF = float("inf")
+_MAX_F = MAX_FEED_MM_MIN / MM_PER_INCH     # in either unit: the full path checks exactly
 
 
 def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
@@ -24,7 +27,7 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
     treatment, which also produces every error message.
     """
     frame = ip.frame
-    if frame.theta_deg != 0.0 or frame.offset:
+    if frame.theta_deg != 0.0 or frame.offset or frame.tilt is not None:
         return False
     motion = ip.motion
     x = y = z = f = g = ci = cj = ck = r = spindle = None
@@ -60,7 +63,7 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
             if f is not None:
                 return False
             f = float(text)
-            if f < 0.0:
+            if not 0.0 < f < _MAX_F:           # F0, too large: the full path says why
                 return False
         elif letter == "I":
             if ci is not None:
@@ -80,7 +83,7 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
             r = float(text)
         elif letter == "M":
             m = float(text)
-            if m in _END_M:                    # program end: the full path decides
+            if m in _END_M or abs(m) == _INF:  # program end or overflow: the full path
                 return False
             if aux is None:
                 aux = []
@@ -89,6 +92,8 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
             if spindle is not None:
                 return False
             spindle = float(text)
+            if abs(spindle) == _INF:           # overflow: the full path says why
+                return False
             if aux is None:
                 aux = []
             aux.append(("S", spindle))
@@ -106,16 +111,19 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
     elif (x is None and y is None and z is None) or ci is not None or cj is not None or (
             ck is not None or r is not None or (motion != "G1" and motion != "G0")):
         return False
-    if feed is None and motion != "G0":
+    if not feed and motion != "G0":            # no feed or F0: the full path says why
         return False
     pos = ip.pos
     k = MM_PER_INCH if ip.inch else 1.0
+    ex = pos["X"] if x is None else (x * k if ip.absolute else pos["X"] + x * k)
+    ey = pos["Y"] if y is None else (y * k if ip.absolute else pos["Y"] + y * k)
+    ez = pos["Z"] if z is None else (z * k if ip.absolute else pos["Z"] + z * k)
+    lim = MAX_COORDINATE_MM
+    if not (-lim <= ex <= lim and -lim <= ey <= lim and -lim <= ez <= lim):
+        return False                           # out of range (or NaN): the full path says why
     if arc:
-        ex = pos["X"] if x is None else (x * k if ip.absolute else pos["X"] + x * k)
-        ey = pos["Y"] if y is None else (y * k if ip.absolute else pos["Y"] + y * k)
-        ez = pos["Z"] if z is None else (z * k if ip.absolute else pos["Z"] + z * k)
         centre = _fast_arc_centre(ip, motion == "G2", ex, ey, ez, ci, cj, ck, r, k)
-        if centre is None:
+        if centre is None or not (-lim <= centre[0] <= lim and -lim <= centre[1] <= lim):
             return False
     ip.feed = feed
     ip.motion = motion
@@ -124,22 +132,7 @@ def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
     start = ip.last_end
     if start is None:
         start = tuple([pos[a] for a in ip.axes])
-    if arc:
-        pos["X"], pos["Y"], pos["Z"] = ex, ey, ez
-    elif ip.absolute:
-        if x is not None:
-            pos["X"] = x * k
-        if y is not None:
-            pos["Y"] = y * k
-        if z is not None:
-            pos["Z"] = z * k
-    else:
-        if x is not None:
-            pos["X"] += x * k
-        if y is not None:
-            pos["Y"] += y * k
-        if z is not None:
-            pos["Z"] += z * k
+    pos["X"], pos["Y"], pos["Z"] = ex, ey, ez
     axes = ip.axes
     if len(axes) == 3:
         end = (pos["X"], pos["Y"], pos["Z"])

@@ -1,8 +1,8 @@
 """Frames and work offsets: where program coordinates sit in machine coordinates.
 
-SINUMERIK programmable frames (``TRANS``/``ATRANS``/``ROT``/``AROT``, rotations about Z
-only) and NGC work offsets (``G10 L2``/``L20`` with ``R`` rotation, G54..G59.3, ``G92``).
-Every frame is ``machine = R(theta about Z) * program + offset``; changing it keeps the
+SINUMERIK programmable frames (``TRANS``/``ATRANS``/``ROT``/``AROT``, rotations about
+X, Y and Z) and NGC work offsets (``G10 L2``/``L20`` with ``R`` rotation, G54..G59.3, ``G92``).
+Every frame is ``machine = R * program + offset`` (R about Z, or tilted); changing it keeps the
 machine position. Units: mm, degrees.
 """
 
@@ -18,16 +18,53 @@ if TYPE_CHECKING:          # the state holds the frames; only annotations need i
     from .state import _Interp
 
 
+_Mat = tuple[tuple[float, float, float], tuple[float, float, float],
+             tuple[float, float, float]]
+
+
+def _rot(axis: str, deg: float) -> _Mat:
+    """Rotation matrix about X, Y or Z by ``deg`` degrees (right hand)."""
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    if axis == "X":
+        return ((1.0, 0.0, 0.0), (0.0, c, -s), (0.0, s, c))
+    if axis == "Y":
+        return ((c, 0.0, s), (0.0, 1.0, 0.0), (-s, 0.0, c))
+    return ((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0))
+
+
+def _matmul(a: _Mat, b: _Mat) -> _Mat:
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3))
+                 for i in range(3))  # type: ignore[return-value]
+
+
 @dataclass(slots=True)
 class _Frame:
-    """Programmable frame: machine = R(theta) * program + offset (theta about Z)."""
+    """Programmable frame: machine = R * program + offset.
+
+    ``R`` is a rotation by ``theta_deg`` about Z, or, when the frame also rotates about X
+    or Y (SINUMERIK ``ROT Y-90``), the full 3x3 matrix ``tilt`` (``theta_deg`` is then
+    0 and unused). Rotations act on the geometry axes X, Y, Z only.
+    """
 
     theta_deg: float = 0.0
     offset: dict | None = None
+    tilt: _Mat | None = None
+
+    @property
+    def identity(self) -> bool:
+        """No rotation and no offset."""
+        return self.theta_deg == 0.0 and not self.offset and self.tilt is None
+
+    def matrix(self) -> _Mat:
+        """The rotation ``R`` as a 3x3 matrix."""
+        return self.tilt if self.tilt is not None else _rot("Z", self.theta_deg)
 
     def to_machine(self, p: dict) -> dict:
         out = dict(p)
-        if self.theta_deg:
+        if self.tilt is not None:
+            v = self.rotate_vec((p.get("X", 0.0), p.get("Y", 0.0), p.get("Z", 0.0)))
+            out["X"], out["Y"], out["Z"] = v
+        elif self.theta_deg:
             c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
             x, y = p.get("X", 0.0), p.get("Y", 0.0)
             out["X"], out["Y"] = c * x - s * y, s * x + c * y
@@ -41,57 +78,85 @@ class _Frame:
         if self.offset:
             for k, v in self.offset.items():
                 out[k] = out.get(k, 0.0) - v
-        if self.theta_deg:
+        if self.tilt is not None:
+            r = self.tilt                              # R^-1 = R^T
+            x, y, z = out.get("X", 0.0), out.get("Y", 0.0), out.get("Z", 0.0)
+            out["X"], out["Y"], out["Z"] = (r[0][i] * x + r[1][i] * y + r[2][i] * z
+                                            for i in range(3))
+        elif self.theta_deg:
             c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
             x, y = out.get("X", 0.0), out.get("Y", 0.0)
             out["X"], out["Y"] = c * x + s * y, -s * x + c * y
         return out
 
     def rotate_vec(self, v: tuple[float, float, float]) -> tuple[float, float, float]:
+        if self.tilt is not None:
+            r = self.tilt
+            return tuple(r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2]
+                         for i in range(3))  # type: ignore[return-value]
         if not self.theta_deg:
             return v
         c, s = math.cos(math.radians(self.theta_deg)), math.sin(math.radians(self.theta_deg))
         return (c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
 
 
+def _with_rotation(old: _Frame, rot: _Mat | None, theta: float, offset: dict | None,
+                   additive: bool) -> _Frame:
+    """A frame with the rotation ``rot`` (or ``theta`` about Z when ``rot`` is None),
+    replacing (``ROT``) or following (``AROT``) the rotation of ``old``."""
+    if rot is None and old.tilt is None:
+        return _Frame((old.theta_deg if additive else 0.0) + theta, offset)
+    new = rot if rot is not None else _rot("Z", theta)
+    full = _matmul(old.matrix(), new) if additive else new
+    return _Frame(0.0, offset, full)
+
+
 def _apply_frame(ip: _Interp, st: Stmt, cmd: str, axis_words, named) -> None:
-    """SINUMERIK programmable frame: machine = R(theta about Z) * program + offset.
+    """SINUMERIK programmable frame: machine = R * program + offset.
 
     ``TRANS`` and ``ROT`` are absolute: each replaces the whole programmable frame (a bare
     ``TRANS`` or ``ROT`` deletes it). ``ATRANS`` adds a translation given in the current,
     possibly rotated, coordinate system; ``AROT`` adds a rotation about the current origin.
-    Rotations about X or Y tilt the working plane and are rejected.
+    ``ROT X.. Y.. Z..`` take the control's default angle convention (MD10600
+    FRAME_ANGLE_INPUT_MODE = 1, RPY): about Z, then the new Y, then the newest X, i.e.
+    ``R = Rz Ry Rx``. A tilted frame (about X or Y) rotates the working plane with it: a
+    G17 arc then lies in the tilted plane; only the positions are modelled (no tool
+    orientation, which needs TRAORI and the machine's kinematics).
     """
-    rot = 0.0
+    angles: dict[str, float] = {}
     moves: dict[str, float] = {}
     for name, val, _mode, col in axis_words:
         if cmd in ("ROT", "AROT"):
-            if name != "Z":
-                raise ip.err(st, col, f"{cmd} {name}: a rotation about {name} tilts the working "
-                                      f"plane, which is not supported (only rotations about "
-                                      f"Z: {cmd} Z... or {cmd} RPL=...)")
-            rot += val
+            if name not in ("X", "Y", "Z"):
+                raise ip.err(st, col, f"{cmd} {name}: rotations are about the geometry axes "
+                                      f"X, Y and Z only")
+            angles[name] = angles.get(name, 0.0) + val
         else:
             moves[name] = val * ip.lin(name)
     if "RPL" in named:
         if ip.plane != "G17":
             raise ip.err(st, named["RPL"][1], f"RPL= rotates in the active plane; only G17 "
                                               f"(about Z) is supported, not {ip.plane}")
-        rot += named["RPL"][0]
+        angles["Z"] = angles.get("Z", 0.0) + named["RPL"][0]
+    rot: _Mat | None = None
+    if angles.get("X", 0.0) or angles.get("Y", 0.0):
+        rot = _matmul(_matmul(_rot("Z", angles.get("Z", 0.0)), _rot("Y", angles.get("Y", 0.0))),
+                      _rot("X", angles.get("X", 0.0)))
+    theta = angles.get("Z", 0.0)
     old = ip.frame
     if cmd == "TRANS":
         ip.frame = _Frame(0.0, moves or None)
     elif cmd == "ROT":
-        ip.frame = _Frame(rot, None)
+        ip.frame = _with_rotation(_Frame(), rot, theta, None, additive=False)
     elif cmd == "ATRANS":
         offset = dict(old.offset or {})
-        d = old.rotate_vec((moves.pop("X", 0.0), moves.pop("Y", 0.0), 0.0))
-        for name, v in (("X", d[0]), ("Y", d[1]), *moves.items()):
+        d = old.rotate_vec((moves.pop("X", 0.0), moves.pop("Y", 0.0), moves.pop("Z", 0.0)))
+        for name, v in (("X", d[0]), ("Y", d[1]), ("Z", d[2]), *moves.items()):
             if v or name in offset:
                 offset[name] = offset.get(name, 0.0) + v
-        ip.frame = _Frame(old.theta_deg, offset or None)
+        ip.frame = _Frame(old.theta_deg, offset or None, old.tilt)
     else:                                               # AROT
-        ip.frame = _Frame(old.theta_deg + rot, old.offset)
+        ip.frame = _with_rotation(old, rot, theta, old.offset, additive=True)
 
 
 def _ngc_frame(ip: _Interp) -> None:

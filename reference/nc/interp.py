@@ -3,7 +3,7 @@
 The interpreter keeps the modal state of both dialects (motion, plane, units,
 absolute/incremental, feed, group 10, exact-stop criterion, TRC, tangential control),
 evaluates variables and control flow whose conditions depend only on program
-variables, applies frames (SINUMERIK TRANS/ATRANS/ROT/AROT about Z, NGC ``G10 L2/L20``
+variables, applies frames (SINUMERIK TRANS/ATRANS/ROT/AROT about X, Y, Z, NGC ``G10 L2/L20``
 work offsets with ``R`` rotation, G54..G59.3, G92), and emits one block per executed line
 with absolute machine positions in mm / degrees.
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .expr import NAME, Cursor, ExprError, parse_expr
+from .expr import NAME, Cursor, ExprError, parse_expr, sin_exponent
 
 #: Single-letter addresses that take a number (both dialects).
 ADDRESSES = frozenset("ABCDEFGHIJKLMNPQRSTUVWXYZ")
@@ -152,6 +152,7 @@ _SIMPLE_SIN = re.compile(r"[ \t]*(?:(N\d+)[ \t]+)?(?:([A-Z_][A-Z0-9_]*):(?!=)[ \
 _SIMPLE_NGC = re.compile(r"(?:(N\d+))?((?:[A-MP-Z][-+]?(?:\d+\.?\d*|\.\d+))+)$")
 _SIMPLE_WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
 _NOT_SIMPLE_NGC = re.compile(r"[(;#\[/%<=]")
+_GLUED_E = re.compile(r"[\d.]E")          # an exponent, or X1E5: the full grammar decides
 
 
 def _fast_stmt(lineno: int, raw: str, label: str | None, comment: str | None,
@@ -193,6 +194,8 @@ def _simple_sin(lineno: int, raw: str) -> Stmt | None:
     up = raw.upper()
     m = _SIMPLE_SIN.match(up)
     if m is None:
+        return None
+    if "E" in up and _GLUED_E.search(up, m.start(3), m.end(3)):
         return None
     comment = None
     if m.group(4) is not None:
@@ -377,23 +380,25 @@ def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
                 raise LineError(f"'=' expected after {name}[{idx}]", cur.pos)
             cur.pos += 1
             # in source order with the other words: R1=10 R[2]=R1/4 uses the new R1
-            st.words.append(Word(f"{name}[{idx.strip()}]", _expr(cur), start + 1))
+            val, mode = _value_with_mode(cur)
+            st.words.append(Word(f"{name}[{idx.strip()}]", val, start + 1, mode))
             continue
         if after == "=" and not t.startswith("==", cur.pos):
             cur.pos = t.index("=", cur.pos) + 1
-            mode = ""
-            mm = _MODE_CALL.match(t, (cur.ws(), cur.pos)[1])
-            if mm:
-                mode = mm.group(1)
-                cur.pos = mm.end() - 1
-                cur.pos += 1
-                val = _expr(cur)
-                if cur.peek() != ")":
-                    raise LineError(f"missing ')' after {mode}(", cur.pos)
-                cur.pos += 1
-            else:
-                val = _expr(cur)
-            st.words.append(Word(name, val, start + 1, mode if mode in ("AC", "IC") else ""))
+            if name == "T" and cur.peek() == '"':
+                # a tool by name (tool management): T="DRILL 8.5", kept as written
+                q = cur.pos
+                end = t.find('"', q + 1)
+                if end < 0:
+                    raise LineError("tool name: missing closing '\"'", q)
+                tool = code[q + 1:end]
+                if not tool.strip():
+                    raise LineError('empty tool name T=""', q)
+                st.words.append(Word(name, ("str", tool), start + 1))
+                cur.pos = end + 1
+                continue
+            val, mode = _value_with_mode(cur)
+            st.words.append(Word(name, val, start + 1, mode))
             continue
         # address + number, possibly glued (G1, X10.5, Y-2., G1X10Y5)
         if name[0] in ADDRESSES and _ADDR_NUM.match(t, start) and name not in FLAGS:
@@ -407,6 +412,22 @@ def _words_sin(st: Stmt, cur: Cursor, code: str) -> None:
         st.calls.append((name, "", start))
 
 
+def _value_with_mode(cur: Cursor) -> tuple[tuple, str]:
+    """The value after ``=``: an expression, or ``AC(...)``/``IC(...)`` (also ``ACP``,
+    ``ACN``, ``DC``, read as absolute). Returns (AST, "" | "AC" | "IC")."""
+    t = cur.text
+    mm = _MODE_CALL.match(t, (cur.ws(), cur.pos)[1])
+    if not mm:
+        return _expr(cur), ""
+    mode = mm.group(1)
+    cur.pos = mm.end()
+    val = _expr(cur)
+    if cur.peek() != ")":
+        raise LineError(f"missing ')' after {mode}(", cur.pos)
+    cur.pos += 1
+    return val, mode if mode in ("AC", "IC") else ""
+
+
 _ADDR_NUM = re.compile(r"([A-Z])[ \t]*([-+]?(?:\d+\.?\d*|\.\d+))")
 _NEXT_WORD = re.compile(r"[A-Z][-+]?[\d.]|[A-Z_][A-Z0-9_]*\s*[=(\[]")
 
@@ -416,6 +437,12 @@ def _address_word(st: Stmt, cur: Cursor) -> None:
     t = cur.text
     m = _ADDR_NUM.match(t, cur.pos)
     end = m.end()
+    cur.pos = end
+    try:
+        exponent = sin_exponent(t, cur)         # 1.5EX-3; 1E5 is an error
+    except ExprError as exc:
+        raise LineError(str(exc), exc.col) from None
+    end = cur.pos
     if end < len(t) and t[end] not in " \t":
         # a glued next word (G1X10) is fine; anything else is a typo such as Y1O
         nm = NAME.match(t, end)
@@ -423,7 +450,7 @@ def _address_word(st: Stmt, cur: Cursor) -> None:
                 nm and nm.group() in FLAGS):
             bad = _NON_BLANK.match(t, m.start(2)).group()
             raise LineError(f"invalid number '{bad}' after address {m.group(1)}", m.start(2))
-    st.words.append(Word(m.group(1), ("num", float(m.group(2))), m.start() + 1))
+    st.words.append(Word(m.group(1), ("num", float(m.group(2) + exponent)), m.start() + 1))
     cur.pos = end
 
 

@@ -111,8 +111,9 @@ class Modal:
         TRC corner behaviour.
     disc : float
         DISC value (0..100) for G450 corners.
-    tool : int or None
-        Active tool number (T), ``None`` if never set.
+    tool : int or str or None
+        Active tool: number (T1) or name (``T="DRILL 8.5"``, tool management); ``None``
+        if never set.
     tool_offset : int or None
         Active tool offset (D on SINUMERIK, H/D on NGC).
     tangential : Tangential or None
@@ -132,7 +133,7 @@ class Modal:
     tool_compensation: ToolCompensation = "G40"
     trc_corner: TrcCorner = "G450"
     disc: float = 0.0
-    tool: int | None = None
+    tool: int | str | None = None
     tool_offset: int | None = None
     tangential: Tangential | None = None
 
@@ -150,8 +151,9 @@ class BlockExtra:
         Additional full turns of an arc (SINUMERIK ``TURN=``, NGC ``P`` minus 1), >= 0.
     dwell_s : float or None
         Dwell time of a G4 block in seconds, else ``None``.
-    aux : tuple[tuple[str, float], ...]
-        M, S, T, D, H words of this block in source order, e.g. ``(("M", 3.0),)``.
+    aux : tuple[tuple[str, float or str], ...]
+        M, S, T, D, H words of this block in source order, e.g. ``(("M", 3.0),)``; a
+        tool by name keeps its name (``("T", "DRILL 8.5")``).
     message : str or None
         ``MSG("...")`` or ``(MSG, ...)`` text of this block.
     comment : str
@@ -169,7 +171,7 @@ class BlockExtra:
     center: tuple[float, ...] | None = None
     turns: int = 0
     dwell_s: float | None = None
-    aux: tuple[tuple[str, float], ...] = ()
+    aux: tuple[tuple[str, float | str], ...] = ()
     message: str | None = None
     comment: str = ""
     kept_unmodelled: tuple[str, ...] = ()

@@ -15,6 +15,23 @@ from .frames import _Frame
 from .lines import Stmt
 from .program import DEFAULT_MODAL, ProgramWarning, Tangential
 
+#: Largest position magnitude accepted, mm (degrees for rotary axes), also for arc
+#: centres. No machine tool travels a kilometre (large gantries: tens of metres), and
+#: below it float64 resolves a position to 1e6 * 2.2e-16 = 2e-10 mm, four decades under
+#: POS_TOL_MM (1e-6 mm) that every geometric test relies on. A position beyond it is a
+#: typing error (X123456789012345678901234567890) and would otherwise overflow into inf
+#: or lose all precision downstream.
+MAX_COORDINATE_MM = 1e6
+#: Largest programmed feed, mm/min. CAM writes "as fast as possible" as F99999 or so,
+#: and a feed above the axis limits is simply capped by them, so the bound is generous:
+#: 1e9 mm/min (1000 km/min) is five decades above the fastest axes (MAX_AX_VELO <= 1e7
+#: by the machine-data rules) and keeps v^2 far from float overflow (a feed of 1e300
+#: overflowed in the planners).
+MAX_FEED_MM_MIN = 1e9
+#: Longest dwell, s: 1e6 s (11.6 days) is no machining dwell, and keeps the program's
+#: times at magnitudes where float64 still resolves a microsecond.
+MAX_DWELL_S = 1e6
+
 #: M codes that end the program (M17 only on SINUMERIK, M99 only on NGC: checked there).
 _END_M = frozenset({2.0, 30.0, 17.0, 99.0})
 GEOMETRY = ("X", "Y", "Z")
@@ -94,6 +111,7 @@ class _Interp:
         self.g92: dict[str, float] = {}  # NGC G92 offsets, program units converted to mm
         self.tang_defs: dict[str, Tangential] = {}
         self.tang_active: str | None = None
+        self.fa: dict[str, float] = {}   # FA[axis]: positioning-axis feed, mm/s or deg/s
         self.out: list = []
         self.warnings: list[ProgramWarning] = []
         self.warned: set[str] = set()
@@ -146,7 +164,7 @@ class _Interp:
                 and name not in ("I", "J", "K", "F", "S", "T", "D", "H", "M", "G", "N", "P"))
 
     def program_pos(self) -> dict:
-        if self.frame.theta_deg == 0.0 and not self.frame.offset:
+        if self.frame.identity:
             return dict(self.pos)
         return self.frame.to_program(self.pos)
 

@@ -81,7 +81,7 @@ CASES = [
     ("G1 X1 F1\nGOTOB NOWHERE\n", SIN, 2, 1, r"GOTOB NOWHERE: no label NOWHERE before"),
     ("o9 call\n", NGC, 1, 1, r"o9 call: no subroutine o9 in this file"),
     # --- unsupported features that would change the path ------------------------------------
-    ("G1 X1 F1\nROT X30\n", SIN, 2, 5, r"ROT X: a rotation about X tilts the working plane"),
+    ("G1 X1 F1\nROT A30\n", SIN, 2, 5, r"ROT A: rotations are about the geometry axes X, Y and Z"),
     ("G81 X1 Y1 Z-1 R1 F1\n", NGC, 1, 1, r"canned cycle G81 is not supported"),
     ("G95 G1 X1 F1\n", NGC, 1, 1, r"feed per revolution \(G95\) is not supported"),
     ("DISC=120\n", SIN, 1, 1, r"DISC=120 must be between 0 and 100"),
