@@ -31,12 +31,11 @@ from reference.prepare import build_path, unmodelled_features
 
 from . import engines
 from .comparison import Comparison, compare
+from .recorded import CheckResult, check_recorded
 
 if TYPE_CHECKING:  # annotations only: importing these costs the planner and the oracle
     from optimal import OptimalSolution
     from reference.planner import ReferencePlan
-
-    from .recorded import CheckResult
 
 #: A program: parsed, or the path of an NC file (dialect from its extension).
 ProgramLike = Union[Program, str, "os.PathLike[str]"]
@@ -298,7 +297,6 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
     FeedOracleError
         Bad program, machine data or recording (naming file and line or row).
     """
-    from .recorded import check_recorded
     if isinstance(smoothing, str) and smoothing != "auto":
         raise ValueError(f"smoothing {smoothing!r}: 'auto' or a noise level in mm")
     if not isinstance(smoothing, str) and not (math.isfinite(smoothing) and smoothing >= 0):
