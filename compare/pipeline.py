@@ -93,13 +93,6 @@ def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
     return Inputs(program=p, machine=m)
 
 
-def _prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
-    """A progress callback that prefixes messages (``None``-safe)."""
-    if progress is None:
-        return None
-    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
-
-
 # --------------------------------------------------------------------- plan
 def plan_program(program: ProgramLike, machine: MachineLike = None, *,
                  dialect: str | None = None, progress: ProgressFn | None = None
@@ -212,7 +205,8 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     # heuristic would contain, computed without it
     holds = imposed_holds(inp.program, path, inp.machine)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol, holds=holds)
+                             progress=engines.prefixed(progress, "oracle: "), tol=tol,
+                             holds=holds)
     return OptimizeResult(program=inp.program.file, machine=inp.machine.name, bounds=bounds,
                           path=path, limits=inp.machine.limits, solution=sol)
 
@@ -250,10 +244,10 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     plan = engines.run_heuristic(inp.program, inp.machine, path=path,
-                                 progress=_prefixed(progress, "heuristic: "))
+                                 progress=engines.prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol,
+                             progress=engines.prefixed(progress, "oracle: "), tol=tol,
                              holds=plan.holds)
     c = compare(plan, sol, limits=inp.machine.limits, program=inp.program,
                 machine=inp.machine.name)

@@ -254,7 +254,7 @@ def check_recorded(file: str | FsPath, program: Program, machine: Machine, *,
     prof = with_holds(prof, path, holds.subset(at_ends))
     bound_set = bounds or "acc"
     sol = engines.run_oracle(path, limits, "acc",
-                             progress=_pre(progress, "oracle: "),
+                             progress=engines.prefixed(progress, "oracle: "),
                              holds=holds)
     i = proj.worst
     tol = measurement_tolerance(path, limits, rec.t, sigma, info["scale"])
@@ -278,9 +278,3 @@ def check_recorded(file: str | FsPath, program: Program, machine: Machine, *,
     return CheckResult(recording=rec, projection=proj, noise_mm=sigma,
                        max_deviation_mm=max_dev, info=info, comparison=c,
                        path_kind=path_kind)
-
-
-def _pre(progress, prefix: str):
-    if progress is None:
-        return None
-    return lambda m, f=-1.0: progress(prefix + m, f)
