@@ -213,13 +213,6 @@ def _report_stems(files: Sequence[str]) -> list[str]:
     return out
 
 
-def _prefixed(progress, prefix: str):
-    """A progress callback that prefixes messages (``None``-safe)."""
-    if progress is None:
-        return None
-    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
-
-
 def cmd_compare(args: argparse.Namespace) -> int:
     """``feedoracle compare``: heuristic vs oracle per program; reports; the CI gate."""
     files = list(args.programs)
@@ -238,7 +231,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
         prefix = f"[{i + 1}/{n}] {f}: " if n > 1 else f"{f}: "
         inputs = _load(f, args)
         c = pipeline.compare_program(inputs.program, inputs.machine, bounds=args.bounds,
-                                     progress=_prefixed(args.progress, prefix))
+                                     progress=engines.prefixed(args.progress, prefix))
         args.progress.done()
         doc = comparison_dict(c, args.max_gap)
         docs.append(doc)

@@ -16,6 +16,27 @@ from reference.nc.program import Program
 
 ProgressFn = Callable[[str, float], None]
 
+
+def prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
+    """A progress callback that prefixes messages (``None``-safe).
+
+    Parameters
+    ----------
+    progress : callable or None
+        ``progress(message, fraction)``.
+    prefix : str
+        Put before every message (``"oracle: "``).
+
+    Returns
+    -------
+    callable or None
+        ``None`` when ``progress`` is ``None``.
+    """
+    if progress is None:
+        return None
+    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
+
+
 #: Bound sets the ``--bounds`` option names (``auto`` picks one, see :func:`resolve_bounds`).
 BOUND_CHOICES = ("auto", "acc", "jerk", "jerk+freq")
 

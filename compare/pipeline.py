@@ -32,12 +32,11 @@ from reference.prepare import build_path, prepare, unmodelled_features
 
 from . import engines
 from .comparison import Comparison, compare
+from .recorded import CheckResult, check_recorded
 
 if TYPE_CHECKING:  # annotations only: importing these costs the planner and the oracle
     from optimal import OptimalSolution
     from reference.planner import ReferencePlan
-
-    from .recorded import CheckResult
 
 #: A program: parsed, or the path of an NC file (dialect from its extension).
 ProgramLike = Union[Program, str, "os.PathLike[str]"]
@@ -93,13 +92,6 @@ def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
     m = machine if isinstance(machine, Machine) else load_machine(machine)
     p = program if isinstance(program, Program) else parse_file(program, dialect=dialect)
     return Inputs(program=p, machine=m)
-
-
-def _prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
-    """A progress callback that prefixes messages (``None``-safe)."""
-    if progress is None:
-        return None
-    return lambda message, fraction=-1.0: progress(f"{prefix}{message}", fraction)
 
 
 # --------------------------------------------------------------------- plan
@@ -240,7 +232,8 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     # heuristic would contain, computed without it
     holds = imposed_holds(inp.program, path, inp.machine)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol, holds=holds)
+                             progress=engines.prefixed(progress, "oracle: "), tol=tol,
+                             holds=holds)
     return OptimizeResult(program=inp.program.file, machine=inp.machine.name, bounds=bounds,
                           path=path, limits=inp.machine.limits, solution=sol)
 
@@ -279,10 +272,10 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
     plan = engines.run_heuristic(inp.program, inp.machine, path=path,
-                                 progress=_prefixed(progress, "heuristic: "))
+                                 progress=engines.prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
-                             progress=_prefixed(progress, "oracle: "), tol=tol,
+                             progress=engines.prefixed(progress, "oracle: "), tol=tol,
                              holds=plan.holds)
     c = compare(plan, sol, limits=inp.machine.limits, program=inp.program,
                 machine=inp.machine.name)
@@ -326,7 +319,6 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
     FeedOracleError
         Bad program, machine data or recording (naming file and line or row).
     """
-    from .recorded import check_recorded
     if isinstance(smoothing, str) and smoothing != "auto":
         raise ValueError(f"smoothing {smoothing!r}: 'auto' or a noise level in mm")
     if not isinstance(smoothing, str) and not (math.isfinite(smoothing) and smoothing >= 0):

@@ -149,3 +149,14 @@ def test_load_inputs_passes_objects_through_and_lists_warnings(small_program):
     assert [b.line for b in from_file.program.blocks] == [b.line for b in
                                                           parse_text(SMALL).blocks]
     assert np.isfinite(from_file.machine.limits.t_ipo_s)
+
+
+def test_prefixed_progress_passes_messages_on_with_the_prefix() -> None:
+    """The one prefixing helper (pipeline, commands and check use it): ``None`` stays
+    ``None``; a message keeps its fraction, and an omitted fraction is unknown (-1)."""
+    assert engines.prefixed(None, "oracle: ") is None
+    seen: list[tuple[str, float]] = []
+    cb = engines.prefixed(lambda m, f: seen.append((m, f)), "oracle: ")
+    cb("grid", 0.25)
+    cb("refining")
+    assert seen == [("oracle: grid", 0.25), ("oracle: refining", -1.0)]
