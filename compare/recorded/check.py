@@ -238,11 +238,10 @@ def check_recorded(file: str | FsPath, program: Program, machine: Machine, *,
     """
     limits = machine.limits
     if path_kind == "reference":
-        path, holds = build_path(program, machine), None
+        path = build_path(program, machine)
     else:
-        path, holds = restrict_to_machine(prepare(program), limits), None
-    if holds is None:
-        holds = imposed_holds(program, path, machine)
+        path = restrict_to_machine(prepare(program), limits)
+    holds = imposed_holds(program, path, machine)
     rec = read_trajectory(file, path.axes, tuple(bool(r) for r in path.rotary))
     if progress is not None:
         progress("projecting the recording", -1.0)
