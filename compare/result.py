@@ -388,8 +388,15 @@ def format_interval(c: Comparison) -> str:
     """The gap interval in percent, e.g. ``"12.1 – 12.4 %"``."""
     lo, hi = c.gap_lower, c.gap_upper
     if not math.isfinite(hi):
-        return f"≥ {100 * lo:.1f} %"
-    return f"{100 * lo:.1f} – {100 * hi:.1f} %"
+        return f"≥ {_pct(lo)} %"
+    return f"{_pct(lo)} – {_pct(hi)} %"
+
+
+def _pct(x: float) -> str:
+    """A fraction in percent with one decimal; a value that rounds to zero prints "0.0",
+    never "-0.0" (a negative zero reads like a planner faster than the optimum)."""
+    s = f"{100 * x:.1f}"
+    return "0.0" if s == "-0.0" else s
 
 
 def describe_violation(v: ConstraintResult, c: Comparison) -> str:
