@@ -4,7 +4,7 @@ whose size does not grow with the program, and a banner that never hides a wide 
 
 from __future__ import annotations
 
-import dataclasses
+import base64
 import re
 
 import numpy as np
@@ -19,6 +19,7 @@ from compare.report.envelope import (N_COLUMNS, chunked_envelopes, column_extrem
                                      envelope, envelope_indices)
 from compare.report.page import (LISTING_HEAD, MAX_LISTING_LINES, MAX_TABLE_ROWS,
                                  render_report, write_index)
+from compare.report.plots import MAX_LINE_TICKS, moving_rows
 from optimal import SolveStatus
 
 
@@ -192,10 +193,8 @@ def test_small_program_keeps_every_row_and_line(pages, big):
 
 
 def test_gap_plot_labels_blocks_not_lines_when_large():
-    from compare.report.plots import MAX_LINE_TICKS, moving_rows
     c = mixed_comparison(1_000)
     assert len(moving_rows(c)) > MAX_LINE_TICKS
-    import base64
     svg = base64.b64decode(re.search(r'id="fig-gaps"><img[^>]*base64,([^"]*)"',
                                      render_report(c)).group(1)).decode()
     assert "execution order" in svg
