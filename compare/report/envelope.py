@@ -58,7 +58,20 @@ def envelope_indices(x: np.ndarray, y: np.ndarray, x0: float, x1: float,
     if ok.size <= 2 * n_columns:
         return ok
     col = _columns(x[ok], x0, x1, n_columns)
-    order = np.lexsort((y[ok], col))          # by column, inside a column by value
+    yk = y[ok]
+    if np.all(col[1:] >= col[:-1]):          # sorted x (the usual case): O(N)
+        start = np.flatnonzero(np.r_[True, col[1:] != col[:-1]])
+        size = np.diff(np.r_[start, col.size])
+        g = np.repeat(np.arange(start.size), size)
+        lo = np.minimum.reduceat(yk, start)
+        hi = np.maximum.reduceat(yk, start)
+        # first sample of each column that attains its min (max)
+        i_lo = np.flatnonzero(yk == lo[g])
+        i_hi = np.flatnonzero(yk == hi[g])
+        i_lo = i_lo[np.r_[True, g[i_lo][1:] != g[i_lo][:-1]]]
+        i_hi = i_hi[np.r_[True, g[i_hi][1:] != g[i_hi][:-1]]]
+        return np.unique(ok[np.concatenate([i_lo, i_hi])])
+    order = np.lexsort((yk, col))             # by column, inside a column by value
     cs = col[order]
     first = np.flatnonzero(np.r_[True, cs[1:] != cs[:-1]])
     last = np.r_[first[1:], cs.size] - 1

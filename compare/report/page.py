@@ -20,8 +20,12 @@ from typing import Mapping, Sequence
 
 from reference.core.constraints import BOUND_SETS
 
-from ..result import GAP_ABS_TOL_S, Comparison, Verdict, describe_violation, format_interval
+from ..result import (GAP_ABS_TOL_S, ComparedBlock, Comparison, Verdict, describe_violation,
+                      format_interval)
 from .plots import N_WORST, moving_rows, plot_axes, plot_gaps, plot_speed, plot_toolpath, who
+
+#: The rows the block table shows, see :func:`table_rows`.
+Shown = tuple[list[tuple[int | None, ComparedBlock]], bool]
 
 #: Block table: all rows up to this many, else the rows with the largest gaps (a table
 #: of 10^5 rows is ~150 MB of HTML and takes a browser minutes to lay out).
@@ -200,7 +204,7 @@ def _info_ratios(c: Comparison) -> str:
 
 
 # --------------------------------------------------------------------- table
-def table_rows(c: Comparison) -> tuple[list[tuple[int | None, object]], bool]:
+def table_rows(c: Comparison) -> Shown:
     """The rows the block table shows, each with its place in execution order.
 
     Returns
@@ -223,9 +227,10 @@ def table_rows(c: Comparison) -> tuple[list[tuple[int | None, object]], bool]:
     return [(order[id(moving[k])], moving[k]) for k in pick], True
 
 
-def _table(c: Comparison, links: Mapping[str, str] | None) -> str:
-    worst = {r.block for r in c.worst_blocks(N_WORST)}
-    rows, limited = table_rows(c)
+def _table(c: Comparison, links: Mapping[str, str] | None, shown: Shown,
+           worst: Sequence[ComparedBlock]) -> str:
+    worst = {r.block for r in worst}
+    rows, limited = shown
     gap_sort = " class='sorted-desc'" if limited else ""
     head = ("<thead><tr><th title='place in execution order (the x of the gap plot)'>#</th>"
             "<th class='t'>line</th><th class='t'>label</th><th class='t'>kind</th>"
@@ -294,14 +299,14 @@ def _table(c: Comparison, links: Mapping[str, str] | None) -> str:
 
 
 # --------------------------------------------------------------------- listing
-def listing_lines(c: Comparison) -> list[int]:
+def listing_lines(c: Comparison, shown: Shown | None = None) -> list[int]:
     """1-based program lines the listing shows (sorted): all of a short program; of a
     long one the head, and every line the table links to with its context."""
     n = len(c.program_lines)
     if n <= MAX_LISTING_LINES:
         return list(range(1, n + 1))
     want = set(range(1, min(LISTING_HEAD, n) + 1))
-    rows, _ = table_rows(c)
+    rows, _ = table_rows(c) if shown is None else shown
     for _, r in rows:
         for line in (r.line, *(r.corner or ())):
             want.update(range(max(1, line - LISTING_CONTEXT),
@@ -309,11 +314,11 @@ def listing_lines(c: Comparison) -> list[int]:
     return sorted(want)
 
 
-def _source(c: Comparison) -> str:
+def _source(c: Comparison, shown: Shown, worst: Sequence[ComparedBlock]) -> str:
     if not c.program_lines:
         return "<p class='sub'>(program text not available)</p>"
-    hot = {r.line for r in c.worst_blocks(N_WORST)}
-    shown = listing_lines(c)
+    hot = {r.line for r in worst}
+    shown = listing_lines(c, shown)
     out = []
     prev = 0
     for n in shown:
@@ -375,6 +380,8 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
     link_html = " · ".join(f"<a href='{_e(u)}'>{_e(k)}</a>" for k, u in (links or {}).items())
     notes = "".join(f"<li>{_e(n)}</li>" for n in c.notes)
     b_cls, b_text = banner(c, v)
+    worst = c.worst_blocks(N_WORST)          # once: each call reads every row's gap
+    shown = table_rows(c)
     stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     speed = _figure(plot_speed(c), "path speed over path length",
                     f"Path speed of the {_e(w)} (solid red) and of the oracle's verified "
@@ -389,7 +396,7 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
                    "(BRISK, the acc oracle) has steps in acceleration, i.e. unbounded jerk "
                    "at those instants, which the jerk plot does not draw. Min/max "
                    "envelopes per pixel column, as above.", "axes")
-    gaps = _figure(plot_gaps(c), "per-block gap bars",
+    gaps = _figure(plot_gaps(c, worst), "per-block gap bars",
                    f"Time lost per block in execution order, t_ref − t_opt: red where the "
                    f"{_e(w)} is slower, blue where it is faster (see the notes in the "
                    "table), orange for inserted blocks (up to 200 blocks, drawn one bar "
@@ -398,7 +405,7 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
                    "blocks are labelled with their source line). The black line (right "
                    "axis) is the accumulated gap: its steep parts are where the total "
                    "time is lost.", "gaps")
-    tool = _figure(plot_toolpath(c), "tool path",
+    tool = _figure(plot_toolpath(c, worst), "tool path",
                    "The path both planners run on, in its main plane: inserted blocks "
                    "orange, the blocks with the largest gaps violet (with the time they "
                    "lose), required stops as squares.", "path")
@@ -425,8 +432,8 @@ in execution order (the x axis of the gap plot). Gap = t_ref − t_opt
 (t_opt from the oracle's verified profile, so the gaps sum to t_ref − UB); both times contain
 the block's hold (dwell, exact-stop settle: the machine's wait, identical on both sides), which
 is therefore never a gap; gap % is relative to the oracle's motion time; speeds in mm/s.</p>
-{_table(c, links)}
-<h2>Program</h2>{_source(c)}
+{_table(c, links, shown, worst)}
+<h2>Program</h2>{_source(c, shown, worst)}
 <p class="sub">feedoracle · gap interval [(t_ref − H)/(UB − H) − 1, (t_ref − H)/(LB − H) − 1]
 from the oracle's certified lower bound LB and verified upper bound UB (the true optimum lies
 between them), on motion times: H, the imposed holds (dwell, exact-stop settle), is in every

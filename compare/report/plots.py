@@ -21,7 +21,7 @@ from reference.core.geometry import KIND_CODES
 from reference.core.tolerances import MOVING_AXIS_TOL
 
 from ..kinematics import axis_motion, limit_curve
-from ..result import INSERTED_KINDS, Comparison
+from ..result import INSERTED_KINDS, ComparedBlock, Comparison
 from .envelope import N_COLUMNS, chunked_envelopes, column_extremes, envelope
 
 #: Colours: the planner under test, the oracle, limits, inserted blocks, worst blocks.
@@ -293,7 +293,7 @@ def moving_rows(c: Comparison) -> list:
     return [r for r in c.rows if r.length_mm > 0 or r.t_reference_s > 0 or r.t_oracle_s > 0]
 
 
-def plot_gaps(c: Comparison) -> str:
+def plot_gaps(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -> str:
     """Per-block gaps in execution order and the accumulated gap (SVG URI).
 
     The x axis is the block's place in the executed program (a loop's lines appear once
@@ -302,6 +302,7 @@ def plot_gaps(c: Comparison) -> str:
     block stays a visible spike. The worst blocks carry their source line, and the
     accumulated gap (right axis) shows where the total time is lost.
     """
+    worst = c.worst_blocks(N_WORST) if worst is None else worst
     rows = moving_rows(c)
     fig = Figure(figsize=(11, 3.4))
     ax = fig.add_subplot()
@@ -332,7 +333,7 @@ def plot_gaps(c: Comparison) -> str:
             y0, y1 = ax.get_ylim()            # room for the labels above the spikes
             ax.set_ylim(y0, y1 + 0.12 * (y1 - y0))
             pos = {id(r): k for k, r in enumerate(rows)}
-            for r in c.worst_blocks(N_WORST):
+            for r in worst:
                 k = pos.get(id(r))
                 if k is not None:
                     ax.annotate(f"line {r.line}", (k + 1, 1e3 * r.gap_s), xytext=(0, 6),
@@ -366,7 +367,7 @@ def _plane(c: Comparison, q: np.ndarray) -> tuple[int, int]:
     return tuple(sorted(best))  # type: ignore[return-value]
 
 
-def plot_toolpath(c: Comparison) -> str:
+def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -> str:
     """The tool path in its main plane with inserted and worst blocks marked (SVG URI)."""
     fig = Figure(figsize=(11, 6.0))
     ax = fig.add_subplot()
@@ -376,7 +377,8 @@ def plot_toolpath(c: Comparison) -> str:
         return svg_uri(fig)
     qs = path.evaluate(np.linspace(0, path.total_length, 500))[0]
     i, j = _plane(c, qs)
-    worst = {r.block for r in c.worst_blocks(N_WORST)}
+    worst_rows = c.worst_blocks(N_WORST) if worst is None else worst
+    worst = {r.block for r in worst_rows}
     # points of every segment (arcs finely), NaN-separated per drawing style
     n_pts = np.where(path.radius == 0, 2, np.clip(
         np.ceil(np.abs(path.omega) * path.length / 0.05).astype(np.int64), 8, 400))
@@ -407,7 +409,7 @@ def plot_toolpath(c: Comparison) -> str:
         brk = np.flatnonzero(np.diff(seg[pts]) > 1) + 1
         x, y = np.insert(x, brk, np.nan), np.insert(y, brk, np.nan)
         ax.plot(x, y, rasterized=raster and name != "worst", **style)
-    for r in c.worst_blocks(N_WORST):
+    for r in worst_rows:
         segs = np.flatnonzero(path.block == r.block)
         if segs.size == 0:
             continue

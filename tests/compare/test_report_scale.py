@@ -19,7 +19,7 @@ from compare.report.envelope import (N_COLUMNS, chunked_envelopes, column_extrem
                                      envelope, envelope_indices)
 from compare.report.page import (LISTING_HEAD, MAX_LISTING_LINES, MAX_TABLE_ROWS,
                                  render_report, write_index)
-from compare.report.plots import MAX_LINE_TICKS, moving_rows
+from compare.report.plots import MAX_LINE_TICKS, moving_rows, plot_gaps
 from optimal import SolveStatus
 
 
@@ -53,6 +53,10 @@ def test_envelope_keeps_every_columns_extremes():
     y = np.array([3, 1, 2, 5, 6, 4, 9, 7, 8, 0, 2, 1], dtype=float)
     keep = envelope_indices(x, y, 0.0, 4.0, n_columns=4)
     assert keep.tolist() == [0, 1, 4, 5, 6, 7, 9, 10]
+    # unsorted x (the general path) keeps the same samples
+    perm = np.random.default_rng(0).permutation(x.size)
+    keep_p = envelope_indices(x[perm], y[perm], 0.0, 4.0, n_columns=4)
+    assert sorted(perm[keep_p].tolist()) == [0, 1, 4, 5, 6, 7, 9, 10]
 
 
 def test_envelope_ignores_non_finite_samples():
@@ -195,6 +199,5 @@ def test_small_program_keeps_every_row_and_line(pages, big):
 def test_gap_plot_labels_blocks_not_lines_when_large():
     c = mixed_comparison(1_000)
     assert len(moving_rows(c)) > MAX_LINE_TICKS
-    svg = base64.b64decode(re.search(r'id="fig-gaps"><img[^>]*base64,([^"]*)"',
-                                     render_report(c)).group(1)).decode()
+    svg = base64.b64decode(plot_gaps(c).split("base64,", 1)[1]).decode()
     assert "execution order" in svg
