@@ -22,7 +22,8 @@ from reference.core.constraints import BOUND_SETS
 
 from ..result import (GAP_ABS_TOL_S, ComparedBlock, Comparison, Verdict, describe_violation,
                       format_interval)
-from .plots import N_WORST, moving_rows, plot_axes, plot_gaps, plot_speed, plot_toolpath, who
+from .plots import (N_WORST, dense, moving_rows, plot_axes, plot_gaps, plot_speed,
+                    plot_toolpath, who)
 
 #: The rows the block table shows, see :func:`table_rows`.
 Shown = tuple[list[tuple[int | None, ComparedBlock]], bool]
@@ -388,8 +389,14 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
                     "profile (dashed blue) over path length, under the limit curve for "
                     "constant-speed motion (programmed feed, axis velocities, centripetal "
                     "acceleration); dotted verticals are required stops. The gap between "
-                    "the two curves is where time is lost. Every curve is a min/max envelope "
-                    "per pixel column: all peaks of the data are drawn.", "speed")
+                    "the two curves is where time is lost. " + (
+                        "The path has more segments than the plot has room for: the "
+                        "bands are each planner's smallest to largest speed per pixel "
+                        "column, the lines its mean speed there (column width over the "
+                        "time spent in it; their ratio is the local gap), and the limit "
+                        "curve is drawn as its highest and lowest value per column."
+                        if dense(c) else "Every curve is a min/max envelope per pixel "
+                        "column: all peaks of the data are drawn."), "speed")
     axes = _figure(plot_axes(c), "axis acceleration and jerk over time",
                    "Axis acceleration (top) and jerk (bottom) over time, per moving axis; "
                    "dotted lines are the axis limits. An acceleration-bounded motion "
