@@ -368,6 +368,12 @@ class Verdict:
                     f"{c.oracle.bounds}-bounded relaxation")
         if max_gap is not None:
             text += f" (within the gate of {100 * max_gap:g} %)"
+        if c.oracle.status != "optimal":
+            # the bounds are valid but the oracle stopped before its tolerance: say how
+            # wide the bracket is, never a bare "ok"
+            lb, ub = c.oracle.lower_bound_s, c.oracle.upper_bound_s
+            text += (f"; the oracle ended '{c.oracle.status}' with a bracket "
+                     f"UB/LB - 1 = {100 * (ub / lb - 1):.2f} %, so the interval is that wide")
         return cls(True, "ok", text, max_gap)
 
 

@@ -201,3 +201,11 @@ def test_gap_plot_labels_blocks_not_lines_when_large():
     assert len(moving_rows(c)) > MAX_LINE_TICKS
     svg = base64.b64decode(plot_gaps(c).split("base64,", 1)[1]).decode()
     assert "execution order" in svg
+
+
+def test_terminal_verdict_names_a_wide_bracket_too(machine):
+    """The text verdict (terminal, JSON) says how wide the bracket is, not a bare ok."""
+    c = _with_bounds(machine, SolveStatus.GAP_NOT_MET, 1.16)
+    v = c.verdict()
+    assert v.ok and "gap_not_met" in v.text and "UB/LB - 1 = 16.00 %" in v.text
+    assert "bracket" not in _with_bounds(machine, SolveStatus.OPTIMAL, 1.001).verdict().text
