@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 _SLOW_OK = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
 
 settings.register_profile(
-    "ci", max_examples=int(os.environ.get("FEEDORACLE_FUZZ_EXAMPLES", 0)) or 25,
+    "ci", max_examples=int(os.environ.get("FEEDORACLE_FUZZ_EXAMPLES", 0)) or 50,
     deadline=None, derandomize=True, database=None, print_blob=True,
     suppress_health_check=_SLOW_OK,
     # no shrinking in CI: a derandomized failure is reproducible as it is, and shrinking

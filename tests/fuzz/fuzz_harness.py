@@ -42,7 +42,7 @@ from compare.cli import main
 
 #: Peak-memory budget of one case, bytes. The fuzz programs have at most ~30 blocks (the
 #: corpus mutants at most 40 lines); the largest real one, ``lcnc_arc_arc_sawtooth.ngc``
-#: (56 lines, 94 segments), peaks at 31 MB (tracemalloc) for ``compare``. 500 MB is 16x
+#: (cut to 40 lines as here), grows the peak resident set by 32 MiB in ``compare``; 500 MiB is 15x
 #: that: a small case above it means some array is sized by a number in the input (a
 #: TURN count, an IPO cycle, a coordinate) rather than by the program's length, the class
 #: of bug issue 9 item 3 removes. Two pytest-xdist workers, each at its baseline (~250 MB

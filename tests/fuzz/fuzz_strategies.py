@@ -386,9 +386,13 @@ _names = st.one_of(st.sampled_from(["X", "Y", "Z", "A", "B", "C", "U", "E", "ELX
 def machine_texts(draw) -> bytes:
     """Machine-data file contents: the default machine with 1-4 edits, as bytes."""
     data = default_machine()
+    # one machine in three only rescales numbers by up to 10x either way (plausible data
+    # that loads, so that plan and compare run on it); the others break rules
+    plausible = draw(st.integers(0, 2)) == 0
     for _ in range(draw(st.integers(1, 4))):
-        edit = draw(st.sampled_from(["value", "value", "value", "type", "unknown", "delete",
-                                     "axis", "section", "adapt", "mode"]))
+        edit = "scale" if plausible else draw(st.sampled_from(
+            ["value", "value", "value", "type", "unknown", "delete", "axis", "section",
+             "adapt", "mode", "scale"]))
         axes = data.get("axis")
         sections = [("machine", data.get("machine")), ("channel", data.get("channel"))] + [
             (f"axis.{ax}", t) for ax, t in (axes.items() if isinstance(axes, dict) else ())]
@@ -398,7 +402,12 @@ def machine_texts(draw) -> bytes:
         name, tbl = draw(st.sampled_from(sections))
         keys = sorted(tbl) or ["MAX_AX_VELO"]
         key = draw(st.sampled_from(keys))
-        if edit == "value":
+        if edit == "scale":
+            old = tbl.get(key)
+            if isinstance(old, (int, float)) and not isinstance(old, bool):
+                tbl[key] = old * draw(st.sampled_from([0.1, 0.3, 0.5, 0.9, 1.1, 2.0, 3.0,
+                                                       10.0]))
+        elif edit == "value":
             tbl[key] = draw(_numbers)
         elif edit == "type":
             tbl[key] = draw(_wrong_types)

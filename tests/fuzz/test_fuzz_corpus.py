@@ -31,7 +31,7 @@ pytestmark = pytest.mark.fuzz
 CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 #: Longest mutant, lines: a few dozen blocks, like the generated programs.
 MAX_LINES = 40
-CI_SEEDS = 3
+CI_SEEDS = 5
 N_SEEDS = int(os.environ.get("FEEDORACLE_FUZZ_SEEDS", 60)) if os.environ.get(
     "FEEDORACLE_FUZZ") else CI_SEEDS
 
