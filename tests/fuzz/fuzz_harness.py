@@ -42,11 +42,12 @@ from compare.cli import main
 
 #: Peak-memory budget of one case, bytes. The fuzz programs have at most ~30 blocks (the
 #: corpus mutants at most 40 lines); the largest real one, ``lcnc_arc_arc_sawtooth.ngc``
-#: (cut to 40 lines as here), grows the peak resident set by 32 MiB in ``compare``; 500 MiB is 15x
-#: that: a small case above it means some array is sized by a number in the input (a
-#: TURN count, an IPO cycle, a coordinate) rather than by the program's length, the class
-#: of bug issue 9 item 3 removes. Two pytest-xdist workers, each at its baseline (~250 MB
-#: with numpy, scipy and the solvers imported) plus this, fit a 2-core CI machine.
+#: (cut to 40 lines as here), grows the peak resident set by 32 MiB in ``compare``;
+#: 500 MiB is 15x that: a small case above it means some array is sized by a number in
+#: the input (a TURN count, an IPO cycle, a coordinate) rather than by the program's
+#: length, the class of bug issue 9 item 3 removes. Two pytest-xdist workers, each at
+#: its baseline (~70 MiB resident after a compare has imported numpy, scipy and the
+#: solvers) plus this, fit a small 2-core CI machine.
 MEMORY_BUDGET_BYTES = 500 * 1024**2
 #: Address space a case may map beyond what the process maps before it, bytes: the
 #: 2 GB resource budget of issue 9 item 3. Above it an allocation raises MemoryError.
@@ -127,7 +128,8 @@ class Outcome:
 
     def describe(self) -> str:
         """The call and its stderr, for an assertion message."""
-        tail = self.err if len(self.err) < 3000 else self.err[:1500] + " ... " + self.err[-1500:]
+        err = self.err
+        tail = err if len(err) < 3000 else err[:1500] + " ... " + err[-1500:]
         return f"feedoracle {' '.join(self.argv)} -> exit {self.code}\nstderr:\n{tail}"
 
 

@@ -114,7 +114,7 @@ def _arc(draw, dialect: str, plane: str, absolute: bool, pos: dict | None, wild:
             rad_s = "-" + rad_s                                 # the long way round
         words.append(f"CR={rad_s}" if dialect == "sin" else f"R{rad_s}")
     elif kind == "broken":
-        words += [f"{ci}{fmt(draw(st.integers(-9, 9)))}", f"{cj}{fmt(draw(st.integers(-9, 9)))}"]
+        words += [f"{c}{draw(st.integers(-9, 9))}" for c in (ci, cj)]
     else:
         words += [f"{ci}{fmt(round(ci_v, 6))}", f"{cj}{fmt(round(cj_v, 6))}"]
     new_pos, restore = None, []
@@ -208,10 +208,10 @@ def _statement(draw, dialect: str, state: dict, depth: int) -> list[str]:
     if kind == "mode":
         # a mode inside a loop or IF body may not run: G90/G91 only at the top level,
         # where the generator can track it
+        top = ["G90", "G91"] if depth == 0 else []
         word = draw(st.sampled_from(
-            ["G90", "G91"][:2 if depth == 0 else 0] + ["G64", "G60", "G9 G1 X1", "G641 ADIS=0.1", "G601", "G602"]
-            if sin else ["G90", "G91"][:2 if depth == 0 else 0] + ["G64", "G64 P0.01", "G64 P0.05 Q0.01", "G61",
-                         "G61.1", "G90.1", "G91.1"]))
+            top + ["G64", "G60", "G9 G1 X1", "G641 ADIS=0.1", "G601", "G602"] if sin else
+            top + ["G64", "G64 P0.01", "G64 P0.05 Q0.01", "G61", "G61.1", "G90.1", "G91.1"]))
         if word in ("G90", "G91"):
             state["absolute"] = word == "G90"
         if word.startswith("G9 "):
@@ -344,7 +344,8 @@ def _toml_value(v) -> str:
     if isinstance(v, list):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}"
+                               for k, x in v.items()) + "}"
     raise TypeError(type(v))
 
 
