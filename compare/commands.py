@@ -152,8 +152,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from reference.planner import ipo_samples, to_json_dict
     inputs = _load(args.program, args)
     program, machine = inputs.program, inputs.machine
-    plan = pipeline.plan_program(program, machine, progress=args.progress)
+    plan = pipeline.plan_program(program, machine, progress=args.progress,
+                                 max_grid_points=args.max_grid_points)
     args.progress.done()
+    if args.csv:
+        pipeline.require_ipo_budget(plan.profile.duration, plan.limits.t_ipo_s, "--csv",
+                                    args.max_grid_points)
     doc = to_json_dict(plan)
     if args.json:
         write_json(doc, args.json)
@@ -179,13 +183,16 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     bounds, _ = engines.resolve_bounds(args.bounds, None)    # an unavailable set: exit 2 now
     inputs = _load(args.program, args)
     res = pipeline.optimize_program(inputs.program, inputs.machine, bounds=bounds,
-                                    progress=args.progress)
+                                    progress=args.progress,
+                                    max_grid_points=args.max_grid_points)
     args.progress.done()
     o = res.oracle_dict()
     rows = res.rows()
     if args.json:
         write_json(res.to_dict(), args.json)
     if args.csv and res.solution.profile is not None:
+        pipeline.require_ipo_budget(res.solution.profile.duration, res.limits.t_ipo_s,
+                                    "--csv", args.max_grid_points)
         header, data = profile_samples(res.path, res.solution.profile, res.limits.t_ipo_s)
         write_samples_csv(header, data, args.csv)
     out = sys.stdout if args.json != "-" and args.csv != "-" else sys.stderr
@@ -238,7 +245,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
         prefix = f"[{i + 1}/{n}] {f}: " if n > 1 else f"{f}: "
         inputs = _load(f, args)
         c = pipeline.compare_program(inputs.program, inputs.machine, bounds=args.bounds,
-                                     progress=_prefixed(args.progress, prefix))
+                                     progress=_prefixed(args.progress, prefix),
+                                     max_grid_points=args.max_grid_points)
         args.progress.done()
         doc = comparison_dict(c, args.max_gap)
         docs.append(doc)
@@ -305,7 +313,8 @@ def cmd_check(args: argparse.Namespace) -> int:
                                        bounds=args.bounds, path_kind=args.path_kind,
                                        smoothing=smoothing,
                                        max_deviation=args.max_deviation,
-                                       progress=args.progress)
+                                       progress=args.progress,
+                                       max_grid_points=args.max_grid_points)
     args.progress.done()
     out = sys.stdout if args.json != "-" else sys.stderr
     result.print(out)
