@@ -150,6 +150,7 @@ def _load(program_file: str, args: argparse.Namespace) -> pipeline.Inputs:
 def cmd_plan(args: argparse.Namespace) -> int:
     """``feedoracle plan``: run the heuristic, print its block table."""
     from reference.planner import ipo_samples, to_json_dict
+    from reference.planner.export import iter_json_rows
     inputs = _load(args.program, args)
     program, machine = inputs.program, inputs.machine
     plan = pipeline.plan_program(program, machine, progress=args.progress,
@@ -158,9 +159,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.csv:
         pipeline.require_ipo_budget(plan.profile.duration, plan.limits.t_ipo_s, "--csv",
                                     args.max_grid_points)
-    doc = to_json_dict(plan)
     if args.json:
+        doc = to_json_dict(plan)
         write_json(doc, args.json)
+        rows = doc["blocks"]
+    else:
+        rows = iter_json_rows(plan)
     if args.csv:
         header, data = ipo_samples(plan)
         write_samples_csv(header, data, args.csv)
@@ -172,8 +176,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     for v in viol:
         out.write(f"  VIOLATION {v.constraint} {v.axis or ''} ratio {v.ratio:.4g} at "
                   f"s = {v.s:.3f} mm, t = {v.t:.4f} s\n")
-    rows_table(doc.get("blocks", []), out, "t_reference_s", "v_exit_reference",
-               "limit_reference")
+    rows_table(rows, out, "t_reference_s", "v_exit_reference", "limit_reference")
     return EXIT_FAIL if viol else EXIT_OK
 
 

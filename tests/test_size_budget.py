@@ -116,3 +116,21 @@ def test_endless_loop_still_stops_at_its_line():
     with pytest.raises(NCSyntaxError, match=r"<string>:2:1: loop does not terminate within "
                                             r"50 blocks"):
         parse_text("G90\nL1: G1 X1 F100\nGOTOB L1\n", max_repeats=50)
+
+
+# ----------------------------------------------------------------- columnar rows
+def test_json_rows_from_columns_equal_the_row_objects():
+    """The JSON rows are built from the table's columns (no object per block); they must
+    be the rows of the table's own PlannedBlock objects, value and type."""
+    from reference.planner import to_json_dict
+    plan = pipeline.plan_program(parse_text(
+        "G90 G1 F1000 X10\nG4 F0.5\nG9 G1 X20 Y5\nG2 X30 Y5 I5 J0\nG60 G1 X40\nM30\n"))
+    rows = to_json_dict(plan)["blocks"]
+    by_hand = [{"block": b.block, "line": max(1, b.line), "label": b.label, "kind": b.kind,
+                "length_mm": max(0.0, b.length_mm), "t_reference_s": max(0.0, b.time_s),
+                "v_exit_reference": max(0.0, b.v_exit), "limit_reference": b.cause,
+                "hold_s": b.hold_s, "hold_cause": plan.holds.cause_of(b.block)}
+               for b in plan.blocks]
+    assert rows == by_hand
+    assert any(r["hold_cause"] for r in rows)
+    assert all(type(r[k]) is type(h[k]) for r, h in zip(rows, by_hand) for k in r)

@@ -713,14 +713,18 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     moving = (p.s[1:] > p.s[:-1])[parent]
     dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
     sign = np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8)
+    # one array per piece is a few bytes per piece; 10^6 blocks make ~5e6 pieces, so the
+    # per-piece temporaries go as soon as the signs are known
+    del pa0, pa1, amax, moving, dominant, first_of_two, second, tz, npc
     if not np.any(sign):
         return
     starts = np.concatenate(([0], np.flatnonzero(np.diff(sign)) + 1))
     ends = np.concatenate((starts[1:], [sign.size]))
     nz = sign[starts] != 0
-    t0 = p.t[parent] + tau0
-    t1 = p.t[parent] + tau1
-    dur = t1[ends - 1] - t0[starts]
+    del sign
+    t0_start = p.t[parent[starts]] + tau0[starts]
+    dur = (p.t[parent[ends - 1]] + tau1[ends - 1]) - t0_start
+    del tau1
     # axes that can move on each piece's segment, OR-ed over each run of pieces
     seg = ctx.seg
     rw = path.radius * np.abs(path.omega)
@@ -734,6 +738,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     if not np.any(ok):
         return
     starts, ends, dur, f_min, ax = starts[ok], ends[ok], dur[ok], f_min[ok], ax[ok]
+    t0_start = t0_start[ok]
     ratio = (1.0 / f_min) / dur
     # per block: every block a process touches
     run_of_piece = np.repeat(np.arange(starts.size), ends - starts)
@@ -746,7 +751,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     s_at, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau0[pc])
     w.found = True
     w.ratio, w.value, w.limit = float(ratio[i]), float(1.0 / dur[i]), float(f_min[i])
-    w.s, w.t = float(s_at), float(t0[pc])
+    w.s, w.t = float(s_at), float(t0_start[i])
     w.block = int(path.block[seg[k]])
     w.axis = path.axes[int(ax[i])]
 

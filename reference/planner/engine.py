@@ -197,6 +197,10 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
                           horizon, holds)
     bound_set = modes.bound_set
+    # the planning stages' arrays are done with: freed before the checker's own (with
+    # 10^6 blocks both together would be about a gigabyte)
+    del modes, seg, junc, horizon, base_units, units, speeds, prof
+    sm = fac = new_units = None     # noqa: F841 - the smoothing's and adaptation's copies
     report = None
     if check:
         report_progress("check", 0.9)
