@@ -14,6 +14,7 @@ to be within the gate.
 from __future__ import annotations
 
 import argparse
+import gc
 import math
 import sys
 from pathlib import Path as FsPath
@@ -149,6 +150,20 @@ def _load(program_file: str, args: argparse.Namespace) -> pipeline.Inputs:
 # --------------------------------------------------------------------- plan
 def cmd_plan(args: argparse.Namespace) -> int:
     """``feedoracle plan``: run the heuristic, print its block table."""
+    # Parsing, the path and the plan build some objects per block and no reference
+    # cycles; with 10^6 blocks the cyclic collector re-scans them again and again (the
+    # planner alone: 44 s -> 24 s without it, measured on a busy machine). Paused for
+    # the command, restored after.
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        return _plan(args)
+    finally:
+        if collecting:
+            gc.enable()
+
+
+def _plan(args: argparse.Namespace) -> int:
     from reference.planner import ipo_samples, to_json_dict
     from reference.planner.export import iter_json_rows
     inputs = _load(args.program, args)
