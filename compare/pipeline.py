@@ -154,13 +154,23 @@ def require_motion(program: Program, path: Path) -> None:
                         "optimize or compare")
 
 
+#: Checker points one interval of the oracle's grid costs against the size budget: an
+#: interval carries LP rows, bounds and certificates of some kilobytes (10^5 mixed blocks,
+#: 5e5 intervals: about 1.1 GB), a checker point some 20 bytes of one bounded chunk. With
+#: the default budget the oracle starts on at most 10^6 intervals (about 2 GB).
+ORACLE_GRID_WEIGHT = 100
+
+
 def require_budget(program: Program, path: Path,
-                   max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> None:
+                   max_grid_points: float = DEFAULT_MAX_GRID_POINTS, *,
+                   oracle: bool = False) -> None:
     """A path whose sampling would exceed the size budget is rejected before any sample.
 
     The points are those of :func:`reference.core.budget.grid_points` (the checker's
-    samples on arcs and helices, the densest sampling of any stage). The message names
-    the line contributing most, and what to change there.
+    samples on arcs and helices, the densest sampling of any stage) and, with
+    ``oracle``, the intervals of the oracle's first grid
+    (:func:`optimal.grid.initial_counts`) at :data:`ORACLE_GRID_WEIGHT` points each.
+    The message names the line contributing most, and what to change there.
 
     Raises
     ------
@@ -169,7 +179,16 @@ def require_budget(program: Program, path: Path,
     """
     pts = grid_points(path)
     total = float(pts.sum()) if pts.size else 0.0
-    if total <= max_grid_points:
+    what = "grid points"
+    if total <= max_grid_points and oracle and path.n_segments:
+        from optimal.grid import initial_counts
+        pts = initial_counts(path)
+        total = float(pts.sum())
+        if total * ORACLE_GRID_WEIGHT <= max_grid_points:
+            return
+        what = (f"oracle grid intervals (at most --max-grid-points / "
+                f"{ORACLE_GRID_WEIGHT} = {max_grid_points / ORACLE_GRID_WEIGHT:.2g})")
+    elif total <= max_grid_points:
         return
     worst = int(np.argmax(pts))
     span = _span_of_block(path, int(path.block[worst]))
@@ -182,7 +201,7 @@ def require_budget(program: Program, path: Path,
         fix = f"reduce {word}"
     else:
         cause, fix = "the program's arcs and helices", "split the program"
-    raise BudgetError(f"{program.file}:{line}: {cause} gives {total:.2g} grid points at "
+    raise BudgetError(f"{program.file}:{line}: {cause} gives {total:.2g} {what} at "
                       f"line {line} (budget {max_grid_points:.2g}); raise "
                       f"--max-grid-points or {fix}")
 
@@ -297,7 +316,7 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
-    require_budget(inp.program, path, max_grid_points)
+    require_budget(inp.program, path, max_grid_points, oracle=True)
     # the waits the program and machine impose (dwell, exact-stop settle): the same the
     # heuristic would contain, computed without it
     holds = imposed_holds(inp.program, path, inp.machine)
@@ -340,7 +359,7 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
-    require_budget(inp.program, path, max_grid_points)
+    require_budget(inp.program, path, max_grid_points, oracle=True)
     plan = engines.run_heuristic(inp.program, inp.machine, path=path,
                                  progress=_prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
@@ -398,7 +417,7 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
     inp = load_inputs(program, machine, dialect=dialect)
     contour = prepare(inp.program)
     require_motion(inp.program, contour)
-    require_budget(inp.program, contour, max_grid_points)
+    require_budget(inp.program, contour, max_grid_points, oracle=True)
     return check_recorded(trajectory, inp.program, inp.machine, bounds=bounds,
                           path_kind=path_kind, smoothing=smoothing,
                           max_deviation=max_deviation, progress=progress)

@@ -134,3 +134,26 @@ def test_json_rows_from_columns_equal_the_row_objects():
     assert rows == by_hand
     assert any(r["hold_cause"] for r in rows)
     assert all(type(r[k]) is type(h[k]) for r, h in zip(rows, by_hand) for k in r)
+
+
+# ----------------------------------------------------------------- the oracle's grid
+def test_oracle_initial_counts_are_the_grid_it_builds():
+    from optimal.grid import initial_counts, initial_grid
+    for text in (HELIX_SIN.format(n=3), "G90 G1 F1000 X10\nG2 X20 I5 J0\nG1 Y30\nM30\n"):
+        path = prepare(parse_text(text))
+        assert initial_counts(path).sum() == initial_grid(path).n_intervals
+
+
+def test_compare_counts_the_oracle_grid(tmp_path, capsys):
+    """TURN=20000 needs 5.8e7 checker points (within 1e8) but 1.3e6 oracle intervals,
+    above 1e8 / 100: compare and optimize refuse it, plan (no oracle) accepts it."""
+    f = tmp_path / "h.mpf"
+    f.write_text(HELIX_SIN.format(n=20_000))
+    assert main(["compare", str(f), "--quiet", "--no-report"]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}:2: TURN=20000 gives 1.3e+06 oracle grid intervals" in err
+    assert "--max-grid-points" in err
+    path = prepare(parse_text(HELIX_SIN.format(n=20_000)))
+    pipeline.require_budget(parse_text(HELIX_SIN.format(n=20_000)), path)   # plan: fine
+    with pytest.raises(BudgetError, match="oracle grid intervals"):
+        pipeline.require_budget(parse_text(HELIX_SIN.format(n=20_000)), path, oracle=True)

@@ -124,8 +124,12 @@ def main() -> int:
                   f"{rss / 2 ** 20:>8.0f} {rss / RSS_BUDGET_B:>7.2f}")
         if len(sizes) >= 2:
             print(f"   scaling exponent plan time ~ N^k: k = {_exponent(sizes, walls):.2f}; "
-                  f"RSS ~ N^k: k = {_exponent(sizes, rsss):.2f} (1 = linear; "
-                  f"{', '.join(format(n, '.0e') for n in sizes)})")
+                  f"RSS ~ N^k: k = {_exponent(sizes, rsss):.2f} (1 = linear; fit over "
+                  f"{', '.join(format(n, '.0e') for n in sizes)}; start-up weighs on the "
+                  "smallest)")
+            print(f"   scaling exponent between the two largest: time k = "
+                  f"{_exponent(sizes[-2:], walls[-2:]):.2f}, RSS k = "
+                  f"{_exponent(sizes[-2:], rsss[-2:]):.2f}")
         f = tmp / "mixed.mpf"
         f.write_text(mixed_program(COMPARE_SIZE))
         js = tmp / "mixed.json"
