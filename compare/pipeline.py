@@ -21,7 +21,10 @@ import os
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Callable, Union
 
-from reference.core.errors import PathError
+import numpy as np
+
+from reference.core.budget import DEFAULT_MAX_GRID_POINTS, grid_points, ipo_points
+from reference.core.errors import BudgetError, PathError
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.machine import Machine, load_machine
@@ -96,8 +99,8 @@ def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
 
 # --------------------------------------------------------------------- plan
 def plan_program(program: ProgramLike, machine: MachineLike = None, *,
-                 dialect: str | None = None, progress: ProgressFn | None = None
-                 ) -> "ReferencePlan":
+                 dialect: str | None = None, progress: ProgressFn | None = None,
+                 max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> "ReferencePlan":
     """The heuristic alone (``feedoracle plan``).
 
     Parameters
@@ -106,6 +109,8 @@ def plan_program(program: ProgramLike, machine: MachineLike = None, *,
         See :func:`load_inputs`.
     progress : callable, optional
         ``progress(message, fraction)``.
+    max_grid_points : float
+        Size budget, see :func:`require_budget`.
 
     Returns
     -------
@@ -115,7 +120,7 @@ def plan_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
-    require_motion(inp.program, path)
+    require_budget(inp.program, path, max_grid_points)
     return engines.run_heuristic(inp.program, inp.machine, path=path, progress=progress)
 
 
@@ -139,6 +144,81 @@ def require_motion(program: Program, path: Path) -> None:
         raise PathError(f"{program.file}: the program has no motion ({n} block"
                         f"{'' if n == 1 else 's'}, none moves an axis): nothing to plan, "
                         "optimize or compare")
+
+
+#: Checker points one interval of the oracle's grid costs against the size budget: an
+#: interval carries LP rows, bounds and certificates of some kilobytes (10^5 mixed blocks,
+#: 5e5 intervals: about 1.1 GB), a checker point some 20 bytes of one bounded chunk. With
+#: the default budget the oracle starts on at most 10^6 intervals (about 2 GB).
+ORACLE_GRID_WEIGHT = 100
+
+
+def require_budget(program: Program, path: Path,
+                   max_grid_points: float = DEFAULT_MAX_GRID_POINTS, *,
+                   oracle: bool = False) -> None:
+    """A path whose sampling would exceed the size budget is rejected before any sample.
+
+    The points are those of :func:`reference.core.budget.grid_points` (the checker's
+    samples on arcs and helices, the densest sampling of any stage) and, with
+    ``oracle``, the intervals of the oracle's first grid
+    (:func:`optimal.grid.initial_counts`) at :data:`ORACLE_GRID_WEIGHT` points each.
+    The message names the line contributing most, and what to change there.
+
+    Raises
+    ------
+    BudgetError
+        More than ``max_grid_points`` points; names file, line and the option.
+    """
+    pts = grid_points(path)
+    total = float(pts.sum()) if pts.size else 0.0
+    what = "grid points"
+    if total <= max_grid_points and oracle and path.n_segments:
+        from optimal.grid import initial_counts
+        pts = initial_counts(path)
+        total = float(pts.sum())
+        if total * ORACLE_GRID_WEIGHT <= max_grid_points:
+            return
+        what = (f"oracle grid intervals (at most --max-grid-points / "
+                f"{ORACLE_GRID_WEIGHT} = {max_grid_points / ORACLE_GRID_WEIGHT:.2g})")
+    elif total <= max_grid_points:
+        return
+    worst = int(np.argmax(pts))
+    span = _span_of_block(path, int(path.block[worst]))
+    line = max(1, span.line) if span is not None else 1
+    blk = program.blocks[int(path.block[worst])] if span is not None else None
+    turns = int(getattr(blk, "turns", 0) or 0) if blk is not None else 0
+    word = "P" if program.dialect == "ngc" else "TURN"
+    if turns > 0:
+        cause = f"P{turns + 1}" if word == "P" else f"TURN={turns}"
+        fix = f"reduce {word}"
+    else:
+        cause, fix = "the program's arcs and helices", "split the program"
+    raise BudgetError(f"{program.file}:{line}: {cause} gives {total:.2g} {what} at "
+                      f"line {line} (budget {max_grid_points:.2g}); raise "
+                      f"--max-grid-points or {fix}")
+
+
+def require_ipo_budget(duration_s: float, t_ipo_s: float, what: str,
+                       max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> None:
+    """A CSV sampled at the IPO cycle must fit the size budget (checked before sampling).
+
+    Raises
+    ------
+    BudgetError
+        More rows than ``max_grid_points``; names the duration, the cycle and the option.
+    """
+    n = ipo_points(duration_s, t_ipo_s)
+    if n > max_grid_points:
+        raise BudgetError(f"{what}: the motion lasts {duration_s:.6g} s, {n:.2g} rows at the "
+                          f"IPO cycle of {t_ipo_s * 1e3:.6g} ms (budget {max_grid_points:.2g}"
+                          "); raise --max-grid-points or omit the CSV")
+
+
+def _span_of_block(path: Path, block: int):
+    for sp in path.blocks:
+        if sp.block == block:
+            return sp
+    return None
 
 
 # --------------------------------------------------------------------- optimize
@@ -200,8 +280,8 @@ class OptimizeResult:
 
 def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
                      bounds: str = "acc", tol: float | None = None,
-                     dialect: str | None = None, progress: ProgressFn | None = None
-                     ) -> OptimizeResult:
+                     dialect: str | None = None, progress: ProgressFn | None = None,
+                     max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> OptimizeResult:
     """The oracle alone on the program's path; the heuristic does not run.
 
     Parameters
@@ -228,6 +308,7 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
+    require_budget(inp.program, path, max_grid_points, oracle=True)
     # the waits the program and machine impose (dwell, exact-stop settle): the same the
     # heuristic would contain, computed without it
     holds = imposed_holds(inp.program, path, inp.machine)
@@ -241,8 +322,8 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
 # --------------------------------------------------------------------- compare
 def compare_program(program: ProgramLike, machine: MachineLike = None, *,
                     bounds: str = "auto", tol: float | None = None,
-                    dialect: str | None = None, progress: ProgressFn | None = None
-                    ) -> Comparison:
+                    dialect: str | None = None, progress: ProgressFn | None = None,
+                    max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> Comparison:
     """Heuristic and oracle on one path, compared block by block (``feedoracle compare``).
 
     Parameters
@@ -271,6 +352,7 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     inp = load_inputs(program, machine, dialect=dialect)
     path = build_path(inp.program, inp.machine)
     require_motion(inp.program, path)
+    require_budget(inp.program, path, max_grid_points, oracle=True)
     plan = engines.run_heuristic(inp.program, inp.machine, path=path,
                                  progress=engines.prefixed(progress, "heuristic: "))
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
@@ -289,7 +371,8 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
                      machine: MachineLike = None, *, bounds: str | None = None,
                      path_kind: str = "reference", smoothing: float | str = "auto",
                      max_deviation: float | None = None, dialect: str | None = None,
-                     progress: ProgressFn | None = None) -> "CheckResult":
+                     progress: ProgressFn | None = None,
+                     max_grid_points: float = DEFAULT_MAX_GRID_POINTS) -> "CheckResult":
     """A recorded trajectory against the limits and the oracle (``feedoracle check``).
 
     Parameters
@@ -324,7 +407,9 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
     if not isinstance(smoothing, str) and not (math.isfinite(smoothing) and smoothing >= 0):
         raise ValueError(f"smoothing {smoothing!r}: must be >= 0 mm")
     inp = load_inputs(program, machine, dialect=dialect)
-    require_motion(inp.program, prepare(inp.program))
+    contour = prepare(inp.program)
+    require_motion(inp.program, contour)
+    require_budget(inp.program, contour, max_grid_points, oracle=True)
     return check_recorded(trajectory, inp.program, inp.machine, bounds=bounds,
                           path_kind=path_kind, smoothing=smoothing,
                           max_deviation=max_deviation, progress=progress)
@@ -332,4 +417,4 @@ def check_trajectory(trajectory: str | os.PathLike[str], program: ProgramLike,
 
 __all__ = ["Inputs", "MachineLike", "OptimizeResult", "ProgramLike", "ProgressFn",
            "check_trajectory", "compare_program", "load_inputs", "optimize_program",
-           "plan_program", "require_motion"]
+           "plan_program", "require_budget", "require_ipo_budget", "require_motion"]

@@ -75,6 +75,24 @@ def _counts(path: Path, n_target: int, min_arc: int, arc_step: float) -> np.ndar
     return np.where(arc, np.maximum(n, n_arc), n)
 
 
+def initial_counts(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS) -> np.ndarray:
+    """Intervals per segment of :func:`initial_grid` (default settings), without building
+    it: the size of the oracle's first grid, known before anything is allocated.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (m,)
+        Float, so that a hostile path (10^6 turns) cannot overflow.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        length = path.length
+        h0 = path.total_length / max(n_intervals, 1)
+        n = np.maximum(MIN_SEGMENT_INTERVALS, np.ceil(length / h0 * (1 - 1e-12)))
+        sweep = np.abs(path.omega) * length
+        n_arc = np.maximum(MIN_ARC_INTERVALS, np.ceil(sweep / MAX_ARC_STEP_RAD))
+        return np.where(path.radius > 0, np.maximum(n, n_arc), n).astype(np.float64)
+
+
 def grid_from_counts(path: Path, counts: np.ndarray) -> Grid:
     """Grid with ``counts[i]`` equal intervals on segment ``i``.
 

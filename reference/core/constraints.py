@@ -465,16 +465,37 @@ def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
         MIN_ARC_SAMPLES,
         np.ceil(plane_amplitudes(path).omega_max[ctx.seg[k_all]] * vpk_all * ctx.h[k_all]
                 / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 0)
+    # An arc interval needing more than a chunk of samples (a long helix run in few
+    # intervals) is cut into pieces of time, each sampled at the same density; so every
+    # chunk stays about CHUNK_SAMPLES points whatever the number of turns.
+    n_piece = np.maximum(1, -(-n_uni // CHUNK_SAMPLES))
+    piece_k = np.repeat(k_all, n_piece)
+    piece_first = np.ones(piece_k.size, bool)
+    if piece_k.size > k_all.size:
+        start = np.concatenate(([0], np.cumsum(n_piece)[:-1]))
+        idx = np.arange(piece_k.size) - np.repeat(start, n_piece)
+        piece_first = idx == 0
+        frac0 = idx / np.repeat(n_piece, n_piece)
+        frac1 = (idx + 1) / np.repeat(n_piece, n_piece)
+        n_rows = np.repeat(np.maximum(MIN_ARC_SAMPLES, -(-n_uni // n_piece) + 1), n_piece)
+        arc_p = np.repeat(arc, n_piece)
+        n_rows = np.where(arc_p, n_rows, 0)
+    else:
+        frac0 = np.zeros(k_all.size)
+        frac1 = np.ones(k_all.size)
+        n_rows, arc_p = n_uni, arc
     # cost: one row per line interval; uniform + stationary + 3 refinement rows per arc
-    cost = np.where(arc, n_uni + 4, 1)
+    cost = np.where(arc_p, n_rows + 4, 1)
     for lo, hi in _chunks(cost):
-        k = k_all[lo:hi]
-        a_mask = arc[lo:hi]
-        _check_feed(ctx, k, worst["feed"])
+        k = piece_k[lo:hi]
+        a_mask = arc_p[lo:hi]
+        once = piece_first[lo:hi]
+        _check_feed(ctx, k[once], worst["feed"])
         if np.any(~a_mask):
             _check_lines(ctx, k[~a_mask], worst)
         if np.any(a_mask):
-            _check_arcs(ctx, k[a_mask], n_uni[lo:hi][a_mask], worst)
+            _check_arcs(ctx, k[a_mask], n_rows[lo:hi][a_mask], worst,
+                        frac0[lo:hi][a_mask], frac1[lo:hi][a_mask])
 
 
 def _check_feed(ctx: _Ctx, k: np.ndarray, w: _Worst) -> None:
@@ -532,17 +553,25 @@ def _axis_kinematics(ctx: _Ctx, k: np.ndarray, tau: np.ndarray):
 
 
 def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
-                worst: dict[str, _Worst]) -> None:
-    """Dense samples on arcs/helices, then one parabolic refinement per interval."""
+                worst: dict[str, _Worst], frac0: np.ndarray | None = None,
+                frac1: np.ndarray | None = None) -> None:
+    """Dense samples on arcs/helices, then one parabolic refinement per interval.
+
+    ``frac0, frac1`` (default 0 and 1) restrict each row to the time piece
+    ``[frac0 h, frac1 h]`` of its interval (a long interval checked in pieces).
+    """
     lim, path, axes = ctx.lim, ctx.path, ctx.path.axes
-    h = ctx.h[k]
+    h_full = ctx.h[k]
     ni = k.size
+    t0 = np.zeros(ni) if frac0 is None else frac0 * h_full
+    t1 = h_full if frac1 is None else frac1 * h_full
+    h = t1 - t0
     # uniform samples, contiguous per interval
     first = np.concatenate(([0], np.cumsum(n_uni)[:-1]))
     row_iv = np.repeat(np.arange(ni), n_uni)
     pos = np.arange(row_iv.size) - first[row_iv]
     dtau = h / (n_uni - 1)
-    tau_u = np.minimum(pos * dtau[row_iv], h[row_iv])
+    tau_u = np.minimum(t0[row_iv] + pos * dtau[row_iv], t1[row_iv])
     _, _, ts = _speed_peak(ctx, k)
     iv = np.concatenate((row_iv, np.arange(ni)))
     tau = np.concatenate((tau_u, ts))
@@ -572,7 +601,7 @@ def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
             off = np.where(den < 0, 0.5 * (ym - yp) / den, 0.0)
         off = np.clip(off, -1.0, 1.0)
         ref_iv.append(np.arange(ni))
-        ref_tau.append(np.clip(tau_u[c] + off * dtau, 0.0, h))
+        ref_tau.append(np.clip(tau_u[c] + off * dtau, t0, t1))
     riv = np.concatenate(ref_iv)
     rk = _axis_kinematics(ctx, k[riv], np.concatenate(ref_tau))
     rblk = path.block[ctx.seg[k[riv]]]
@@ -684,14 +713,18 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     moving = (p.s[1:] > p.s[:-1])[parent]
     dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
     sign = np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8)
+    # one array per piece is a few bytes per piece; 10^6 blocks make ~5e6 pieces, so the
+    # per-piece temporaries go as soon as the signs are known
+    del pa0, pa1, amax, moving, dominant, first_of_two, second, tz, npc
     if not np.any(sign):
         return
     starts = np.concatenate(([0], np.flatnonzero(np.diff(sign)) + 1))
     ends = np.concatenate((starts[1:], [sign.size]))
     nz = sign[starts] != 0
-    t0 = p.t[parent] + tau0
-    t1 = p.t[parent] + tau1
-    dur = t1[ends - 1] - t0[starts]
+    del sign
+    t0_start = p.t[parent[starts]] + tau0[starts]
+    dur = (p.t[parent[ends - 1]] + tau1[ends - 1]) - t0_start
+    del tau1
     # axes that can move on each piece's segment, OR-ed over each run of pieces
     seg = ctx.seg
     rw = path.radius * np.abs(path.omega)
@@ -705,6 +738,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     if not np.any(ok):
         return
     starts, ends, dur, f_min, ax = starts[ok], ends[ok], dur[ok], f_min[ok], ax[ok]
+    t0_start = t0_start[ok]
     ratio = (1.0 / f_min) / dur
     # per block: every block a process touches
     run_of_piece = np.repeat(np.arange(starts.size), ends - starts)
@@ -717,7 +751,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     s_at, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau0[pc])
     w.found = True
     w.ratio, w.value, w.limit = float(ratio[i]), float(1.0 / dur[i]), float(f_min[i])
-    w.s, w.t = float(s_at), float(t0[pc])
+    w.s, w.t = float(s_at), float(t0_start[i])
     w.block = int(path.block[seg[k]])
     w.axis = path.axes[int(ax[i])]
 

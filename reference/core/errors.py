@@ -114,3 +114,11 @@ class InternalError(RuntimeError):
     Deliberately *not* a :class:`FeedOracleError`: the CLI reports it with exit code 3
     ("internal error"), so a CI gate never mistakes a crash for bad input or a gap.
     """
+
+
+class BudgetError(FeedOracleError, ValueError):
+    """A program (or machine data) whose evaluation would exceed a stated size budget.
+
+    Raised *before* the large arrays are allocated, naming the cause (the line, the key or
+    the option) and the option that raises the budget.
+    """

@@ -98,6 +98,15 @@ class Holds:
             return ""
         return self.cause[int(sel[np.argmax(self.duration_s[sel])])]
 
+    def causes_by_block(self) -> dict[int, str]:
+        """``{block: cause of its longest hold}`` for every block with a hold (one pass,
+        the same choice as :meth:`cause_of`: the first of equally long holds)."""
+        out: dict[int, tuple[float, str]] = {}
+        for b, d, c in zip(self.block.tolist(), self.duration_s.tolist(), self.cause):
+            if b not in out or d > out[b][0]:
+                out[b] = (d, c)
+        return {b: c for b, (_, c) in out.items()}
+
     def subset(self, keep: np.ndarray) -> "Holds":
         """The holds where ``keep`` (bool, shape ``(h,)``) is True, in the same order."""
         keep = np.asarray(keep, dtype=bool)

@@ -13,7 +13,7 @@ from pathlib import Path as FsPath
 
 from ..core.errors import NCSyntaxError
 from .expr import ExprError
-from .interp import run
+from .interp import MAX_EXECUTED_BLOCKS, run
 from .lines import LineError, parse_ngc, parse_sinumerik
 from .program import Block, Program, ProgramWarning, Tangential
 
@@ -26,7 +26,8 @@ def _split_lines(text: str) -> list[str]:
     return text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
 
 
-def parse_text(text: str, file: str = "<string>", dialect: str = "sinumerik") -> Program:
+def parse_text(text: str, file: str = "<string>", dialect: str = "sinumerik", *,
+               max_repeats: int = MAX_EXECUTED_BLOCKS) -> Program:
     """Parse NC program text.
 
     Parameters
@@ -37,6 +38,10 @@ def parse_text(text: str, file: str = "<string>", dialect: str = "sinumerik") ->
         Name used in messages.
     dialect : {"sinumerik", "ngc"}
         NC dialect.
+    max_repeats : int
+        Endless-loop guard: the most lines executed *again* (loop passes, jumps back,
+        subprogram calls) beyond each statement's first run. A loop-free program of
+        any length passes it.
 
     Returns
     -------
@@ -55,13 +60,13 @@ def parse_text(text: str, file: str = "<string>", dialect: str = "sinumerik") ->
     collecting = gc.isenabled()
     gc.disable()
     try:
-        return _parse(text, file, dialect)
+        return _parse(text, file, dialect, max_repeats)
     finally:
         if collecting:
             gc.enable()
 
 
-def _parse(text: str, file: str, dialect: str) -> Program:
+def _parse(text: str, file: str, dialect: str, max_repeats: int) -> Program:
     lines = _split_lines(text)
     if lines and lines[-1] == "":
         lines.pop()
@@ -76,7 +81,7 @@ def _parse(text: str, file: str, dialect: str) -> Program:
             raise NCSyntaxError(file, i, _col(raw, exc.col, dialect), str(exc)) from None
         if not st.empty or st.kind != "block":
             stmts.append(st)
-    return run(file, dialect, stmts, tuple(lines))
+    return run(file, dialect, stmts, tuple(lines), max_repeats=max_repeats)
 
 
 def _col(raw: str, col0: int, dialect: str) -> int:

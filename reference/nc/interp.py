@@ -11,8 +11,10 @@ Rules worth knowing:
 
 * Declarations and control flow (``DEF``, ``IF``/``ELSE``/``ENDIF``, loops, ``GOTO``,
   ``CASE``, NGC O-words) make no block; every other executed line makes one, a line run
-  by a loop once per pass. More than :data:`MAX_EXECUTED_BLOCKS` executed lines is an
-  error naming the loop that jumped back last.
+  by a loop once per pass. The guard against endless loops counts *re-executions*: the
+  lines executed beyond the program's own statements (loop passes, subprogram calls). More
+  than :data:`MAX_EXECUTED_BLOCKS` of them is an error naming the loop that jumped back
+  last; a loop-free program of any length is never stopped by it.
 * A frame change keeps the machine position; the axes a later block does not program
   stay where they are in machine coordinates.
 * Anything that needs a real control (system variables, cycles, subprograms that are not
@@ -53,13 +55,20 @@ from .state import (_CENTER_WORD, _END_M, _G_GROUPS_NGC, _G_GROUPS_SIN,  # noqa:
                     _IGNORED_G_NGC, _IGNORED_G_SIN, _IGNORED_WHY, _MODES10_SIN, _NGC_CS,
                     _PLANE_AXES, _UNSUPPORTED_G, GEOMETRY)
 
+#: Largest number of re-executed lines (statements run again by a loop, a jump back or a
+#: subprogram call), beyond each statement's first run. It stops endless loops; a
+#: loop-free program's own length is limited only by the memory budget, not by this.
 MAX_EXECUTED_BLOCKS = 1_000_000
 #: Loop openers whose closer jumps to the first statement of the body (not to the opener).
 _BODY_OPENERS = frozenset({"LOOP", "REPEAT", "O:REPEAT"})
 
 
-def run(file: str, dialect: str, stmts: list[Stmt], lines: tuple[str, ...]) -> Program:
+def run(file: str, dialect: str, stmts: list[Stmt], lines: tuple[str, ...], *,
+        max_repeats: int = MAX_EXECUTED_BLOCKS) -> Program:
     """Execute parsed statements and build the :class:`Program`.
+
+    ``max_repeats`` is the endless-loop guard: the most statements executed beyond the
+    program's own ``len(stmts)`` (default :data:`MAX_EXECUTED_BLOCKS`).
 
     Raises
     ------
@@ -67,7 +76,7 @@ def run(file: str, dialect: str, stmts: list[Stmt], lines: tuple[str, ...]) -> P
         Any error in the program, naming file, line and column.
     """
     ip = _Interp(file, dialect, stmts, lines)
-    _execute(ip)
+    _execute(ip, max_repeats)
     n = len(ip.axes)
     blocks = ip.out
     for i, b in enumerate(blocks):
@@ -85,7 +94,7 @@ def run(file: str, dialect: str, stmts: list[Stmt], lines: tuple[str, ...]) -> P
                    warnings=tuple(ip.warnings), source_units=ip.start_units, lines=lines)
 
 
-def _execute(ip: _Interp) -> None:
+def _execute(ip: _Interp, max_repeats: int = MAX_EXECUTED_BLOCKS) -> None:
     stmts = ip.stmts
     pairs = _match_blocks(ip)
     labels = _LazyLabels(ip)
@@ -96,6 +105,9 @@ def _execute(ip: _Interp) -> None:
     i = 0
     prev = -1
     n = len(stmts)
+    # Each statement runs once in a loop-free program, so at most n executions are the
+    # program itself; only what lies beyond counts against the guard.
+    cap = n + max_repeats
     while i < n:
         st = stmts[i]
         k = st.kind
@@ -105,12 +117,12 @@ def _execute(ip: _Interp) -> None:
             ip.loop_line = head.line
             ip.jump_line = stmts[prev].line
         prev = i
-        if executed > MAX_EXECUTED_BLOCKS:
+        if executed > cap:
             line = ip.loop_line or st.line
             raise NCSyntaxError(ip.file, line, 1, f"loop does not terminate within "
-                                f"{MAX_EXECUTED_BLOCKS} blocks (the program does not end "
-                                f"within {MAX_EXECUTED_BLOCKS} executed lines; it jumps back "
-                                f"here from line {ip.jump_line or st.line})")
+                                f"{max_repeats} blocks (the program does not end within "
+                                f"{max_repeats} lines executed again by loops and jumps; "
+                                f"it jumps back here from line {ip.jump_line or st.line})")
         if k == "block":
             fast = st.fast
             if fast is not None and _fast_block(ip, st, fast):

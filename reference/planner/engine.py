@@ -197,6 +197,10 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
                           horizon, holds)
     bound_set = modes.bound_set
+    # the planning stages' arrays are done with: freed before the checker's own (with
+    # 10^6 blocks both together would be about a gigabyte)
+    del modes, seg, junc, horizon, base_units, units, speeds, prof
+    sm = fac = new_units = None     # noqa: F841 - the smoothing's and adaptation's copies
     report = None
     if check:
         report_progress("check", 0.9)
@@ -248,15 +252,38 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
     h = prof.duration
     a0 = prof.a0
     jj = prof.jerk
-    dv = a0 * h + jj * h * h / 2
-    v_start = prof.v_in[:, None] + _exclusive_cumsum(dv)
-    ds = v_start * h + a0 * h * h / 2 + jj * h ** 3 / 6
-    s_start = units.s_start[:, None] + _exclusive_cumsum(ds)
+    # In place, one temporary at a time: every (units x phases) array is some 50 MB for
+    # 10^6 blocks. Same operations in the same order as the plain formulas
+    # dv = a0 h + jj h^2 / 2, ds = v_start h + a0 h^2 / 2 + jj h^3 / 6 (bitwise equal).
+    dv = a0 * h
+    tmp = jj * h
+    tmp *= h
+    tmp /= 2
+    dv += tmp
+    v_start = _exclusive_cumsum(dv)
+    del dv
+    v_start += prof.v_in[:, None]
+    ds = v_start * h
+    np.multiply(a0, h, out=tmp)
+    tmp *= h
+    tmp /= 2
+    ds += tmp
+    del tmp
+    tmp = h ** 3
+    tmp *= jj
+    tmp /= 6
+    ds += tmp
+    del tmp
+    s_start = _exclusive_cumsum(ds)
+    del ds
+    s_start += units.s_start[:, None]
     keep = h > 0
     hh = h[keep]
     t = np.concatenate(([0.0], np.cumsum(hh)))
     s = np.concatenate((s_start[keep], [path.total_length]))
+    del s_start
     v = np.concatenate((np.maximum(v_start[keep], 0.0), [0.0]))
+    del v_start
     return Profile(t=t, s=s, v=v, a=a0[keep], j=jj[keep], block=np.full(hh.size, -1))
 
 

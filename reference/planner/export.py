@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+from typing import Iterator
+
+import numpy as np
+
 from ..core.constraints import BOUND_SETS
+from . import causes as C
 from .result import ReferencePlan
 
 
@@ -38,12 +43,27 @@ def to_json_dict(plan: ReferencePlan) -> dict:
         for r in plan.report.violations(BOUND_SETS[plan.bound_set]):
             viol.append({"constraint": r.constraint, "axis": r.axis, "ratio": _num(r.ratio),
                          "s": _num(r.s), "block": int(r.block)})
-    blocks = [{"block": int(b.block), "line": max(1, int(b.line)), "label": b.label,
-               "kind": b.kind, "length_mm": max(0.0, _num(b.length_mm)),
-               "t_reference_s": max(0.0, _num(b.time_s)),
-               "v_exit_reference": max(0.0, _num(b.v_exit)),
-               "limit_reference": b.cause, "hold_s": b.hold_s,
-               "hold_cause": plan.holds.cause_of(int(b.block))} for b in plan.blocks]
+    blocks = list(iter_json_rows(plan))
     return {"program": plan.program, "machine": plan.machine, "bounds": plan.bound_set,
             "reference": {"time_s": _num(plan.time_s), "violations": viol},
             "blocks": blocks}
+
+
+def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
+    """The ``blocks`` rows of :func:`to_json_dict`, one dict at a time (a table printed
+    from them never holds all 10^6 of them at once)."""
+    # Built from the table's columns: 10^6 blocks would cost 10^6 row objects otherwise.
+    tab = plan.blocks
+    cols_names = ("block", "line", "label", "kind", "length_mm", "time_s", "v_exit",
+                  "cause_code", "hold_s")
+    cols = [tab.column(name) for name in cols_names]
+    cols = [c.tolist() if isinstance(c, np.ndarray) else c for c in cols]
+    for i in (4, 5, 6, 8):                      # plain floats, as the contract says
+        cols[i] = np.asarray(tab.column(cols_names[i]), dtype=np.float64).tolist()
+    cols[7] = [C.CAUSES[k] if k >= 0 else "" for k in cols[7]]
+    hold_cause = plan.holds.causes_by_block()
+    for b, ln, lab, kind, length, t, v, cause, hold in zip(*cols):
+        yield {"block": b, "line": max(1, ln), "label": lab, "kind": kind,
+               "length_mm": max(0.0, length), "t_reference_s": max(0.0, t),
+               "v_exit_reference": max(0.0, v), "limit_reference": cause, "hold_s": hold,
+               "hold_cause": hold_cause.get(b, "")}

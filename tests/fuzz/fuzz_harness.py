@@ -76,11 +76,6 @@ KNOWN_BUG_SIGNATURES: dict[str, tuple[str, str]] = {
         "('integrated velocity ... does not meet the next knot'), reported as exit 2 "
         "without file:line (an internal inconsistency presented as bad input)",
         r"integrated (velocity|position) \S+ mm(/s)? does not meet the next knot"),
-    "turn_allocation": (
-        "a helix with TURN=999999 (NGC P1000000) sizes an array by the turn count: "
-        "MemoryError 'Unable to allocate 21.5 GiB', exit 3 (issue 9 item 3, the resource "
-        "limits, fixed in the resource/scale work)",
-        r"internal error .*MemoryError: Unable to allocate"),
 }
 KNOWN_BUGS = {name: what for name, (what, _) in KNOWN_BUG_SIGNATURES.items()}
 

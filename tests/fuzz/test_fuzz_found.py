@@ -25,13 +25,12 @@ FOUND = [
         "slow_feed.mpf", "G1 X0 Y0 Z0 F0.001\nG1 X=1000000\n",
         marks=pytest.mark.xfail(strict=True, reason=KNOWN_BUGS["profile_precision"]),
         id="profile_precision"),
+    # found, then fixed (the size budget): kept as regression cases
     pytest.param(
         "turn.mpf", "G1 F1000 X0 Y0\nG2 X0 Y0 Z10 I5 J0 TURN=999999\nM30\n",
-        marks=pytest.mark.xfail(strict=True, reason=KNOWN_BUGS["turn_allocation"]),
         id="turn_allocation_sin"),
     pytest.param(
         "turn.ngc", "G1 F100 X0 Y0\nG2 X0 Y0 Z10 I5 J0 P1000000\nM2\n",
-        marks=pytest.mark.xfail(strict=True, reason=KNOWN_BUGS["turn_allocation"]),
         id="turn_allocation_ngc"),
 ]
 

@@ -191,7 +191,7 @@ def test_ngc_o_words_if_while_sub():
 
 
 def test_loop_guard():
-    with pytest.raises(NCSyntaxError, match=r"does not end within 1000000 executed lines"):
+    with pytest.raises(NCSyntaxError, match=r"does not end within 1000000 lines executed again"):
         sin("L1: G1 X1 F100\nGOTOB L1\n")
 
 
