@@ -29,7 +29,8 @@ from .core.errors import MachineDataError, PathError
 from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segments, line_segments
 from .core.limits import MachineLimits
 from .core.rules import is_tangential
-from .core.tolerances import ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, POS_TOL_MM
+from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_MOTION_S,
+                              POS_TOL_MM)
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 
@@ -322,7 +323,27 @@ def build_path(program: Program, machine: Machine) -> Path:
     MachineDataError
         The program moves an axis the machine has no limits for (names axis and line).
     """
-    return restrict_to_machine(prepare(program), machine.limits)
+    path = restrict_to_machine(prepare(program), machine.limits)
+    _check_motion_times(path)
+    return path
+
+
+def _check_motion_times(path: Path) -> None:
+    """Reject a block whose motion at its programmed feed lasts beyond
+    :data:`~reference.core.tolerances.MAX_BLOCK_MOTION_S` (names file and line)."""
+    if path.n_segments == 0:
+        return
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_min = np.where(path.feed > 0, path.length / path.feed, 0.0)
+    t_blk = np.bincount(path.block, weights=t_min)
+    worst = int(np.argmax(t_blk))
+    if t_blk[worst] > MAX_BLOCK_MOTION_S:
+        span = next(b for b in path.blocks if b.block == worst)
+        raise PathError(f"{path.source}:{span.line}: the block moves "
+                        f"{span.length:.6g} mm at F{60.0 * path.feed[path.block == worst][0]:g} "
+                        f"mm/min, at least {t_blk[worst]:.3g} s of motion, above the "
+                        f"{MAX_BLOCK_MOTION_S:.0e} s one block may take (float64 time "
+                        f"resolution); raise the feed or split the block", worst)
 
 
 __all__ = ["build_path", "prepare", "require_axes", "restrict_to_machine",

@@ -20,8 +20,10 @@ from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.prepare import prepare
 
-HELIX_SIN = "G17 G90 G1 F1000 X0 Y0 Z0\nG2 X0 Y0 Z10 I5 J0 TURN={n}\nM30\n"
-HELIX_NGC = "G17 G90 G1 F1000 X0 Y0 Z0\nG2 X0 Y0 Z10 I5 J0 P{n}\nM30\n"
+# F100000: fast enough that 1e6 turns (3.1e7 mm) move in 1.9e4 s, inside the motion
+# time one block may take (MAX_BLOCK_MOTION_S): the grid budget is what these test
+HELIX_SIN = "G17 G90 G1 F100000 X0 Y0 Z0\nG2 X0 Y0 Z10 I5 J0 TURN={n}\nM30\n"
+HELIX_NGC = "G17 G90 G1 F100000 X0 Y0 Z0\nG2 X0 Y0 Z10 I5 J0 P{n}\nM30\n"
 
 
 @pytest.mark.parametrize("name, text, word", [

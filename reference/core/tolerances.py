@@ -66,3 +66,11 @@ CURVATURE_JUMP_TOL_PER_MM = 1e-12
 #: segment (1; deg/mm for rotary axes): a 1e-9 component at 1 m/s moves the axis by
 #: 4 pm per IPO cycle.
 MOVING_AXIS_TOL = 1e-9
+
+#: Longest time one block's motion may take at its programmed feed, s (length / F).
+#: 1e6 s (11.6 days) is no machining move, and keeps profile knot times at magnitudes
+#: where float64 resolves the shortest phases the planners build: at 1e6 s the time
+#: resolution is 2e-10 s, while a block of 1e10 s (F0.001 mm/min over 1000 m) has
+#: 2e-6 s, longer than its own braking phase, and its profile no longer integrates.
+#: Same bound as the longest dwell (reference.nc.state.MAX_DWELL_S).
+MAX_BLOCK_MOTION_S = 1e6

@@ -87,3 +87,21 @@ def test_tangent_tolerance_decides_a_g61_corner(factor, stops):
             f"Y{100 * np.sin(th):.12f}\n")
     p = prepare(parse_text(text, "t.ngc", "ngc"))
     assert bool(p.stop[1]) is stops
+
+
+@pytest.mark.parametrize("factor, ok", [(0.5, True), (1.5, False)])
+def test_block_motion_time_bound_at_half_and_one_and_a_half(factor, ok):
+    """A block moving MAX_BLOCK_MOTION_S * factor at its feed: kept at 0.5x, an error at
+    its line at 1.5x (F6 mm/min = 0.1 mm/s, so the length is 0.1 mm/s times the time)."""
+    from reference.core.errors import PathError
+    from reference.core.tolerances import MAX_BLOCK_MOTION_S
+    from reference.machine import load_machine
+    from reference.nc import parse_text
+    from reference.prepare import build_path
+    length = 0.1 * factor * MAX_BLOCK_MOTION_S
+    prog = parse_text(f"G90 G1 X0 Y0 F6\nX{length:.6f}\nM30\n", "slow.mpf")
+    if ok:
+        assert build_path(prog, load_machine()).n_segments == 1
+    else:
+        with pytest.raises(PathError, match=r"slow.mpf:2: .* above the 1e\+06 s"):
+            build_path(prog, load_machine())

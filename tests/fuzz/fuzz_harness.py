@@ -70,12 +70,6 @@ _NO_MOTION = ": the program has no motion ("
 #: expression its stderr matches). Each has a strict-xfail case in ``test_fuzz_found.py``;
 #: the generated tests record a match as a known bug and look on (:func:`known_bug`).
 KNOWN_BUG_SIGNATURES: dict[str, tuple[str, str]] = {
-    "profile_precision": (
-        "a block of ~1e10 s (F0.001 over 1000 m) loses the planner's short braking phases "
-        "to float64 rounding of the knot times: Profile's own check raises ProfileError "
-        "('integrated velocity ... does not meet the next knot'), reported as exit 2 "
-        "without file:line (an internal inconsistency presented as bad input)",
-        r"integrated (velocity|position) \S+ mm(/s)? does not meet the next knot"),
 }
 KNOWN_BUGS = {name: what for name, (what, _) in KNOWN_BUG_SIGNATURES.items()}
 

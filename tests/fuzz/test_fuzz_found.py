@@ -21,9 +21,9 @@ from fuzz_harness import KNOWN_BUGS, assert_clean, run_cli
 pytestmark = pytest.mark.fuzz
 
 FOUND = [
+    # found, then fixed (a block's motion time is bounded, MAX_BLOCK_MOTION_S)
     pytest.param(
         "slow_feed.mpf", "G1 X0 Y0 Z0 F0.001\nG1 X=1000000\n",
-        marks=pytest.mark.xfail(strict=True, reason=KNOWN_BUGS["profile_precision"]),
         id="profile_precision"),
     # found, then fixed (the size budget): kept as regression cases
     pytest.param(
