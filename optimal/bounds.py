@@ -13,13 +13,17 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    ``D/2 sup|q''_j|``) and, on arcs, the two-axis elimination
    ``|q'_l q''_j - q'_j q''_l| b <= |q'_l| A_j + |q'_j| A_i`` (``a`` eliminated; the
    coefficient is bounded below via ``sup|q'''|``). Then ``|a| <= (A_j + sup|q''_j| Bbar)
-   / inf|q'_j|`` for every axis ``j``, so ``|b'| <= M_k`` (twice the best such bound).
+   / inf|q'_j|`` for every axis ``j``, so ``|b'| <= M_k`` (twice the best such bound);
+   on lines, arcs and helices also ``|b'| <= 2 sum_j sup|q'_j| A_j / |q'|^2``, free of
+   ``b`` (``q' . q'' = 0`` there; proof in :mod:`optimal.arc_bounds`), and ``M_k`` is the
+   smaller of the two.
 2. *Interval-exact rows.* Integrating ``q'_j a + q''_j b`` over ``I_k`` by parts
    (``a = b'/2``) gives exactly
    ``[q'_j b]_{s_k}^{s_{k+1}} / 2 + int q''_j b / 2 ds``, and its average is at most
    ``A_j`` (and at least ``-A_j``). Writing ``b = b_lin + e`` with ``b_lin`` the chord
-   through the end values, ``|e(s)| <= 2 M t (D - t) / D`` (Lipschitz), so
-   ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 6 =: E_jk``. Hence the end values satisfy the
+   through the end values, ``int |e| <= M D^2 / 4`` (tents of slope ``M`` on each
+   one-signed part of ``e``, :mod:`optimal.arc_bounds`), so
+   ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 8 =: E_jk``. Hence the end values satisfy the
    linear rows ``sigma ([q'_j b]/2 + w0 b_k + w1 b_{k+1}) <= A_j D + E_jk`` with
    ``w0, w1 = int q''_j (1 - t/D) / 2, int q''_j (t/D) / 2`` (closed form on helices).
    On spiral arcs (curvature varying along the arc) ``sup|q''_j|`` and ``sup|q'''_j|``
@@ -66,6 +70,7 @@ from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
 
+from .arc_bounds import REMAINDER_DIVISOR, slope_peak, tangential_slope_bound
 from .backends.fast import sweep
 from .grid import Grid
 from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
@@ -119,6 +124,7 @@ class _IntervalData:
     node_mvc: np.ndarray      # (N + 1,) static maximum-velocity curve at the nodes
     axes_used: np.ndarray     # indices of moving axes
     ierr: np.ndarray          # (N, n) round-off bound of |I0| + |I1| (spirals; else 0)
+    slope_tan: np.ndarray     # (N,) b-free bound of |b'| (optimal.arc_bounds; inf spirals)
 
 
 def _pair_mvc(dq: np.ndarray, ddq: np.ndarray, a_max: np.ndarray) -> np.ndarray:
@@ -203,8 +209,9 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
     ierr = np.zeros((N, n))
     if spi.size:
         I0[spi], I1[spi], ierr[spi] = _spiral_weights(path, grid, spi, dq0[spi], dq1[spi])
+    slope_tan = tangential_slope_bound(path, lim, seg, dqm, hi)
     return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
-                         moving_axes(dq0, ddq0, dq1, ddq1), ierr)
+                         moving_axes(dq0, ddq0, dq1, ddq1), ierr, slope_tan)
 
 
 def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
@@ -231,13 +238,14 @@ def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
 
 
 def _slope_bound(geo: _IntervalData, lim: AxisArrays, B: np.ndarray) -> np.ndarray:
-    """``M = min_j 2 (A_j + sup|q''_j| B) / inf|q'_j|``: bound of ``|b'|`` where b <= B."""
+    """``M = min_j 2 (A_j + sup|q''_j| B) / inf|q'_j|``: bound of ``|b'|`` where b <= B,
+    or the b-free tangential bound where smaller."""
     lo = geo.lo
     with np.errstate(divide="ignore", invalid="ignore"):
         curv = np.where(geo.k2 > 0, geo.k2 * B[:, None], 0.0)      # 0 * inf -> 0
         acap = np.where(lo > 0, (lim.a_max[None, :] + curv) / np.where(lo > 0, lo, 1.0),
                         np.inf)
-    return 2.0 * acap.min(axis=1)
+    return np.minimum(2.0 * acap.min(axis=1), geo.slope_tan)
 
 
 def _gronwall_peak(geo: _IntervalData, lim: AxisArrays, b_node: np.ndarray) -> np.ndarray:
@@ -276,7 +284,8 @@ def _gronwall_peak(geo: _IntervalData, lim: AxisArrays, b_node: np.ndarray) -> n
         f = x0 + (x0 + c) * np.expm1(bt * tp)
         g = x1 + (x1 + c) * np.expm1(bt * (d - tp))
         out[ex] = np.minimum(f, g)
-    return out
+    # the b-free tangential slope bound gives a plain tent (optimal.arc_bounds)
+    return np.minimum(out, slope_peak(b0, b1, geo.slope_tan, D))
 
 
 def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData,
@@ -294,7 +303,7 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
     if b_node is not None:
         fin = np.isfinite(b_node)
         caps.add(np.flatnonzero(fin), np.maximum(b_node[fin], 0.0), CAP_BOUND)
-    margin = np.where(good, slope, 0.0) * ds * ds / 6.0
+    margin = np.where(good, slope, 0.0) * ds * ds / REMAINDER_DIVISOR
     E = np.where(good[:, None], geo.k2 * margin[:, None]
                  + geo.ierr * np.where(good, B, 0.0)[:, None], np.inf)
     cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
