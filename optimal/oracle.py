@@ -419,8 +419,14 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     elif status == SolveStatus.OPTIMAL:
         message = f"gap {gap:.4%} <= {tol:.4%} on {g.n_points} points"
     else:
-        message = (f"gap {gap:.4%} > {tol:.4%} after {it} rounds ({g.n_points} points, "
-                   f"max_grid {max_grid}); both bounds are valid")
+        if grid.n_intervals >= max_grid:
+            budget = f"grid budget max_grid = {max_grid} intervals reached"
+        elif it >= max_iterations:
+            budget = f"round budget max_iterations = {max_iterations} reached"
+        else:
+            budget = "no interval can be split further"
+        message = (f"gap {gap:.4%} > {tol:.4%}: {budget} after {it} rounds ({g.n_points} "
+                   f"points); bracket [{best_lb:.6g}, {ub:.6g}] s, both bounds are valid")
     if progress:
         progress("done", 1.0)
     return OptimalSolution(

@@ -1,0 +1,237 @@
+"""The arc ingredients of the lower bound (:mod:`optimal.arc_bounds`) and the certificate
+on arc hand cases, each against an independent reference.
+
+* the b-free tangential slope bound: the largest ``|a|`` of the point-wise axis
+  constraints, by an LP (scipy HiGHS) in ``(a, b)`` at sampled points, never exceeds
+  ``M_tan / 2``;
+* the remainder ``int |b - b_lin| <= M D^2 / 4``: random functions with ``|b'| <= M``;
+* hand cases (full circle, anisotropic axis limits, helices in G18 and G19, radii
+  0.01 mm .. 1000 mm): the oracle's lower bound is below the time of an independent
+  feasible motion (toppra on a fine grid, judged by the checker and time-scaled until
+  accepted), and the oracle's upper bound is within the tolerance of it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+import optimal
+from optimal.arc_bounds import tangential_slope_bound
+from optimal.bounds import _interval_data, verified_profile
+from optimal.grid import grid_from_counts, initial_grid
+from reference.core import AxisLimits, MachineLimits
+from reference.machine import load_machine
+from reference.nc import parse_text
+from reference.prepare import build_path
+
+
+def _limits(v, a, axes=("X", "Y", "Z")):
+    return MachineLimits(tuple(AxisLimits(n, float(vi), float(ai), 1e6, 1.2)
+                               for n, vi, ai in zip(axes, v, a)), 0.004)
+
+
+def _path(text):
+    return build_path(parse_text(text, "t.mpf"), load_machine(None))
+
+
+HELIX_G18 = "G90 G18 G1 X0 Y0 Z10 F6000\nG3 X0 Y7 Z10 I0 K-10 TURN=1\nM30\n"
+HELIX_G19 = "G90 G19 G1 X0 Y10 Z0 F6000\nG2 X-5 Y-10 Z0 J-10 K0\nM30\n"
+
+
+@pytest.mark.parametrize("text,lim", [
+    ("G90 G17 G1 X10 Y0 F9000\nG3 X10 Y0 I-10 J0\nM30\n", ((500,) * 3, (2000,) * 3)),
+    ("G90 G17 G1 X10 Y0 F9000\nG2 X0 Y-10 I-10 J0\nM30\n", ((500, 80, 500), (3000, 300, 1000))),
+    (HELIX_G18, ((500, 400, 300), (2000, 1500, 500))),
+    (HELIX_G19, ((300, 400, 500), (800, 2500, 1500))),
+])
+def test_tangential_slope_bound_dominates_every_pointwise_acceleration(text, lim):
+    path = _path(text)
+    la = _limits(*lim).for_axes(path.axes)
+    grid = initial_grid(path, 30)
+    geo = _interval_data(path, la, grid)
+    rng = np.random.default_rng(0)
+    arc = np.flatnonzero(path.radius[grid.segment] > 0)
+    assert arc.size
+    for k in rng.choice(arc, 12):
+        s = rng.uniform(grid.s[k], grid.s[k + 1])
+        _, dq, ddq, _ = path.evaluate(np.array([s]), segment=grid.segment[k:k + 1])
+        # max |a| s.t. -A_j <= q'_j a + q''_j b <= A_j, b >= 0 (independent LP)
+        A_ub = np.r_[np.c_[dq[0], ddq[0]], -np.c_[dq[0], ddq[0]]]
+        b_ub = np.r_[la.a_max, la.a_max]
+        best = 0.0
+        for sign in (1.0, -1.0):
+            r = linprog([-sign, 0.0], A_ub=A_ub, b_ub=b_ub,
+                        bounds=[(None, None), (0, None)], method="highs")
+            assert r.status == 0
+            best = max(best, abs(r.x[0]))
+        assert 2 * best <= geo.slope_tan[k] * (1 + 1e-12)
+
+
+def test_tangential_slope_bound_is_infinite_on_spirals():
+    from reference.core import path_from_pieces
+    from reference.core.geometry import arc_segment
+
+    arc = arc_segment(np.array([2.0, 0, 0]), np.array([0, 2.5, 0]), np.zeros(3), (0, 1),
+                      False, 0, np.ones(3, bool), 0, np.inf)
+    path = path_from_pieces(("X", "Y", "Z"), [arc], feed=100.0)
+    assert path.dradius[0] != 0
+    grid = initial_grid(path, 10)
+    _, dqm, _, _ = path.evaluate(0.5 * (grid.s[:-1] + grid.s[1:]), segment=grid.segment)
+    out = tangential_slope_bound(path, _limits((1e3,) * 3, (1e3,) * 3).for_axes(path.axes),
+                                 grid.segment, dqm, np.abs(dqm))
+    assert np.all(np.isinf(out))
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_chord_remainder_is_at_most_m_d2_over_4(seed):
+    rng = np.random.default_rng(seed)
+    D, M = rng.uniform(0.1, 5.0), rng.uniform(0.5, 20.0)
+    t = np.linspace(0.0, D, 20001)
+    # piecewise-linear b with |b'| <= M: random slopes, some at the limit
+    knots = np.sort(rng.uniform(0, D, rng.integers(1, 6)))
+    slopes = M * rng.uniform(-1.0, 1.0, knots.size + 1)
+    at_limit = rng.random(slopes.size) < 0.5
+    slopes[at_limit] = M * np.where(rng.random(int(at_limit.sum())) < 0.5, -1.0, 1.0)
+    piece = np.searchsorted(knots, t)
+    db = slopes[piece]
+    b = np.concatenate(([0.0], np.cumsum(0.5 * (db[1:] + db[:-1]) * np.diff(t))))
+    e = b - (b[0] + (b[-1] - b[0]) * t / D)
+    assert np.trapezoid(np.abs(e), t) <= M * D * D / 4 * (1 + 1e-6)
+
+
+def test_chord_remainder_bound_is_attained_by_a_tent():
+    D, M = 2.0, 3.0
+    t = np.linspace(0.0, D, 200001)
+    b = np.minimum(M * t, M * (D - t))
+    assert np.trapezoid(b, t) == pytest.approx(M * D * D / 4, rel=1e-8)
+
+
+# ---------------------------------------------------------------- hand cases vs toppra
+class _FeedPath:
+    """Path plus a virtual axis q = s whose velocity limit is the feed (toppra)."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def __call__(self, s, order=0):
+        scalar = np.ndim(s) == 0
+        ss = np.atleast_1d(np.asarray(s, float))
+        extra = ss if order == 0 else (np.ones_like(ss) if order == 1 else np.zeros_like(ss))
+        out = np.c_[self.path.evaluate(ss)[order], extra]
+        return out[0] if scalar else out
+
+    @property
+    def dof(self):
+        return self.path.n_axes + 1
+
+    @property
+    def path_interval(self):
+        return np.array([0.0, self.path.total_length])
+
+
+def _toppra_feasible_time(path, limits, per_arc=4000):
+    """Duration of toppra's fine-grid profile after the checker's time scaling: the time
+    of a motion that satisfies every constraint, hence >= the true optimum."""
+    toppra = pytest.importorskip("toppra")
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    toppra.setup_logging("WARNING")
+    la = limits.for_axes(path.axes)
+    feed = float(np.min(path.feed))
+    v = np.r_[la.v_max, feed]
+    a = np.r_[la.a_max, 1e30]
+    counts = np.where(path.radius > 0, per_arc, 200)
+    grid = grid_from_counts(path, counts)
+    inst = algo.TOPPRA([constraint.JointVelocityConstraint(np.c_[-v, v]),
+                        constraint.JointAccelerationConstraint(
+                            np.c_[-a, a],
+                            discretization_scheme=constraint.DiscretizationType.Interpolation)],
+                       _FeedPath(path), gridpoints=grid.s, solver_wrapper="seidel")
+    _, sd, _ = inst.compute_parameterization(0, 0)
+    assert sd is not None
+    prof, lam, _ = verified_profile(path, limits, grid.s, np.maximum(sd, 0.0) ** 2,
+                                    path.block[grid.segment])
+    return prof.duration, lam
+
+
+def _arc_path(start, end, center, plane, *, turns=0, clockwise=False, feed=200.0,
+              lead=0.0):
+    """One arc (helix) built directly, optionally preceded by a tangent line of length
+    ``lead``: rest only at the path ends, which toppra handles exactly."""
+    from reference.core import path_from_pieces
+    from reference.core.geometry import arc_segment, line_segments
+
+    geo = np.ones(3, bool)
+    arc = arc_segment(np.asarray(start, float), np.asarray(end, float),
+                      np.asarray(center, float), plane, clockwise, turns, geo, 1, 1e-9)
+    pieces = [arc]
+    if lead > 0:
+        p = path_from_pieces(("X", "Y", "Z"), [arc])
+        t0 = p.evaluate(np.array([0.0]))[1][0]
+        s0 = np.asarray(start, float) - lead * t0 / np.linalg.norm(t0)
+        pieces = [line_segments(s0[None], np.asarray(start, float)[None], geo,
+                                np.array([0])), arc]
+    return path_from_pieces(("X", "Y", "Z"), pieces, feed=feed)
+
+
+HAND_CASES = {
+    # full circle R 10 mm after a tangent 20 mm lead-in, isotropic limits
+    "full circle R10": (lambda: _arc_path([10, 0, 0], [10, 0, 0], [0, 0, 0], (0, 1),
+                                          turns=0, feed=200.0, lead=20.0),
+                        ((500,) * 3, (2000,) * 3)),
+    "anisotropic circle R10": (lambda: _arc_path([10, 0, 0], [10, 0, 0], [0, 0, 0], (0, 1),
+                                                 clockwise=True, feed=200.0, lead=20.0),
+                               ((500, 60, 500), (3000, 250, 800))),
+    # G18 (Z -> X) helix along Y, one and a half turns
+    "helix G18": (lambda: _arc_path([0, 0, 10], [0, 12, -10], [0, 0, 0], (2, 0), turns=1,
+                                    feed=150.0),
+                  ((500, 400, 300), (2000, 1500, 500))),
+    # G19 (Y -> Z) helix along X, clockwise
+    "helix G19": (lambda: _arc_path([0, 10, 0], [-5, 0, -10], [0, 0, 0], (1, 2),
+                                    clockwise=True, feed=150.0),
+                  ((300, 400, 500), (800, 2500, 1500))),
+    "arc R0.01": (lambda: _arc_path([0.01, 0, 0], [-0.01, 0, 0], [0, 0, 0], (0, 1),
+                                    feed=100.0, lead=0.05),
+                  ((500,) * 3, (2000,) * 3)),
+    "arc R1": (lambda: _arc_path([1, 0, 0], [0, -1, 0], [0, 0, 0], (0, 1), feed=100.0,
+                                 lead=2.0),
+               ((500, 300, 500), (2000, 700, 2000))),
+    "arc R1000": (lambda: _arc_path([1000, 0, 0], [0, 1000, 0], [0, 0, 0], (0, 1),
+                                    feed=500.0, lead=100.0),
+                  ((500, 400, 500), (2000, 900, 2000))),
+}
+
+
+@pytest.mark.parametrize("name", list(HAND_CASES))
+def test_arc_hand_cases_bracket_an_independent_feasible_motion(name):
+    build, lim = HAND_CASES[name]
+    path = build()
+    limits = _limits(*lim, axes=path.axes)
+    sol = optimal.solve(path, limits)
+    assert sol.status == optimal.SolveStatus.OPTIMAL
+    t_feas, lam = _toppra_feasible_time(path, limits)
+    assert lam < 1.01                                # the fine toppra grid is nearly exact
+    # the exact optimum is <= t_feas: a certified lower bound must be below it
+    assert sol.lower_bound_s <= t_feas
+    # and the oracle's verified motion is no worse than the tolerance above it
+    assert sol.upper_bound_s <= t_feas * (1 + 2e-3)
+
+
+@pytest.mark.parametrize("name", list(HAND_CASES))
+def test_arc_lower_bound_holds_on_coarse_grids(name):
+    """Coarse grids (2 .. 128 intervals, down to one interval per half turn) are where the
+    remainder terms are largest: the relaxation alone must stay below the feasible time."""
+    from optimal.bounds import lower_bound
+
+    build, lim = HAND_CASES[name]
+    path = build()
+    limits = _limits(*lim, axes=path.axes)
+    t_feas, _ = _toppra_feasible_time(path, limits)
+    la = limits.for_axes(path.axes)
+    for n in (2, 8, 32, 128):
+        g = initial_grid(path, n, min_arc_intervals=2, max_arc_step_rad=np.pi)
+        lb = lower_bound(path, la, g)[0]
+        assert 0 < lb <= t_feas
