@@ -105,3 +105,148 @@ def slope_peak(b0: np.ndarray, b1: np.ndarray, slope: np.ndarray, D: np.ndarray
     tp = np.clip((b1 - b0 + M * D) / (2 * M), 0.0, D)
     peak = np.minimum(b0 + M * tp, b1 + M * (D - tp))
     return np.where(good, peak, np.where(slope == 0, np.maximum(b0, b1), np.inf))
+
+
+# --------------------------------------------------------------------------- envelopes
+def _one_axis_rates(A: np.ndarray, c_lo: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Root ``r = A / c_lo`` and the rates ``2 c_lo / lo`` (below it) and
+    ``2 c_lo / hi`` (above it) of ``F(b)`` (docstring of :func:`envelope_times`);
+    ``usable`` where ``c_lo > 0`` and ``lo > 0``. Shapes ``(N, n)``."""
+    usable = (c_lo > 0) & (lo > 0) & np.isfinite(A)
+    c = np.where(usable, c_lo, 1.0)
+    r = np.where(usable, A / c, np.inf)
+    beta_lo = np.where(usable, 2 * c / np.where(usable, lo, 1.0), 0.0)
+    beta_hi = np.where(usable, 2 * c / np.where(usable, hi, 1.0), 0.0)
+    return usable, r, beta_lo, beta_hi
+
+
+def _relax(b0, r, beta_lo, beta_hi, t):
+    """``y(t)`` of ``y' = F(y)``, ``y(0) = b0``: ``r - (r - b0) e^{-beta t}`` with
+    ``beta = beta_lo`` below the root and ``beta_hi`` above it."""
+    beta = np.where(b0 <= r, beta_lo, beta_hi)
+    return b0 + (r - b0) * (-np.expm1(-beta * t)), beta
+
+
+def _time_under(b0, r, beta_lo, beta_hi, B, t1):
+    """``int_0^t1 dt / sqrt(min(y(t), B))`` for the relaxation ``y`` of :func:`_relax`
+    (``0 < b0 <= B``, ``r`` finite, ``beta > 0``), closed form.
+
+    With ``w = sqrt(y / r)``: ``d/dt [t + (2 / beta) ln(1 + w)] = 1 / w`` on both sides of
+    the root, so ``int dt / sqrt(y) = [t + (2 / beta) ln(1 + w)] / sqrt(r)``. Below the
+    root ``y`` rises and may reach ``B`` at ``t_B = ln((r - b0) / (r - B)) / beta``; the
+    rest of the way ``min(y, B) = B``.
+    """
+    beta = np.where(b0 <= r, beta_lo, beta_hi)
+    rising = (b0 < r) & (B < r)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tB = np.where(rising, np.log((r - b0) / np.where(rising, r - B, 1.0)) / beta, np.inf)
+    te = np.minimum(t1, np.maximum(tB, 0.0))
+    y1, _ = _relax(b0, r, beta_lo, beta_hi, te)
+    sy0, sy1 = np.sqrt(b0), np.sqrt(y1)
+    sr = np.sqrt(r)
+    # ln((1 + w1) / (1 + w0)) without cancellation: w1 - w0 = (y1 - y0) / (sr (sy1 + sy0))
+    dw = (y1 - b0) / (sr * (sy1 + sy0))
+    part = (te + (2.0 / beta) * np.log1p(dw / (1.0 + sy0 / sr))) / sr
+    return part + np.maximum(t1 - te, 0.0) / np.sqrt(B)
+
+
+def envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
+                   A: np.ndarray, dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
+                   hi: np.ndarray, k3: np.ndarray, iterations: int = 40) -> np.ndarray:
+    """Lower estimate of the time on every interval from one-axis comparison envelopes.
+
+    Why it is one
+    -------------
+    Take an axis ``j`` whose tangent keeps its sign ``sigma`` on ``I_k`` (``inf|q'_j| =
+    lo_j > 0``) and let ``c_j(s) = sigma q''_j(s)``, so ``c_j >= c_lo := sigma
+    q''_j(mid) - (D / 2) sup|q'''_j|`` on ``I_k``. The row ``|q'_j a + q''_j b| <= A_j``
+    gives, for every feasible motion (``b >= 0``),
+
+    * forward: ``|q'_j| a <= A_j - c_j b <= A_j - c_lo b``, hence
+      ``b' = 2a <= F(b) := 2 (A_j - c_lo b) / lo_j`` where that is ``>= 0`` and
+      ``2 (A_j - c_lo b) / hi_j`` where it is negative (a negative numerator over the
+      largest ``|q'_j|``);
+    * backward: ``-|q'_j| a <= A_j + c_j b``, the same with ``c_j`` replaced by
+      ``-c_j`` (``-b'`` bounded, ``s`` run backwards from ``s_{k+1}``).
+
+    With ``c_lo > 0``, ``F`` is decreasing and Lipschitz, so by the comparison lemma
+    ``b(s_k + t) <= y_f(t)``, the solution of ``y' = F(y)``, ``y(0) = b_k``, which relaxes
+    exponentially towards the root ``r = A_j / c_lo`` (:func:`_relax`); likewise
+    ``b(s_{k+1} - t) <= y_b(t)`` from the end value. ``b_k, b_{k+1}`` are upper bounds of
+    ``b`` at the nodes (the relaxation's optimum): the comparison lemma (``b`` absolutely
+    continuous, ``b' <= F(b)`` almost everywhere, ``F`` Lipschitz, ``b <= y`` at the
+    start) needs no more. Also ``b <= B`` on ``I_k``. For *any* split
+    ``t*`` in ``[0, D]``, ``1 / sqrt(b) >= 1 / sqrt(min(y_f, B))`` on ``[0, t*]`` and
+    ``>= 1 / sqrt(min(y_b, B))`` on ``[t*, D]``, so the time on ``I_k`` is at least the
+    sum of the two closed-form integrals (:func:`_time_under`). ``t*`` is the crossing of
+    ``y_f`` and ``y_b`` by bisection (only its accuracy, not the validity, depends on
+    it). The axis of each side is the one whose envelope is lowest at the mid-point.
+
+    Intervals where no axis qualifies on a side (lines, a tangent component changing
+    sign, ``c_lo <= 0``) get 0 here (the tent of :func:`optimal.bounds.tent_times`
+    remains); the caller takes the larger of the two valid estimates.
+
+    Parameters
+    ----------
+    D : numpy.ndarray, shape (N,)
+        Interval lengths, mm.
+    b0, b1 : numpy.ndarray, shape (N,)
+        Upper bounds of ``b`` at the interval ends, mm^2/s^2.
+    B : numpy.ndarray, shape (N,)
+        Upper bound of ``b`` on each interval, mm^2/s^2.
+    A : numpy.ndarray, shape (n,)
+        Axis acceleration limits, mm/s^2.
+    dq_mid, ddq_mid : numpy.ndarray, shape (N, n)
+        ``q'`` and ``q''`` at the interval mid-points.
+    lo, hi : numpy.ndarray, shape (N, n)
+        Lower and upper bounds of ``|q'_j|`` on the intervals.
+    k3 : numpy.ndarray, shape (N, n)
+        Upper bound of ``|q'''_j|`` on the intervals' segments, 1/mm^2.
+    iterations : int
+        Bisection steps for the split.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Seconds (0 where not applicable).
+    """
+    N = D.size
+    out = np.zeros(N)
+    if N == 0:
+        return out
+    sig = np.sign(dq_mid)
+    half = 0.5 * D[:, None]
+    Ab = np.broadcast_to(A[None, :], dq_mid.shape)
+    fwd = _one_axis_rates(Ab, sig * ddq_mid - half * k3, lo, hi)
+    bwd = _one_axis_rates(Ab, -sig * ddq_mid - half * k3, lo, hi)
+    Bc = np.where(np.isfinite(B), B, np.inf)
+    x0 = np.minimum(np.maximum(b0, 0.0), Bc)
+    x1 = np.minimum(np.maximum(b1, 0.0), Bc)
+
+    def pick(rates, x):
+        usable, r, bl, bh = rates
+        y, _ = _relax(x[:, None], np.where(usable, r, x[:, None]), bl, bh, half)
+        y = np.where(usable, y, np.inf)
+        j = np.argmin(y, axis=1)
+        ar = np.arange(N)
+        return usable[ar, j], r[ar, j], bl[ar, j], bh[ar, j]
+
+    uf, rf, blf, bhf = pick(fwd, x0)
+    ub, rb, blb, bhb = pick(bwd, x1)
+    ok = uf & ub & np.isfinite(Bc) & (x0 > 0) & (x1 > 0) & (Bc > 0)
+    if not np.any(ok):
+        return out
+    d, x0, x1, Bc = D[ok], x0[ok], x1[ok], Bc[ok]
+    rf, blf, bhf, rb, blb, bhb = rf[ok], blf[ok], bhf[ok], rb[ok], blb[ok], bhb[ok]
+    lo_t, hi_t = np.zeros(d.size), d.copy()
+    for _ in range(iterations):          # crossing of y_f(t) and y_b(D - t)
+        mid = 0.5 * (lo_t + hi_t)
+        yf, _ = _relax(x0, rf, blf, bhf, mid)
+        yb, _ = _relax(x1, rb, blb, bhb, d - mid)
+        left = yf < yb
+        lo_t = np.where(left, mid, lo_t)
+        hi_t = np.where(left, hi_t, mid)
+    ts = 0.5 * (lo_t + hi_t)
+    out[ok] = (_time_under(x0, rf, blf, bhf, Bc, ts)
+               + _time_under(x1, rb, blb, bhb, Bc, d - ts))
+    return out

@@ -40,7 +40,10 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    :mod:`optimal.backends.fast`) therefore dominates them: ``b(s_k) <= bhat_k``.
 4. *Time.* On ``I_k``, ``b(s) <= min(Bbar_k, bhat_k + M t, bhat_{k+1} + M (D - t))``
    (Lipschitz from both ends), so ``T >= sum_k int_0^D dt / sqrt(that tent)``, a closed
-   form. This is ``lower_bound_s`` (less ``LB_ROUNDOFF_REL`` for round-off), plus dwells.
+   form. On arcs the one-axis comparison envelopes of
+   :func:`optimal.arc_bounds.envelope_times` (exponential relaxation towards the axis'
+   static limit, from both ends) give another valid estimate; each interval takes the
+   larger. This is ``lower_bound_s`` (less ``LB_ROUNDOFF_REL`` for round-off), plus dwells.
 
 Every step only weakens constraints or over-estimates ``b``; the bound holds for every
 grid. Its looseness is O(D) on arcs and vanishes on lines (the tent is then exact
@@ -70,7 +73,8 @@ from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
 
-from .arc_bounds import REMAINDER_DIVISOR, slope_peak, tangential_slope_bound
+from .arc_bounds import (REMAINDER_DIVISOR, envelope_times, slope_peak,
+                         tangential_slope_bound)
 from .backends.fast import sweep
 from .grid import Grid
 from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
@@ -125,6 +129,10 @@ class _IntervalData:
     axes_used: np.ndarray     # indices of moving axes
     ierr: np.ndarray          # (N, n) round-off bound of |I0| + |I1| (spirals; else 0)
     slope_tan: np.ndarray     # (N,) b-free bound of |b'| (optimal.arc_bounds; inf spirals)
+    dq_mid: np.ndarray        # (N, n) q' at interval mid-points
+    ddq_mid: np.ndarray       # (N, n) q'' at interval mid-points
+    hi: np.ndarray            # (N, n) sup |q'_j| on the interval
+    k3: np.ndarray            # (N, n) sup |q'''_j| on the segment
 
 
 def _pair_mvc(dq: np.ndarray, ddq: np.ndarray, a_max: np.ndarray) -> np.ndarray:
@@ -211,7 +219,8 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
         I0[spi], I1[spi], ierr[spi] = _spiral_weights(path, grid, spi, dq0[spi], dq1[spi])
     slope_tan = tangential_slope_bound(path, lim, seg, dqm, hi)
     return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
-                         moving_axes(dq0, ddq0, dq1, ddq1), ierr, slope_tan)
+                         moving_axes(dq0, ddq0, dq1, ddq1), ierr, slope_tan, dqm, ddqm,
+                         hi, k3)
 
 
 def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
@@ -437,6 +446,10 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
         rel = _relaxed_problem(path, lim, grid, geo, B, b_node)
         b_hat, _, _ = sweep(rel.problem)
         t = tent_times(grid.s, b_hat, rel.b_bar, rel.slope)
+        # arcs: one-axis comparison envelopes, valid too; keep the larger estimate
+        t = np.maximum(t, envelope_times(geo.ds, b_hat[:-1], b_hat[1:], rel.b_bar,
+                                         lim.a_max, geo.dq_mid, geo.ddq_mid, geo.lo,
+                                         geo.hi, geo.k3))
         T = float(t.sum())
         improved = best is None or T > best[0] * (1 + LB_ROUND_IMPROVEMENT)
         if best is None or T > best[0]:

@@ -235,3 +235,74 @@ def test_arc_lower_bound_holds_on_coarse_grids(name):
         g = initial_grid(path, n, min_arc_intervals=2, max_arc_step_rad=np.pi)
         lb = lower_bound(path, la, g)[0]
         assert 0 < lb <= t_feas
+
+
+# ---------------------------------------------------------------- comparison envelopes
+@pytest.mark.parametrize("b0,r,B", [(1.0, 4.0, 10.0), (1.0, 4.0, 2.5), (4.0, 4.0, 9.0),
+                                    (6.0, 4.0, 9.0), (1e-3, 50.0, 20.0)])
+def test_envelope_closed_forms_match_ode_and_quadrature(b0, r, B):
+    from scipy.integrate import quad, solve_ivp
+
+    from optimal.arc_bounds import _relax, _time_under
+
+    A, c, lo, hi, t1 = r * 0.7, 0.7, 0.4, 0.9, 1.3
+
+    def F(_, y):
+        num = A - c * y[0]
+        return [2 * num / (lo if num >= 0 else hi)]
+
+    bl, bh = 2 * c / lo, 2 * c / hi
+    sol = solve_ivp(F, (0, t1), [b0], rtol=1e-11, atol=1e-12, dense_output=True)
+    for t in np.linspace(0, t1, 7):
+        y, _ = _relax(np.array([b0]), np.array([r]), np.array([bl]), np.array([bh]),
+                      np.array([t]))
+        assert y[0] == pytest.approx(sol.sol(t)[0], rel=1e-8)
+    ref, _ = quad(lambda t: 1 / np.sqrt(min(sol.sol(t)[0], B)), 0, t1, epsabs=1e-13,
+                  limit=200)
+    got = _time_under(np.array([b0]), np.array([r]), np.array([bl]), np.array([bh]),
+                      np.array([B]), np.array([t1]))[0]
+    assert got == pytest.approx(ref, rel=1e-7)
+
+
+@pytest.mark.parametrize("name", list(HAND_CASES))
+def test_envelope_time_is_below_a_feasible_motion_on_every_interval(name):
+    """The per-interval estimate from the envelopes, started from the node values of a
+    feasible motion (toppra, checker-scaled), never exceeds that motion's time on the
+    interval: the comparison argument of the envelopes alone, interval by interval."""
+    from optimal.arc_bounds import envelope_times
+    from optimal.bounds import _interval_data
+
+    build, lim = HAND_CASES[name]
+    path = build()
+    limits = _limits(*lim, axes=path.axes)
+    la = limits.for_axes(path.axes)
+    fine_counts = np.where(path.radius > 0, 4000, 200)
+    fine = grid_from_counts(path, fine_counts)
+    toppra = pytest.importorskip("toppra")
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    toppra.setup_logging("WARNING")
+    v = np.r_[la.v_max, float(np.min(path.feed))]
+    a = np.r_[la.a_max, 1e30]
+    inst = algo.TOPPRA([constraint.JointVelocityConstraint(np.c_[-v, v]),
+                        constraint.JointAccelerationConstraint(
+                            np.c_[-a, a],
+                            discretization_scheme=constraint.DiscretizationType.Interpolation)],
+                       _FeedPath(path), gridpoints=fine.s, solver_wrapper="seidel")
+    _, sd, _ = inst.compute_parameterization(0, 0)
+    prof, lam, _ = verified_profile(path, limits, fine.s, np.maximum(sd, 0.0) ** 2,
+                                    path.block[fine.segment])
+    for per_arc in (8, 40, 200):
+        coarse = grid_from_counts(path, np.where(path.radius > 0, per_arc, 2))
+        assert np.all(np.isin(coarse.s, fine.s))
+        t_nodes = np.interp(coarse.s, prof.s, prof.t)
+        b_nodes = np.interp(coarse.s, prof.s, prof.v) ** 2
+        geo = _interval_data(path, la, coarse)
+        B = np.full(coarse.n_intervals, 1e30)
+        est = envelope_times(geo.ds, b_nodes[:-1], b_nodes[1:], B, la.a_max, geo.dq_mid,
+                             geo.ddq_mid, geo.lo, geo.hi, geo.k3)
+        actual = np.diff(t_nodes)
+        # at 8 per full turn (45 deg) no tangent keeps its sign with c_lo > 0
+        assert per_arc == 8 or np.mean(est > 0) > 0.3
+        assert np.all(est <= actual * (1 + 1e-9))
