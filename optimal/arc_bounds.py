@@ -250,3 +250,153 @@ def envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
     out[ok] = (_time_under(x0, rf, blf, bhf, Bc, ts)
                + _time_under(x1, rb, blb, bhb, Bc, d - ts))
     return out
+
+
+# --------------------------------------------------------------------------- rows
+def _phi_psi(kappa: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``Phi = int_0^tau e^{2 kappa t} dt`` and ``Psi = int_0^tau Phi(t) dt``, stable at
+    ``kappa -> 0`` (``tau`` and ``tau^2 / 2``)."""
+    x = 2.0 * kappa * tau
+    small = np.abs(x) < 1e-3
+    xs = np.where(small, 1.0, x)
+    with np.errstate(over="ignore", invalid="ignore"):
+        f1 = np.where(small, 1 + x * (0.5 + x * (1 / 6 + x / 24)), np.expm1(xs) / xs)
+        f2 = np.where(small, 0.5 + x * (1 / 6 + x * (1 / 24 + x / 120)),
+                      (np.expm1(xs) - xs) / (xs * xs))
+    return tau * f1, tau * tau * f2
+
+
+def _lower_rates(A: np.ndarray, c_lo: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """``g = 2 A / lo`` and ``kappa`` (``c_lo / hi`` if ``c_lo >= 0`` else ``c_lo / lo``)
+    of the affine bound ``(A - c(s) b) / |q'(s)| <= A / lo - kappa b`` (``b >= 0``);
+    ``usable`` where ``lo > 0``. Shapes ``(N, n)``."""
+    usable = (lo > 0) & np.isfinite(A)
+    los = np.where(usable, lo, 1.0)
+    his = np.where(usable, hi, 1.0)
+    kappa = np.where(c_lo >= 0, c_lo / his, c_lo / los)
+    return usable, np.where(usable, 2 * A / los, np.inf), np.where(usable, kappa, 0.0)
+
+
+def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
+                  dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                  k3: np.ndarray, slope: np.ndarray, j: int, c: np.ndarray,
+                  iterations: int = 30):
+    """Second-order form of the interval-exact row of axis ``j`` where ``c > 0``.
+
+    Why it is valid
+    ---------------
+    The row ``sigma int (q'_j a + q''_j b) <= A_j D`` reads exactly
+    ``sigma [q'_j b] / 2 + sigma (I0 b_k + I1 b_{k+1}) + sigma int q''_j e / 2 <= A_j D``
+    (:mod:`optimal.bounds`, ``e = b - b_lin``). With ``c = sigma q''_j(mid) > 0`` and
+    ``|sigma q''_j(s) - c| <= |s - mid| sup|q'''_j|``,
+    ``sigma int q''_j e >= c int e - sup|q'''_j| int |s - mid| |e| >= c int e
+    - sup|q'''_j| M D^3 / 16`` (``|e| <= 2 M t (D - t) / D``). And
+    ``int e = int b - D (b_k + b_{k+1}) / 2 >= int L - D (b_k + b_{k+1}) / 2`` for any
+    lower bound ``L`` of ``b`` on the interval. Lower envelopes, by the comparison lemma
+    from the *actual* end values: forward, ``b' = 2 a >= -2 (A_m - ct_m b) / |q'_m|``
+    (``ct_m = -sigma_m q''_m``, any axis ``m`` whose tangent keeps its sign
+    ``sigma_m``), which is ``>= -(g - 2 kappa b)`` with ``g = 2 A_m / inf|q'_m|`` and
+    ``kappa`` from the interval bounds (:func:`_lower_rates`); so
+    ``b(s_k + t) >= z_f(t) = b_k e^{2 kappa t} - g Phi(t)``. Backward from ``b_{k+1}``
+    the same with the acceleration side (``c_m = sigma_m q''_m``); or, for either side,
+    ``|b'| <= M`` (``kappa = 0``, ``g = M``). ``z`` is affine in its start value, so
+    with ``L = z_f`` on ``[0, t*]`` and ``z_b`` on ``[t*, D]`` for any split ``t*``,
+    ``int L = Phi_f(t*) b_k - g_f Psi_f(t*) + Phi_b(D - t*) b_{k+1} - g_b Psi_b(D - t*)``
+    and the row becomes linear in ``(b_k, b_{k+1})``:
+
+        ``old row + (c / 2) [(Phi_f - D/2) b_k + (Phi_b - D/2) b_{k+1}]
+        <= A_j D + (c / 2) (g_f Psi_f + g_b Psi_b) + sup|q'''_j| M D^3 / 32``.
+
+    Validity holds for every split and every choice of axes; the guide values (an
+    earlier relaxation's optimum) only choose them, so that the envelope from the side
+    where ``b`` moves at its capacity is used: then ``L`` follows ``b`` to ``O(D^2)``
+    and the row is tight to third order per interval (the old remainder
+    ``sup|q''_j| M D^2 / 8`` is second order).
+
+    Parameters
+    ----------
+    D : numpy.ndarray, shape (N,)
+        Interval lengths, mm.
+    guide0, guide1 : numpy.ndarray, shape (N,)
+        Guide values of ``b`` at the interval ends (any finite numbers), mm^2/s^2.
+    A : numpy.ndarray, shape (n,)
+        Axis acceleration limits, mm/s^2.
+    dq_mid, ddq_mid, lo, hi, k3 : numpy.ndarray, shape (N, n)
+        Mid-point ``q'`` and ``q''``, bounds of ``|q'_j|`` and ``sup|q'''_j|``.
+    slope : numpy.ndarray, shape (N,)
+        Bound ``M`` of ``|b'|`` on the intervals, mm/s^2.
+    j : int
+        Axis of the row.
+    c : numpy.ndarray, shape (N,)
+        ``sigma q''_j(mid)``; the row is formed where ``c > 0``.
+    iterations : int
+        Bisection steps for the split.
+
+    Returns
+    -------
+    ok : numpy.ndarray of bool, shape (N,)
+        Where the row is formed.
+    dc1, dc2 : numpy.ndarray, shape (N,)
+        Added to the coefficients of ``b_k`` and ``b_{k+1}`` (row divided by ``D``).
+    rhs : numpy.ndarray, shape (N,)
+        The right-hand side's addition ``((c/2)(g_f Psi_f + g_b Psi_b) +
+        sup|q'''_j| M D^3 / 32) / D`` (mm/s^2) where ``ok``.
+    """
+    N = D.size
+    sig = np.sign(dq_mid)
+    half = 0.5 * D[:, None]
+    Ab = np.broadcast_to(A[None, :], dq_mid.shape)
+    fin_m = np.isfinite(slope) & (slope > 0)
+    # candidates: every axis, plus |b'| <= M (last column)
+    uf, gf, kf = _lower_rates(Ab, -sig * ddq_mid - half * k3, lo, hi)
+    ub, gb, kb = _lower_rates(Ab, sig * ddq_mid - half * k3, lo, hi)
+    Mcol = np.where(fin_m, slope, np.inf)[:, None]
+    uf = np.c_[uf, fin_m]
+    ub = np.c_[ub, fin_m]
+    gf, gb = np.c_[gf, Mcol], np.c_[gb, Mcol]
+    kf, kb = np.c_[kf, np.zeros(N)], np.c_[kb, np.zeros(N)]
+    g0 = np.maximum(guide0, 0.0)[:, None]
+    g1 = np.maximum(guide1, 0.0)[:, None]
+
+    def best(usable, g, kappa, start):
+        ph, _ = _phi_psi(kappa, np.broadcast_to(half, kappa.shape))
+        e = np.exp(2 * kappa * half)
+        with np.errstate(over="ignore", invalid="ignore"):
+            z = start * e - np.where(usable, g, 0.0) * ph
+        z = np.where(usable & np.isfinite(z), z, -np.inf)
+        m = np.argmax(z, axis=1)
+        ar = np.arange(N)
+        return usable[ar, m], g[ar, m], kappa[ar, m]
+
+    okf, gf1, kf1 = best(uf, gf, kf, g0)
+    okb, gb1, kb1 = best(ub, gb, kb, g1)
+    ok = (c > 0) & okf & okb & fin_m & np.isfinite(gf1) & np.isfinite(gb1)
+    # the envelopes must stay finite over the whole interval (no overflow of e^{2 kappa D})
+    ok &= (np.abs(2 * kf1 * D) < 50.0) & (np.abs(2 * kb1 * D) < 50.0)
+    dc1 = np.zeros(N)
+    dc2 = np.zeros(N)
+    rhs = np.zeros(N)
+    if not np.any(ok):
+        return ok, dc1, dc2, rhs
+    d = D[ok]
+    x0, x1 = g0[ok, 0], g1[ok, 0]
+    gf1, kf1, gb1, kb1 = gf1[ok], kf1[ok], gb1[ok], kb1[ok]
+
+    def z(x, g, kappa, t):
+        ph, _ = _phi_psi(kappa, t)
+        return x * np.exp(2 * kappa * t) - g * ph
+
+    lo_t, hi_t = np.zeros(d.size), d.copy()
+    for _ in range(iterations):            # where z_f(t) meets z_b(D - t)
+        mid = 0.5 * (lo_t + hi_t)
+        above = z(x0, gf1, kf1, mid) > z(x1, gb1, kb1, d - mid)
+        lo_t = np.where(above, mid, lo_t)
+        hi_t = np.where(above, hi_t, mid)
+    ts = 0.5 * (lo_t + hi_t)
+    phf, psf = _phi_psi(kf1, ts)
+    phb, psb = _phi_psi(kb1, d - ts)
+    cc = c[ok]
+    dc1[ok] = 0.5 * cc * (phf - 0.5 * d) / d
+    dc2[ok] = 0.5 * cc * (phb - 0.5 * d) / d
+    rhs[ok] = (0.5 * cc * (gf1 * psf + gb1 * psb) + k3[ok, j] * slope[ok] * d ** 3 / 32) / d
+    return ok, dc1, dc2, rhs

@@ -73,7 +73,7 @@ from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
 
-from .arc_bounds import (REMAINDER_DIVISOR, envelope_times, slope_peak,
+from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, slope_peak,
                          tangential_slope_bound)
 from .backends.fast import sweep
 from .grid import Grid
@@ -298,7 +298,8 @@ def _gronwall_peak(geo: _IntervalData, lim: AxisArrays, b_node: np.ndarray) -> n
 
 
 def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData,
-                     B: np.ndarray, b_node: np.ndarray | None = None) -> Relaxation:
+                     B: np.ndarray, b_node: np.ndarray | None = None,
+                     guide: np.ndarray | None = None) -> Relaxation:
     N = geo.ds.size
     ds = geo.ds
     slope = _slope_bound(geo, lim, B)
@@ -332,6 +333,27 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
             cols_c1.append(np.where(both, 0.0, c1))
             cols_c2.append(np.where(both, 0.0, c2))
             cols_h.append(np.where(fin, hrow, 1.0))
+            row_axis.append(j)
+            if guide is None:
+                continue
+            # the same row in second-order form (optimal.arc_bounds.envelope_rows)
+            ok, dc1, dc2, rhs = envelope_rows(
+                ds, guide[:-1], guide[1:], lim.a_max, geo.dq_mid, geo.ddq_mid, geo.lo,
+                geo.hi, geo.k3, np.where(good, slope, np.inf), int(j),
+                sigma * geo.ddq_mid[:, j])
+            h2 = lim.a_max[j] + rhs + geo.ierr[:, j] * np.where(good, B, 0.0) / ds
+            ok &= fin & good & np.isfinite(h2)
+            if not np.any(ok):
+                continue
+            n1 = np.where(ok, c1 + dc1, 0.0)
+            n2 = np.where(ok, c2 + dc2, 0.0)
+            both = ok & (n1 > 0) & (n2 > 0)
+            if np.any(both):
+                caps.add(left[both], h2[both] / n1[both], CAP_BOUND)
+                caps.add(left[both] + 1, h2[both] / n2[both], CAP_BOUND)
+            cols_c1.append(np.where(both, 0.0, n1))
+            cols_c2.append(np.where(both, 0.0, n2))
+            cols_h.append(np.where(ok, h2, 1.0))
             row_axis.append(j)
     prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
     return Relaxation(prob, B, slope)
@@ -442,8 +464,9 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
     if b_node is not None:
         B = np.minimum(B, _gronwall_peak(geo, lim, b_node))
     best = None
+    guide = b_node if b_node is not None and np.all(np.isfinite(b_node)) else None
     for _ in range(max(rounds, 1)):
-        rel = _relaxed_problem(path, lim, grid, geo, B, b_node)
+        rel = _relaxed_problem(path, lim, grid, geo, B, b_node, guide)
         b_hat, _, _ = sweep(rel.problem)
         t = tent_times(grid.s, b_hat, rel.b_bar, rel.slope)
         # arcs: one-axis comparison envelopes, valid too; keep the larger estimate
@@ -457,6 +480,7 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
         if not improved:
             break
         B = np.minimum(B, _gronwall_peak(geo, lim, b_hat))
+        guide = b_hat
     T, t, rel, b_hat = best
     return T * (1.0 - LB_ROUNDOFF_REL), t, rel, b_hat
 

@@ -306,3 +306,70 @@ def test_envelope_time_is_below_a_feasible_motion_on_every_interval(name):
         # at 8 per full turn (45 deg) no tangent keeps its sign with c_lo > 0
         assert per_arc == 8 or np.mean(est > 0) > 0.3
         assert np.all(est <= actual * (1 + 1e-9))
+
+
+@pytest.mark.parametrize("kappa", [-40.0, -0.1, -1e-5, 0.0, 1e-5, 0.1, 3.0])
+def test_phi_psi_match_quadrature(kappa):
+    from scipy.integrate import quad
+
+    from optimal.arc_bounds import _phi_psi
+
+    tau = 0.37
+    phi = lambda t: quad(lambda u: np.exp(2 * kappa * u), 0, t, epsabs=1e-15)[0]  # noqa
+    ref_phi = phi(tau)
+    ref_psi = quad(phi, 0, tau, epsabs=1e-15)[0]
+    got_phi, got_psi = _phi_psi(np.array([kappa]), np.array([tau]))
+    assert got_phi[0] == pytest.approx(ref_phi, rel=1e-10)
+    assert got_psi[0] == pytest.approx(ref_psi, rel=1e-9)
+
+
+def _feasible_profile(path, limits):
+    toppra = pytest.importorskip("toppra")
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    toppra.setup_logging("WARNING")
+    la = limits.for_axes(path.axes)
+    fine = grid_from_counts(path, np.where(path.radius > 0, 4000, 200))
+    v = np.r_[la.v_max, float(np.min(path.feed))]
+    a = np.r_[la.a_max, 1e30]
+    inst = algo.TOPPRA([constraint.JointVelocityConstraint(np.c_[-v, v]),
+                        constraint.JointAccelerationConstraint(
+                            np.c_[-a, a],
+                            discretization_scheme=constraint.DiscretizationType.Interpolation)],
+                       _FeedPath(path), gridpoints=fine.s, solver_wrapper="seidel")
+    _, sd, _ = inst.compute_parameterization(0, 0)
+    prof, _, _ = verified_profile(path, limits, fine.s, np.maximum(sd, 0.0) ** 2,
+                                  path.block[fine.segment])
+    return fine, prof
+
+
+@pytest.mark.parametrize("name", list(HAND_CASES))
+def test_second_order_rows_hold_for_a_feasible_motion(name):
+    """Every row and cap of the relaxation (with the second-order rows of
+    :func:`optimal.arc_bounds.envelope_rows`) holds at the node values of a feasible
+    motion, whatever the guide values (the motion's own, or off by +-30 %)."""
+    from optimal.bounds import _relaxed_problem
+
+    build, lim = HAND_CASES[name]
+    path = build()
+    limits = _limits(*lim, axes=path.axes)
+    la = limits.for_axes(path.axes)
+    fine, prof = _feasible_profile(path, limits)
+    rng = np.random.default_rng(1)
+    n_new = 0
+    for per_arc in (8, 40, 200):
+        coarse = grid_from_counts(path, np.where(path.radius > 0, per_arc, 2))
+        assert np.all(np.isin(coarse.s, fine.s))
+        b = np.interp(coarse.s, prof.s, prof.v) ** 2
+        geo = _interval_data(path, la, coarse)
+        base = _relaxed_problem(path, la, coarse, geo, geo.b_static).problem
+        for guide in (b, b * rng.uniform(0.7, 1.3, b.size)):
+            P = _relaxed_problem(path, la, coarse, geo, geo.b_static, None, guide).problem
+            n_new += P.c1.shape[1] - base.c1.shape[1]
+            lhs = P.c1 * b[:-1, None] + P.c2 * b[1:, None]
+            used = (P.c1 != 0) | (P.c2 != 0)
+            scale = np.abs(P.c1 * b[:-1, None]) + np.abs(P.c2 * b[1:, None]) + np.abs(P.h)
+            assert np.all(np.where(used, lhs - P.h, -1.0) <= 1e-9 * scale)
+            assert np.all(b <= P.cap * (1 + 1e-9))
+    assert n_new > 0
