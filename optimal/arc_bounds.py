@@ -52,6 +52,8 @@ Units: mm, s. Shapes: ``N`` intervals, ``n`` axes.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from reference.core.geometry import Path
@@ -152,7 +154,7 @@ def _time_under(b0, r, beta_lo, beta_hi, B, t1):
 
 def envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
                    A: np.ndarray, dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
-                   hi: np.ndarray, k3: np.ndarray, iterations: int = 40) -> np.ndarray:
+                   hi: np.ndarray, k3: np.ndarray, iterations: int = 20) -> np.ndarray:
     """Lower estimate of the time on every interval from one-axis comparison envelopes.
 
     Why it is one
@@ -277,10 +279,8 @@ def _lower_rates(A: np.ndarray, c_lo: np.ndarray, lo: np.ndarray, hi: np.ndarray
     return usable, np.where(usable, 2 * A / los, np.inf), np.where(usable, kappa, 0.0)
 
 
-def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
-                  dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                  k3: np.ndarray, slope: np.ndarray, j: int, c: np.ndarray,
-                  iterations: int = 30):
+def envelope_rows(env: "LowerEnvelopes", k3: np.ndarray, slope: np.ndarray, j: int,
+                  c: np.ndarray):
     """Second-order form of the interval-exact row of axis ``j`` where ``c > 0``.
 
     Why it is valid
@@ -315,22 +315,16 @@ def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.n
 
     Parameters
     ----------
-    D : numpy.ndarray, shape (N,)
-        Interval lengths, mm.
-    guide0, guide1 : numpy.ndarray, shape (N,)
-        Guide values of ``b`` at the interval ends (any finite numbers), mm^2/s^2.
-    A : numpy.ndarray, shape (n,)
-        Axis acceleration limits, mm/s^2.
-    dq_mid, ddq_mid, lo, hi, k3 : numpy.ndarray, shape (N, n)
-        Mid-point ``q'`` and ``q''``, bounds of ``|q'_j|`` and ``sup|q'''_j|``.
+    env : LowerEnvelopes
+        The envelopes and splits of every interval (:func:`lower_envelopes`).
+    k3 : numpy.ndarray, shape (N, n)
+        Upper bounds of the third derivative ``|q^(3)_j|`` on the intervals, 1/mm^2.
     slope : numpy.ndarray, shape (N,)
         Bound ``M`` of ``|b'|`` on the intervals, mm/s^2.
     j : int
         Axis of the row.
     c : numpy.ndarray, shape (N,)
         ``sigma q''_j(mid)``; the row is formed where ``c > 0``.
-    iterations : int
-        Bisection steps for the split.
 
     Returns
     -------
@@ -341,6 +335,65 @@ def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.n
     rhs : numpy.ndarray, shape (N,)
         The right-hand side's addition ``((c/2)(g_f Psi_f + g_b Psi_b) +
         sup|q'''_j| M D^3 / 32) / D`` (mm/s^2) where ``ok``.
+    """
+    ok = env.ok & (c > 0)
+    dc1 = np.zeros(c.size)
+    dc2 = np.zeros(c.size)
+    rhs = np.zeros(c.size)
+    if not np.any(ok):
+        return ok, dc1, dc2, rhs
+    d, cc = env.D[ok], c[ok]
+    dc1[ok] = 0.5 * cc * (env.phi_f[ok] - 0.5 * d) / d
+    dc2[ok] = 0.5 * cc * (env.phi_b[ok] - 0.5 * d) / d
+    rhs[ok] = (0.5 * cc * (env.g_f[ok] * env.psi_f[ok] + env.g_b[ok] * env.psi_b[ok])
+               + k3[ok, j] * slope[ok] * d ** 3 / 32) / d
+    return ok, dc1, dc2, rhs
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LowerEnvelopes:
+    """The lower envelopes of every interval and their integrals up to the split
+    (:func:`lower_envelopes`); shapes ``(N,)``."""
+
+    ok: np.ndarray        # envelopes on both sides exist and stay finite
+    D: np.ndarray         # interval lengths, mm
+    phi_f: np.ndarray     # Phi_f(t*), coefficient of b_k in int_0^t* z_f
+    psi_f: np.ndarray     # Psi_f(t*)
+    g_f: np.ndarray       # g of the forward envelope, mm/s^2
+    phi_b: np.ndarray     # Phi_b(D - t*), coefficient of b_{k+1}
+    psi_b: np.ndarray     # Psi_b(D - t*)
+    g_b: np.ndarray       # g of the backward envelope, mm/s^2
+
+
+def lower_envelopes(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
+                    dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
+                    hi: np.ndarray, k3: np.ndarray, slope: np.ndarray,
+                    iterations: int = 16) -> LowerEnvelopes:
+    """Choose the lower envelopes and the split of every interval (:func:`envelope_rows`).
+
+    The candidates of each side are every axis whose tangent keeps its sign, and
+    ``|b'| <= M``; the one highest at the mid-point when started from the guide value
+    is taken, and ``t*`` is where the two meet (bisection). Validity does not depend on
+    these choices, only the tightness does.
+
+    Parameters
+    ----------
+    D : numpy.ndarray, shape (N,)
+        Interval lengths, mm.
+    guide0, guide1 : numpy.ndarray, shape (N,)
+        Guide values of ``b`` at the interval ends (any finite numbers), mm^2/s^2.
+    A : numpy.ndarray, shape (n,)
+        Axis acceleration limits, mm/s^2.
+    dq_mid, ddq_mid, lo, hi, k3 : numpy.ndarray, shape (N, n)
+        Mid-point ``q'`` and ``q''``, bounds of ``|q'_j|`` and of the third derivative.
+    slope : numpy.ndarray, shape (N,)
+        Bound ``M`` of ``|b'|`` on the intervals (``inf``: none), mm/s^2.
+    iterations : int
+        Bisection steps for the split.
+
+    Returns
+    -------
+    LowerEnvelopes
     """
     N = D.size
     sig = np.sign(dq_mid)
@@ -360,9 +413,8 @@ def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.n
 
     def best(usable, g, kappa, start):
         ph, _ = _phi_psi(kappa, np.broadcast_to(half, kappa.shape))
-        e = np.exp(2 * kappa * half)
         with np.errstate(over="ignore", invalid="ignore"):
-            z = start * e - np.where(usable, g, 0.0) * ph
+            z = start * np.exp(2 * kappa * half) - np.where(usable, g, 0.0) * ph
         z = np.where(usable & np.isfinite(z), z, -np.inf)
         m = np.argmax(z, axis=1)
         ar = np.arange(N)
@@ -370,17 +422,15 @@ def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.n
 
     okf, gf1, kf1 = best(uf, gf, kf, g0)
     okb, gb1, kb1 = best(ub, gb, kb, g1)
-    ok = (c > 0) & okf & okb & fin_m & np.isfinite(gf1) & np.isfinite(gb1)
+    ok = okf & okb & fin_m & np.isfinite(gf1) & np.isfinite(gb1)
     # the envelopes must stay finite over the whole interval (no overflow of e^{2 kappa D})
     ok &= (np.abs(2 * kf1 * D) < 50.0) & (np.abs(2 * kb1 * D) < 50.0)
-    dc1 = np.zeros(N)
-    dc2 = np.zeros(N)
-    rhs = np.zeros(N)
+    zero = np.zeros(N)
     if not np.any(ok):
-        return ok, dc1, dc2, rhs
+        return LowerEnvelopes(ok, D, zero, zero, zero, zero, zero, zero)
     d = D[ok]
     x0, x1 = g0[ok, 0], g1[ok, 0]
-    gf1, kf1, gb1, kb1 = gf1[ok], kf1[ok], gb1[ok], kb1[ok]
+    gfo, kfo, gbo, kbo = gf1[ok], kf1[ok], gb1[ok], kb1[ok]
 
     def z(x, g, kappa, t):
         ph, _ = _phi_psi(kappa, t)
@@ -389,14 +439,13 @@ def envelope_rows(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.n
     lo_t, hi_t = np.zeros(d.size), d.copy()
     for _ in range(iterations):            # where z_f(t) meets z_b(D - t)
         mid = 0.5 * (lo_t + hi_t)
-        above = z(x0, gf1, kf1, mid) > z(x1, gb1, kb1, d - mid)
+        above = z(x0, gfo, kfo, mid) > z(x1, gbo, kbo, d - mid)
         lo_t = np.where(above, mid, lo_t)
         hi_t = np.where(above, hi_t, mid)
     ts = 0.5 * (lo_t + hi_t)
-    phf, psf = _phi_psi(kf1, ts)
-    phb, psb = _phi_psi(kb1, d - ts)
-    cc = c[ok]
-    dc1[ok] = 0.5 * cc * (phf - 0.5 * d) / d
-    dc2[ok] = 0.5 * cc * (phb - 0.5 * d) / d
-    rhs[ok] = (0.5 * cc * (gf1 * psf + gb1 * psb) + k3[ok, j] * slope[ok] * d ** 3 / 32) / d
-    return ok, dc1, dc2, rhs
+    phf, psf = zero.copy(), zero.copy()
+    phb, psb = zero.copy(), zero.copy()
+    phf[ok], psf[ok] = _phi_psi(kfo, ts)
+    phb[ok], psb[ok] = _phi_psi(kbo, d - ts)
+    return LowerEnvelopes(ok, D, phf, psf, np.where(ok, gf1, 0.0), phb, psb,
+                          np.where(ok, gb1, 0.0))

@@ -73,8 +73,8 @@ from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays, MachineLimits
 from reference.core.profile import Profile
 
-from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, slope_peak,
-                         tangential_slope_bound)
+from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, lower_envelopes,
+                         slope_peak, tangential_slope_bound)
 from .backends.fast import sweep
 from .grid import Grid
 from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
@@ -317,6 +317,10 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
     E = np.where(good[:, None], geo.k2 * margin[:, None]
                  + geo.ierr * np.where(good, B, 0.0)[:, None], np.inf)
     cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
+    if guide is not None:       # second-order rows (optimal.arc_bounds.envelope_rows)
+        slope_g = np.where(good, slope, np.inf)
+        env = lower_envelopes(ds, guide[:-1], guide[1:], lim.a_max, geo.dq_mid,
+                              geo.ddq_mid, geo.lo, geo.hi, geo.k3, slope_g)
     for j in geo.axes_used:
         hrow = lim.a_max[j] + E[:, j] / ds
         fin = np.isfinite(hrow)
@@ -337,10 +341,8 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
             if guide is None:
                 continue
             # the same row in second-order form (optimal.arc_bounds.envelope_rows)
-            ok, dc1, dc2, rhs = envelope_rows(
-                ds, guide[:-1], guide[1:], lim.a_max, geo.dq_mid, geo.ddq_mid, geo.lo,
-                geo.hi, geo.k3, np.where(good, slope, np.inf), int(j),
-                sigma * geo.ddq_mid[:, j])
+            ok, dc1, dc2, rhs = envelope_rows(env, geo.k3, slope_g, int(j),
+                                              sigma * geo.ddq_mid[:, j])
             h2 = lim.a_max[j] + rhs + geo.ierr[:, j] * np.where(good, B, 0.0) / ds
             ok &= fin & good & np.isfinite(h2)
             if not np.any(ok):
