@@ -41,7 +41,7 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
 from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
-                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS)
+                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE)
 
 SUPPORTED_BOUNDS = ("acc",)
 
@@ -181,7 +181,7 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
     if total > 0:
         order = np.argsort(-disc, kind="stable")
         cum = np.cumsum(disc[order])
-        n_take = int(np.searchsorted(cum, 0.6 * total)) + 1
+        n_take = int(np.searchsorted(cum, REFINE_GAP_SHARE * total)) + 1
         mark[order[:n_take]] = True
     scale_part = (lam - 1.0) * float(t_prim.sum())
     if report is not None and lam > 1.0 and scale_part > 0.2 * float(d.sum()):
