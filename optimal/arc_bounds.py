@@ -1,4 +1,15 @@
-"""Tighter a-priori bounds of the lower-bound relaxation on lines, arcs and helices.
+"""Tighter ingredients of the lower-bound relaxation on lines, arcs and helices.
+
+Four parts, each proved where it is defined and each only used where it is at least as
+tight as the ingredient of :mod:`optimal.bounds` it joins (the relaxation keeps both):
+
+1. :func:`tangential_slope_bound`: a bound of ``|b'|`` free of ``b`` (below);
+2. the remainder of the interval-exact rows with ``int |e| <= M D^2 / 4`` (below);
+3. :func:`envelope_times`: the time of an interval from one-axis comparison envelopes
+   (``b`` relaxes exponentially towards an axis' static limit), instead of a tent of
+   slope ``M``;
+4. :func:`lower_envelopes` / :func:`envelope_rows`: the curved rows with ``int e``
+   bounded below by lower comparison envelopes, affine in the end values.
 
 The relaxation of :mod:`optimal.bounds` loses, on every interval ``I_k`` of length
 ``D``, a remainder proportional to a bound ``M_k`` of ``|b'| = 2 |a|`` (the term

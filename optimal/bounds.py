@@ -32,6 +32,11 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    ``w1 = (q'_j(s_{k+1}) - dq/D) / 2`` (``dq`` the exact chord), whose round-off bound
    times ``Bbar_k`` is added to ``E_jk``.
    On lines ``q'' = 0``: the row is the exact ``|q'_j (b_{k+1} - b_k)| / (2D) <= A_j``.
+   From the second round on (or with node bounds from a coarser grid) each curved row
+   where ``sigma q''_j(mid) > 0`` is added once more in a sharper form: ``int e`` is
+   bounded below by lower comparison envelopes from both actual end values, affine in
+   them, so the row stays linear (:func:`optimal.arc_bounds.envelope_rows`, proof
+   there); the previous round's optimum only chooses the envelopes and their split.
    Rows that are not in lattice form are relaxed further (one term dropped, ``b >= 0``).
 3. *Node caps* are those of the continuous problem at the nodes (velocity on both sides,
    feed, stops, the junction rule with the checker's allowance), plus ``Bbar`` of both
@@ -46,7 +51,10 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    larger. This is ``lower_bound_s`` (less ``LB_ROUNDOFF_REL`` for round-off), plus dwells.
 
 Every step only weakens constraints or over-estimates ``b``; the bound holds for every
-grid. Its looseness is O(D) on arcs and vanishes on lines (the tent is then exact
+grid. Its looseness is O(D) on arcs (the envelopes of :mod:`optimal.arc_bounds` shrink
+the constant: measured on 200 tangent S-bends at 80,000 intervals, the bound's distance
+below the grid optimum fell from 0.40 % with the tangential slope bound alone to
+0.09 %; it still about halves per halving of the intervals) and vanishes on lines (the tent is then exact
 wherever the optimum accelerates at the limit), so refinement closes the gap.
 
 Upper bound
