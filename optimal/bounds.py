@@ -33,7 +33,8 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    times ``Bbar_k`` is added to ``E_jk``.
    On lines ``q'' = 0``: the row is the exact ``|q'_j (b_{k+1} - b_k)| / (2D) <= A_j``.
    From the second round on (or with node bounds from a coarser grid) each curved row
-   where ``sigma q''_j(mid) > 0`` is added once more in a sharper form: ``int e`` is
+   where ``sigma q''_j(mid) > 0`` is replaced by a sharper form (dropping the old one
+   only relaxes, and the new one is valid on its own): ``int e`` is
    bounded below by lower comparison envelopes from both actual end values, affine in
    them, so the row stays linear (:func:`optimal.arc_bounds.envelope_rows`, proof
    there); the previous round's optimum only chooses the envelopes and their split.
@@ -361,10 +362,11 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
             if np.any(both):
                 caps.add(left[both], h2[both] / n1[both], CAP_BOUND)
                 caps.add(left[both] + 1, h2[both] / n2[both], CAP_BOUND)
-            cols_c1.append(np.where(both, 0.0, n1))
-            cols_c2.append(np.where(both, 0.0, n2))
-            cols_h.append(np.where(ok, h2, 1.0))
-            row_axis.append(j)
+            # where formed it replaces the first-order row in the same column (dropping
+            # a valid row only relaxes; this keeps the sweep's column count)
+            cols_c1[-1] = np.where(ok, np.where(both, 0.0, n1), cols_c1[-1])
+            cols_c2[-1] = np.where(ok, np.where(both, 0.0, n2), cols_c2[-1])
+            cols_h[-1] = np.where(ok, h2, cols_h[-1])
     prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
     return Relaxation(prob, B, slope)
 
