@@ -373,3 +373,23 @@ def test_second_order_rows_hold_for_a_feasible_motion(name):
             assert np.all(np.where(used, lhs - P.h, -1.0) <= 1e-9 * scale)
             assert np.all(b <= P.cap * (1 + 1e-9))
     assert n_new > 0
+
+
+def test_budget_end_names_the_budget_and_the_bracket():
+    """When a budget ends refinement the status says gap_not_met and the message names
+    the budget and the bracket achieved (both bounds valid)."""
+    R = (3.0, 7.0, 4.5, 9.0, 2.5, 6.0)
+    lines, x = ["G90 G17 G1 X0 Y0 F12000"], 0.0
+    for i, r in enumerate(R):
+        x += 2 * r
+        lines.append(f"{'G3' if i % 2 == 0 else 'G2'} X{x:.6f} Y0 CR={r:.6f}")
+    path = _path("\n".join(lines + ["M30"]) + "\n")
+    limits = load_machine(None).limits
+    by_grid = optimal.solve(path, limits, tol=1e-5, max_grid=400)
+    assert by_grid.status == optimal.SolveStatus.GAP_NOT_MET
+    assert "grid budget max_grid = 400" in by_grid.message
+    assert f"[{by_grid.lower_bound_s:.6g}, {by_grid.upper_bound_s:.6g}] s" in by_grid.message
+    by_rounds = optimal.solve(path, limits, tol=1e-5, max_iterations=1)
+    assert by_rounds.status == optimal.SolveStatus.GAP_NOT_MET
+    assert "round budget max_iterations = 1" in by_rounds.message
+    assert by_rounds.lower_bound_s <= by_rounds.upper_bound_s
