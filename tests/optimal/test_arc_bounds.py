@@ -393,3 +393,52 @@ def test_budget_end_names_the_budget_and_the_bracket():
     assert by_rounds.status == optimal.SolveStatus.GAP_NOT_MET
     assert "round budget max_iterations = 1" in by_rounds.message
     assert by_rounds.lower_bound_s <= by_rounds.upper_bound_s
+
+
+def _random_arc_program(seed: int) -> str:
+    """Lines, arcs of radius 0.01 .. 1000 mm and helices in G17, G18 or G19."""
+    rng = np.random.default_rng(seed)
+    plane = ("G17", "G18", "G19")[seed % 3]
+    ax = {"G17": ("X", "Y", "Z"), "G18": ("Z", "X", "Y"), "G19": ("Y", "Z", "X")}[plane]
+    letter = {"X": "I", "Y": "J", "Z": "K"}
+    lines = [f"G90 {plane} G64 G1 X0 Y0 Z0 F{rng.choice([3000, 8000, 15000, 30000])}"]
+    pos = {"X": 0.0, "Y": 0.0, "Z": 0.0}
+    for _ in range(int(rng.integers(3, 12))):
+        if rng.random() < 0.3:
+            for a in pos:
+                pos[a] = round(pos[a] + rng.uniform(-20, 20), 6)
+            lines.append("G1 " + " ".join(f"{a}{pos[a]:.6f}" for a in "XYZ"))
+            continue
+        r = 10 ** rng.uniform(-2, 3)
+        th, sweep = rng.uniform(-np.pi, np.pi), rng.uniform(0.1, 3.0)
+        u, v = pos[ax[0]], pos[ax[1]]
+        cu, cv = u - r * np.cos(th), v - r * np.sin(th)
+        pos[ax[0]] = round(cu + r * np.cos(th + sweep), 6)
+        pos[ax[1]] = round(cv + r * np.sin(th + sweep), 6)
+        if rng.random() < 0.4:
+            pos[ax[2]] = round(pos[ax[2]] + rng.uniform(-3, 3), 6)
+        lines.append("G3 " + " ".join(f"{a}{pos[a]:.6f}" for a in "XYZ")
+                     + f" {letter[ax[0]]}{cu - u:.6f} {letter[ax[1]]}{cv - v:.6f}")
+    return "\n".join(lines + ["M30"]) + "\n"
+
+
+@pytest.mark.parametrize("seed", range(9))
+def test_lower_bound_below_verified_motion_on_random_arc_programs(seed):
+    """Random arcs (R 0.01 .. 1000 mm), helices in every plane and random anisotropic
+    limits: the bound on coarse grids (2 .. 128 intervals, where the new remainders are
+    largest) and after refinement stays below the checker-verified upper bound."""
+    from optimal.bounds import lower_bound
+
+    path = _path(_random_arc_program(seed))
+    rng = np.random.default_rng(seed + 1000)
+    limits = MachineLimits(tuple(AxisLimits(a, float(rng.uniform(100, 600)),
+                                            float(rng.uniform(200, 5000)), 1e6, 1.2)
+                                 for a in path.axes), 0.004)
+    sol = optimal.solve(path, limits, tol=3e-4)
+    assert sol.status == optimal.SolveStatus.OPTIMAL
+    ub = sol.upper_bound_s - sol.dwell_s
+    la = limits.for_axes(path.axes)
+    for n in (2, 8, 32, 128):
+        g = initial_grid(path, n, min_arc_intervals=2, max_arc_step_rad=np.pi)
+        assert lower_bound(path, la, g)[0] <= ub
+    assert sol.lower_bound_s <= sol.upper_bound_s
