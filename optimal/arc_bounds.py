@@ -154,11 +154,14 @@ def _time_under(b0, r, beta_lo, beta_hi, B, t1):
     with np.errstate(divide="ignore", invalid="ignore"):
         tB = np.where(rising, np.log((r - b0) / np.where(rising, r - B, 1.0)) / beta, np.inf)
     te = np.minimum(t1, np.maximum(tB, 0.0))
-    y1, _ = _relax(b0, r, beta_lo, beta_hi, te)
-    sy0, sy1 = np.sqrt(b0), np.sqrt(y1)
+    # y1 - b0 formed directly (not as the difference of y1 and b0, which cancels when
+    # b0 >> r and beta te is small, and the log below would amplify that error by w)
+    dy = (r - b0) * (-np.expm1(-beta * te))
+    y1 = b0 + dy
+    sy0, sy1 = np.sqrt(b0), np.sqrt(np.maximum(y1, 0.0))
     sr = np.sqrt(r)
     # ln((1 + w1) / (1 + w0)) without cancellation: w1 - w0 = (y1 - y0) / (sr (sy1 + sy0))
-    dw = (y1 - b0) / (sr * (sy1 + sy0))
+    dw = dy / (sr * (sy1 + sy0))
     part = (te + (2.0 / beta) * np.log1p(dw / (1.0 + sy0 / sr))) / sr
     return part + np.maximum(t1 - te, 0.0) / np.sqrt(B)
 

@@ -442,3 +442,19 @@ def test_lower_bound_below_verified_motion_on_random_arc_programs(seed):
         g = initial_grid(path, n, min_arc_intervals=2, max_arc_step_rad=np.pi)
         assert lower_bound(path, la, g)[0] <= ub
     assert sol.lower_bound_s <= sol.upper_bound_s
+
+
+def test_time_under_keeps_precision_when_the_start_is_far_above_the_root():
+    """b0 >> r with a short step: the closed form must not cancel (an independent review
+    found a 2x overestimate here when y1 - b0 was formed as a difference). Reference:
+    the integral by adaptive quadrature of 1/sqrt(y(t)) on the explicit relaxation."""
+    from scipy.integrate import quad
+    from optimal.arc_bounds import _time_under
+    b0, r, beta = 4644913325449.768, 115213.80817438016, 1.0382120723213445e-08
+    t1 = 5.164712158455123e-06
+    got = float(_time_under(np.array([b0]), np.array([r]), np.array([33.64186199443823]),
+                            np.array([beta]), np.array([b0]), np.array([t1]))[0])
+    ref, _ = quad(lambda t: 1.0 / np.sqrt(r + (b0 - r) * np.exp(-beta * t)), 0.0, t1,
+                  epsabs=0.0, epsrel=1e-13)
+    assert got == pytest.approx(ref, rel=1e-9)
+    assert got <= ref * (1 + 1e-12)
