@@ -41,7 +41,7 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
 from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
-                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS)
+                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE)
 
 SUPPORTED_BOUNDS = ("acc",)
 
@@ -181,7 +181,7 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
     if total > 0:
         order = np.argsort(-disc, kind="stable")
         cum = np.cumsum(disc[order])
-        n_take = int(np.searchsorted(cum, 0.6 * total)) + 1
+        n_take = int(np.searchsorted(cum, REFINE_GAP_SHARE * total)) + 1
         mark[order[:n_take]] = True
     scale_part = (lam - 1.0) * float(t_prim.sum())
     if report is not None and lam > 1.0 and scale_part > 0.2 * float(d.sum()):
@@ -419,8 +419,14 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     elif status == SolveStatus.OPTIMAL:
         message = f"gap {gap:.4%} <= {tol:.4%} on {g.n_points} points"
     else:
-        message = (f"gap {gap:.4%} > {tol:.4%} after {it} rounds ({g.n_points} points, "
-                   f"max_grid {max_grid}); both bounds are valid")
+        if grid.n_intervals >= max_grid:
+            budget = f"grid budget max_grid = {max_grid} intervals reached"
+        elif it >= max_iterations:
+            budget = f"round budget max_iterations = {max_iterations} reached"
+        else:
+            budget = "no interval can be split further"
+        message = (f"gap {gap:.4%} > {tol:.4%}: {budget} after {it} rounds ({g.n_points} "
+                   f"points); bracket [{best_lb:.6g}, {ub:.6g}] s, both bounds are valid")
     if progress:
         progress("done", 1.0)
     return OptimalSolution(

@@ -61,3 +61,11 @@ LB_ROUNDS = 4
 
 #: Stop the lower-bound rounds when the bound improves by less than this (relative).
 LB_ROUND_IMPROVEMENT = 1e-4
+
+#: Share of the bracket (sum over intervals of grid time minus lower-bound time) whose
+#: largest carriers are halved in each refinement round. With the second-order arc bound
+#: (:mod:`optimal.arc_bounds`) an interval's share falls about fourfold per halving, so
+#: refining nearly all of the bracket at once saves rounds: measured on the S-bend and
+#: CAM benchmarks (``tests/bench/bench_arcs.py``), 0.6 took 6-7 rounds, 0.9 4-5, for
+#: grids of similar size.
+REFINE_GAP_SHARE = 0.9
