@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.core.arrays import readonly
 from reference.core.geometry import Path
 
 from .tolerances import (DEFAULT_INITIAL_INTERVALS, MAX_ARC_STEP_RAD, MIN_ARC_INTERVALS,
@@ -25,10 +26,6 @@ from .tolerances import (DEFAULT_INITIAL_INTERVALS, MAX_ARC_STEP_RAD, MIN_ARC_IN
 _MIN_SPLIT_REL = 1e-12
 
 
-def _ro(a: np.ndarray, dtype=np.float64) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=dtype)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -50,9 +47,9 @@ class Grid:
     break_node: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "s", _ro(self.s))
-        object.__setattr__(self, "segment", _ro(self.segment, np.int64))
-        object.__setattr__(self, "break_node", _ro(self.break_node, np.int64))
+        object.__setattr__(self, "s", readonly(self.s, np.float64))
+        object.__setattr__(self, "segment", readonly(self.segment, np.int64))
+        object.__setattr__(self, "break_node", readonly(self.break_node, np.int64))
 
     @property
     def n_intervals(self) -> int:

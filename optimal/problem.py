@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from reference.core.arrays import readonly
 from reference.core.errors import InfeasibleError
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays
@@ -61,10 +62,6 @@ CAP_NAMES = {CAP_NONE: "none", CAP_STOP: "stop", CAP_JUNCTION: "velocity_jump",
              CAP_BOUND: "bound"}
 
 
-def _ro(a, dtype=np.float64) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=dtype)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -111,9 +108,9 @@ class DiscreteProblem:
 
     def __post_init__(self) -> None:
         for name in ("s", "cap", "c1", "c2", "h"):
-            object.__setattr__(self, name, _ro(getattr(self, name)))
+            object.__setattr__(self, name, readonly(getattr(self, name), np.float64))
         for name in ("segment", "row_axis", "cap_code", "cap_axis"):
-            object.__setattr__(self, name, _ro(getattr(self, name), np.int64))
+            object.__setattr__(self, name, readonly(getattr(self, name), np.int64))
         N = self.s.size - 1
         if N < 0:
             raise ValueError("a discrete problem needs at least one node")
@@ -131,7 +128,7 @@ class DiscreteProblem:
             raise ValueError("caps must be finite and >= 0")
         if np.any(self.c1 * self.c2 > 0) or np.any(self.h < 0):
             raise ValueError("rows are not in lattice form (c1 * c2 <= 0, h >= 0)")
-        object.__setattr__(self, "ds", _ro(ds))
+        object.__setattr__(self, "ds", readonly(ds, np.float64))
 
     @property
     def n_intervals(self) -> int:

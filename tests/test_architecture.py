@@ -101,7 +101,7 @@ def test_rules_catch_a_violation(tmp_path: Path) -> None:
 #: The modules that hold the shared rules (DESIGN section 2, "One rulebook").
 RULEBOOK = ("reference/core/rules.py", "reference/core/causes.py",
             "reference/core/tolerances.py", "reference/core/rows.py",
-            "reference/core/jsonio.py")
+            "reference/core/jsonio.py", "reference/core/arrays.py")
 #: Where the heuristic, the oracle (grid problem and relaxation), the checker and
 #: compare live: none of them may define its own copy of a rulebook name.
 CONSUMERS = ("reference", "optimal", "compare")

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .arrays import readonly
 from .causes import HOLD_CAUSES
 from .errors import ProfileError
 from .profile import Profile
@@ -30,10 +31,6 @@ from .tolerances import POS_TOL_MM, VEL_TOL_MM_S
 DWELL_CAUSE, SETTLE_CAUSE = HOLD_CAUSES
 
 
-def _ro(a, dtype) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=dtype)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -60,9 +57,9 @@ class Holds:
     cause: tuple[str, ...]
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "break_index", _ro(self.break_index, np.int64))
-        object.__setattr__(self, "block", _ro(self.block, np.int64))
-        object.__setattr__(self, "duration_s", _ro(self.duration_s, np.float64))
+        object.__setattr__(self, "break_index", readonly(self.break_index, np.int64))
+        object.__setattr__(self, "block", readonly(self.block, np.int64))
+        object.__setattr__(self, "duration_s", readonly(self.duration_s, np.float64))
         object.__setattr__(self, "cause", tuple(self.cause))
         h = self.duration_s.size
         if not (self.break_index.shape == self.block.shape == (h,) and len(self.cause) == h):

@@ -24,14 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .arrays import readonly
 from .errors import ProfileError
 from .tolerances import POS_TOL_MM, VEL_TOL_MM_S
 
 
-def _ro(a, dtype=np.float64) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=dtype)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -63,8 +60,8 @@ class Profile:
 
     def __post_init__(self) -> None:
         for name in ("t", "s", "v", "a", "j"):
-            object.__setattr__(self, name, _ro(getattr(self, name)))
-        object.__setattr__(self, "block", _ro(self.block, np.int64))
+            object.__setattr__(self, name, readonly(getattr(self, name), np.float64))
+        object.__setattr__(self, "block", readonly(self.block, np.int64))
         K = self.a.size
         if self.t.shape != (K + 1,) or self.s.shape != (K + 1,) or self.v.shape != (K + 1,):
             raise ProfileError(f"knot arrays must have {K + 1} entries for {K} intervals "

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..core.arrays import readonly
 from ..core.constraints import BOUND_SETS, ConstraintReport
 from ..core.geometry import Path
 from ..core.holds import Holds
@@ -97,10 +98,6 @@ class CornerRow(NamedTuple):
     cause: str
 
 
-def _ro(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
 
 
 class _Table(Sequence):
@@ -114,7 +111,7 @@ class _Table(Sequence):
     def __init__(self, **cols) -> None:
         for k, v in cols.items():
             if isinstance(v, np.ndarray):
-                cols[k] = _ro(v)
+                cols[k] = readonly(v)
         object.__setattr__(self, "_cols", cols)
         object.__setattr__(self, "_n", len(next(iter(cols.values()))) if cols else 0)
 
