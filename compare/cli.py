@@ -7,16 +7,15 @@ Exit codes: 0 all good; 1 a gap above ``--max-gap`` or a limit violation; 2 bad 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import traceback
-from pathlib import Path as FsPath
 from typing import Sequence
 
 from reference.core.budget import DEFAULT_MAX_GRID_POINTS
 from reference.core.errors import FeedOracleError
 from reference.prepare import prepare
 
+from .commands import number_at_least
 from .pipeline import load_inputs
 from .progress import Progress
 
@@ -67,17 +66,6 @@ def cmd_inspect(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _grid_points(text: str) -> float:
-    """``--max-grid-points``: a number >= 1 (``1e9`` allowed)."""
-    try:
-        x = float(text)
-    except ValueError:
-        x = math.nan
-    if not (math.isfinite(x) and x >= 1):
-        raise argparse.ArgumentTypeError(f"{text!r}: expected a number of points >= 1")
-    return x
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of all sub-commands."""
     p = _Parser(prog="feedoracle", description=__doc__.splitlines()[0])
@@ -92,7 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--quiet", action="store_true", help="no progress output")
         sp.add_argument("--debug", action="store_true",
                         help="on an internal error (exit 3), print the traceback")
-        sp.add_argument("--max-grid-points", metavar="N", type=_grid_points,
+        sp.add_argument("--max-grid-points", metavar="N",
+                        type=number_at_least(1.0, "a number of points >= 1"),
                         default=DEFAULT_MAX_GRID_POINTS,
                         help="size budget: most points sampled along the path (arc and "
                              "helix samples, IPO rows of a CSV); a program needing more "

@@ -18,7 +18,7 @@ import gc
 import math
 import sys
 from pathlib import Path as FsPath
-from typing import Callable, Sequence, TextIO
+from typing import Callable, Sequence
 
 from reference.core.constraints import BOUND_SETS
 from reference.core.errors import FeedOracleError
@@ -56,15 +56,22 @@ def parse_max_gap(text: str) -> float:
     return pct / 100.0
 
 
-def _mm(text: str) -> float:
-    """A length >= 0 in mm (``--max-deviation``)."""
-    try:
-        x = float(text)
-    except ValueError:
-        x = math.nan
-    if not (math.isfinite(x) and x >= 0):
-        raise argparse.ArgumentTypeError(f"{text!r}: expected a length >= 0 in mm")
-    return x
+def number_at_least(minimum: float, what: str) -> Callable[[str], float]:
+    """An argparse ``type``: a finite number ``>= minimum`` (``1e9`` allowed), else an
+    error naming ``what`` was expected."""
+    def parse(text: str) -> float:
+        try:
+            x = float(text)
+        except ValueError:
+            x = math.nan
+        if not (math.isfinite(x) and x >= minimum):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {what}")
+        return x
+    return parse
+
+
+#: ``--max-deviation``.
+_mm = number_at_least(0.0, "a length >= 0 in mm")
 
 
 # --------------------------------------------------------------------- registration

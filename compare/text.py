@@ -71,7 +71,7 @@ def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
         out.write(f"  note: {note}\n")
     worst = c.worst_blocks(n_worst)
     if worst:
-        out.write(f"  largest block gaps:\n")
+        out.write("  largest block gaps:\n")
         block_table(worst, out)
 
 

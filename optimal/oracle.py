@@ -28,7 +28,7 @@ import numpy as np
 from reference.core.constraints import BOUND_SETS, ConstraintReport
 from reference.core.errors import InfeasibleError
 from reference.core.geometry import Path
-from reference.core.holds import DWELL_CAUSE, NO_HOLDS, Holds, dwell_holds, with_holds
+from reference.core.holds import DWELL_CAUSE, Holds, dwell_holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import BlockRow, block_motion, block_rows

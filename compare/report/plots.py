@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import base64
 import io
+from typing import Sequence
+
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator

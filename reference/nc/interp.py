@@ -46,14 +46,6 @@ from .lines import Stmt
 from .program import Block, BlockExtra, Program
 from .state import ROTARY, _Interp
 
-# Everything this module defined before it was split by stage stays importable from here.
-from .arcs import _arc, _fast_arc_centre, _radius_centre  # noqa: F401
-from .block import _indexed_assignment, _tangential  # noqa: F401
-from .flow import _labels, _o_endif, _o_next_branch, _o_scan  # noqa: F401
-from .frames import _Frame, _apply_frame, _apply_g10, _apply_g92, _ngc_frame  # noqa: F401
-from .state import (_CENTER_WORD, _END_M, _G_GROUPS_NGC, _G_GROUPS_SIN,  # noqa: F401
-                    _IGNORED_G_NGC, _IGNORED_G_SIN, _IGNORED_WHY, _MODES10_SIN, _NGC_CS,
-                    _PLANE_AXES, _UNSUPPORTED_G, GEOMETRY)
 
 #: Largest number of re-executed lines (statements run again by a loop, a jump back or a
 #: subprogram call), beyond each statement's first run. It stops endless loops; a
