@@ -39,6 +39,21 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    them, so the row stays linear (:func:`optimal.arc_bounds.envelope_rows`, proof
    there); the previous round's optimum only chooses the envelopes and their split.
    Rows that are not in lattice form are relaxed further (one term dropped, ``b >= 0``).
+2b. *Energy rows.* For every axis, ``(q'_j^2 b)' = 2 q'_j (q'_j a + q''_j b)`` (the
+   squared axis velocity ``v_j^2 = q'_j^2 b``), so integrating over ``I_k`` with
+   ``|q'_j a + q''_j b| <= A_j`` gives exactly
+   ``|q'_j(s_{k+1})^2 b_{k+1} - q'_j(s_k)^2 b_k| <= 2 A_j int_{I_k} |q'_j| ds``: an axis
+   gains or loses at most ``2 A_j`` of squared velocity per mm of its travel. No
+   remainder, any geometry; the travel is the exact chord ``|Delta q_j|`` where ``q'_j``
+   keeps its sign (``inf|q'_j| > 0``; on lines and helices in the cancellation-free form
+   ``D (sinc(omega D / 2) (q'_mid - d) + d)``, on spirals the chord of the exact positions
+   plus its round-off bound) and ``D sup|q'_j|`` elsewhere. These rows are what makes the
+   bound converge fast where the optimum follows an axis' acceleration limit along an
+   arc: the averaged rows above admit node values that only a motion dipping inside
+   the intervals could reach, and the time estimate of step 4 does not charge for the
+   dip, a first-order loss (measured on 60 tangent S-bends, 7,797 points: the bound's
+   distance below the converged time fell from 0.28 % to 0.11 %, at 15,593 points from
+   0.11 % to 0.04 %).
 3. *Node caps* are those of the continuous problem at the nodes (velocity on both sides,
    feed, stops, the junction rule with the checker's allowance), plus ``Bbar`` of both
    neighbouring intervals. So the node values ``(b(s_k))`` are feasible for this
@@ -87,7 +102,7 @@ from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, lower
 from .backends.fast import sweep
 from .grid import Grid
 from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
-                      interval_geometry, moving_axes)
+                      interval_geometry, moving_axes, pair_mvc)
 from .tolerances import LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
 
 
@@ -142,28 +157,7 @@ class _IntervalData:
     ddq_mid: np.ndarray       # (N, n) q'' at interval mid-points
     hi: np.ndarray            # (N, n) sup |q'_j| on the interval
     k3: np.ndarray            # (N, n) sup |q'''_j| on the segment
-
-
-def _pair_mvc(dq: np.ndarray, ddq: np.ndarray, a_max: np.ndarray) -> np.ndarray:
-    """Exact static bound ``max b`` s.t. some ``a`` has ``|q'_j a + q''_j b| <= A_j``.
-
-    The 2-variable LP's optimum is the smallest optimum over its two-constraint
-    sub-problems: ``(A_j |q'_l| + A_l |q'_j|) / |q'_l q''_j - q'_j q''_l|`` for axis pairs
-    and ``A_j / |q''_j|`` for an axis with ``q'_j = 0``. Shape ``(K, n) -> (K,)``.
-    """
-    K, n = dq.shape
-    out = np.full(K, np.inf)
-    for j in range(n):
-        single = (dq[:, j] == 0) & (ddq[:, j] != 0)
-        if np.any(single):
-            out[single] = np.minimum(out[single], a_max[j] / np.abs(ddq[single, j]))
-        for m in range(j + 1, n):
-            W = np.abs(dq[:, m] * ddq[:, j] - dq[:, j] * ddq[:, m])
-            ok = W > 0
-            if np.any(ok):
-                val = (a_max[j] * np.abs(dq[ok, m]) + a_max[m] * np.abs(dq[ok, j])) / W[ok]
-                out[ok] = np.minimum(out[ok], val)
-    return out
+    travel: np.ndarray        # (N, n) upper bound of the axis travel int |q'_j| on I_k
 
 
 def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
@@ -210,8 +204,8 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
                     b_bar[ia] = np.minimum(b_bar[ia], val)
     # ---- exact static bound at the nodes, from both sides
     node_mvc = np.full(N + 1, np.inf)
-    node_mvc[:-1] = _pair_mvc(dq0, ddq0, lim.a_max)
-    node_mvc[1:] = np.minimum(node_mvc[1:], _pair_mvc(dq1, ddq1, lim.a_max))
+    node_mvc[:-1] = pair_mvc(dq0, ddq0, lim.a_max)
+    node_mvc[1:] = np.minimum(node_mvc[1:], pair_mvc(dq1, ddq1, lim.a_max))
     # ---- closed-form weights of the interval-exact rows
     phi_m = path.theta0[seg] + w * (mid - path.s_breaks[seg])
     x = w * 0.5 * ds
@@ -227,9 +221,18 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
     if spi.size:
         I0[spi], I1[spi], ierr[spi] = _spiral_weights(path, grid, spi, dq0[spi], dq1[spi])
     slope_tan = tangential_slope_bound(path, lim, seg, dqm, hi)
+    # axis travel int |q'_j| on I_k (energy rows): where q'_j keeps its sign it is the
+    # exact chord |q_j(s_{k+1}) - q_j(s_k)|, on lines and helices in the cancellation-free
+    # form D (sinc(omega D / 2) (q'_mid - d) + d); elsewhere D sup|q'_j|
+    chord = np.abs(ds[:, None] * (sinc[:, None] * (dqm - path.d[seg]) + path.d[seg]))
+    if spi.size:
+        q0 = path.evaluate(grid.s[spi], segment=seg[spi])[0]
+        q1 = path.evaluate(grid.s[spi + 1], segment=seg[spi])[0]
+        chord[spi] = np.abs(q1 - q0) + ierr[spi] * ds[spi, None]
+    travel = np.where(lo > 0, np.minimum(chord, ds[:, None] * hi), ds[:, None] * hi)
     return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
                          moving_axes(dq0, ddq0, dq1, ddq1), ierr, slope_tan, dqm, ddqm,
-                         hi, k3)
+                         hi, k3, travel)
 
 
 def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
@@ -367,6 +370,15 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
             cols_c1[-1] = np.where(ok, np.where(both, 0.0, n1), cols_c1[-1])
             cols_c2[-1] = np.where(ok, np.where(both, 0.0, n2), cols_c2[-1])
             cols_h[-1] = np.where(ok, h2, cols_h[-1])
+        # energy rows (step 2b of the module docstring): exact, no remainder
+        e0 = geo.dq0[:, j] ** 2
+        e1 = geo.dq1[:, j] ** 2
+        he = 2.0 * lim.a_max[j] * geo.travel[:, j]
+        for c1, c2 in ((-e0, e1), (e0, -e1)):
+            cols_c1.append(c1)
+            cols_c2.append(c2)
+            cols_h.append(he)
+            row_axis.append(j)
     prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
     return Relaxation(prob, B, slope)
 

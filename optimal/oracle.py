@@ -41,7 +41,8 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
 from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
-                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE)
+                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE,
+                         LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET)
 
 SUPPORTED_BOUNDS = ("acc",)
 
@@ -170,9 +171,12 @@ def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
 
 
 def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, lam: float,
-                  report: ConstraintReport | None, budget: int) -> np.ndarray:
-    """Intervals to halve: those carrying most of the gap, plus arc intervals of blocks
-    where the checker needed time scaling."""
+                  report: ConstraintReport | None, budget: int, target_s: float
+                  ) -> np.ndarray:
+    """Intervals to halve: the fewest of the largest carriers of the gap whose halving is
+    predicted to bring the gap below ``target_s`` (a halved interval keeps about
+    :data:`REFINE_RESIDUAL` of its share), at most :data:`REFINE_GAP_SHARE` of it; plus
+    arc intervals of blocks where the checker needed time scaling."""
     N = grid.n_intervals
     mark = np.zeros(N, bool)
     d = np.maximum(lam * t_prim - t_lb, 0.0)
@@ -181,7 +185,9 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
     if total > 0:
         order = np.argsort(-disc, kind="stable")
         cum = np.cumsum(disc[order])
-        n_take = int(np.searchsorted(cum, REFINE_GAP_SHARE * total)) + 1
+        need = (total - max(target_s, 0.0)) / (1.0 - REFINE_RESIDUAL)
+        share = min(max(need, 0.0), REFINE_GAP_SHARE * total)
+        n_take = int(np.searchsorted(cum, share)) + 1
         mark[order[:n_take]] = True
     scale_part = (lam - 1.0) * float(t_prim.sum())
     if report is not None and lam > 1.0 and scale_part > 0.2 * float(d.sum()):
@@ -351,7 +357,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         te = time.perf_counter()
         b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
                   if warm is not None else None)
-        lb, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
+        lb, t_lb, rel, b_hat = lower_bound(
+            path, lim, grid, b_node=b_node,
+            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM)
         warm = _WarmStart(grid, b_hat, rel.b_bar)
         t_bound += time.perf_counter() - te
         t_prim = interval_times(grid.s, res.b)
@@ -362,7 +370,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
         new_grid = None
         if not (disc_gap <= tol or last):
-            mark = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget)
+            mark = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget,
+                                 REFINE_TARGET * tol * best_lb)
             new_grid = split(grid, path, mark)
             if new_grid is grid:
                 last, new_grid = True, None
@@ -391,7 +400,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             break
         if last:
             break
-        mark = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget)
+        mark = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget,
+                             REFINE_TARGET * tol * best_lb)
         new_grid = split(grid, path, mark)
         if new_grid is grid:
             break

@@ -59,6 +59,12 @@ SCAN_CHUNK = 256
 #: Lipschitz margins where the a-priori bounds are loose (e.g. one axis much stiffer).
 LB_ROUNDS = 4
 
+#: Rounds of the relaxation on a grid refined from an earlier one: its node bounds
+#: (:func:`optimal.bounds.node_bounds_on`) already play the part of the first round's
+#: optimum, and a second round moved the bound by less than 1e-5 (relative) on the
+#: S-bend and CAM benchmarks.
+LB_ROUNDS_WARM = 1
+
 #: Stop the lower-bound rounds when the bound improves by less than this (relative).
 LB_ROUND_IMPROVEMENT = 1e-4
 
@@ -69,3 +75,14 @@ LB_ROUND_IMPROVEMENT = 1e-4
 #: CAM benchmarks (``tests/bench/bench_arcs.py``), 0.6 took 6-7 rounds, 0.9 4-5, for
 #: grids of similar size.
 REFINE_GAP_SHARE = 0.9
+
+#: Share of its gap contribution that an interval keeps, summed over its two halves, after
+#: it is halved: the refinement's prediction model. Measured on the S-bend and CAM
+#: benchmarks (``tests/bench/bench_arcs.py``) with the energy rows of the lower bound:
+#: 0.3-0.4 (between the first-order 0.5 and the second-order 0.25).
+REFINE_RESIDUAL = 0.35
+
+#: A round refines so that the predicted gap lands at this fraction of the requested one
+#: (a margin for the prediction's error: a round that falls just short costs a whole
+#: further round, one that overshoots only some grid points).
+REFINE_TARGET = 0.7
