@@ -86,12 +86,16 @@ def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | Non
 
 def run_oracle(path: Path, limits: MachineLimits, bounds: str,
                progress: ProgressFn | None = None, *, tol: float | None = None,
-               holds=None):
+               holds=None, max_grid: int | None = None):
     """``optimal.solve`` on ``path`` under ``bounds`` with the imposed ``holds``
     (``reference.holds.imposed_holds``, the heuristic's ``plan.holds``); ``tol``: the
-    requested relative gap between its bounds (``None`` for the oracle's default)."""
+    requested relative gap between its bounds (``None`` for the oracle's default);
+    ``max_grid``: its interval budget (``None`` for the oracle's default; the pipeline
+    derives it from ``--max-grid-points``)."""
     import optimal
     options = {} if tol is None else {"tol": tol}
+    if max_grid is not None:
+        options["max_grid"] = max(int(max_grid), 2)
     return optimal.solve(path, limits, bounds=bounds, progress=progress, holds=holds,
                          **options)
 

@@ -153,6 +153,14 @@ def require_motion(program: Program, path: Path) -> None:
 ORACLE_GRID_WEIGHT = 100
 
 
+def oracle_intervals(max_grid_points: float) -> int:
+    """The oracle's interval budget under the size budget ``max_grid_points``: the
+    refinement may grow its grid to ``max_grid_points / ORACLE_GRID_WEIGHT`` intervals
+    (10^6 by default), the same weight :func:`require_budget` charges for its first grid.
+    """
+    return int(min(max_grid_points / ORACLE_GRID_WEIGHT, 2 ** 62))
+
+
 def require_budget(program: Program, path: Path,
                    max_grid_points: float = DEFAULT_MAX_GRID_POINTS, *,
                    oracle: bool = False) -> None:
@@ -314,7 +322,8 @@ def optimize_program(program: ProgramLike, machine: MachineLike = None, *,
     holds = imposed_holds(inp.program, path, inp.machine)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
                              progress=engines.prefixed(progress, "oracle: "), tol=tol,
-                             holds=holds)
+                             holds=holds,
+                             max_grid=oracle_intervals(max_grid_points))
     return OptimizeResult(program=inp.program.file, machine=inp.machine.name, bounds=bounds,
                           path=path, limits=inp.machine.limits, solution=sol)
 
@@ -358,7 +367,8 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     bounds, notes = engines.resolve_bounds(bounds, plan.bound_set)
     sol = engines.run_oracle(path, inp.machine.limits, bounds,
                              progress=engines.prefixed(progress, "oracle: "), tol=tol,
-                             holds=plan.holds)
+                             holds=plan.holds,
+                             max_grid=oracle_intervals(max_grid_points))
     c = compare(plan, sol, limits=inp.machine.limits, program=inp.program,
                 machine=inp.machine.name)
     if notes:

@@ -57,7 +57,8 @@ def fake_engines(monkeypatch):
             path = restrict_to_machine(prepare(program), machine.limits)
         return fake_plan(path, machine.limits)
 
-    def run_oracle(path, limits, bounds, progress=None, *, tol=None, holds=None):
+    def run_oracle(path, limits, bounds, progress=None, *, tol=None, holds=None,
+                   max_grid=None):
         return fake_solution(path, limits)
 
     monkeypatch.setattr(engines, "run_heuristic", run_heuristic)

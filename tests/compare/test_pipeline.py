@@ -17,6 +17,8 @@ from conftest import SMALL
 import compare
 from compare import cli, engines, pipeline
 from compare.export import comparison_dict, dumps, profile_samples, write_samples_csv
+from compare.pipeline import oracle_intervals
+from reference.core.budget import DEFAULT_MAX_GRID_POINTS
 from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import to_json_dict
@@ -74,15 +76,20 @@ def test_compare_program_runs_both_sides_on_one_path_object(small_program, monke
         seen["heuristic"] = path
         return real_h(program, machine, progress, path=path)
 
-    def oracle(path, limits, bounds, progress=None, *, tol=None, holds=None):
+    def oracle(path, limits, bounds, progress=None, *, tol=None, holds=None,
+               max_grid=None):
         seen["oracle"] = path
         seen["holds"] = holds
-        return real_o(path, limits, bounds, progress, tol=tol, holds=holds)
+        seen["max_grid"] = max_grid
+        return real_o(path, limits, bounds, progress, tol=tol, holds=holds,
+                      max_grid=max_grid)
 
     monkeypatch.setattr(engines, "run_heuristic", heuristic)
     monkeypatch.setattr(engines, "run_oracle", oracle)
     c = pipeline.compare_program(small_program, "default")
     assert seen["heuristic"] is not None and seen["heuristic"] is seen["oracle"]
+    # the oracle's interval budget follows the size budget (--max-grid-points)
+    assert seen["max_grid"] == oracle_intervals(DEFAULT_MAX_GRID_POINTS)
     assert c.path is seen["oracle"]
     # the oracle waits where the heuristic waits (the small program has G9 and G4 F0.2)
     h = seen["holds"]
