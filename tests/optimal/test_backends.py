@@ -75,6 +75,44 @@ def test_vectorised_and_sequential_sweeps_are_identical(problem):
     assert a.time_s == pytest.approx(b.time_s, rel=1e-10)
 
 
+@pytest.mark.parametrize("problem", PROBLEMS)
+def test_compiled_kernel_matches_the_sequential_sweep(problem):
+    """The compiled kernel (optimal.backends.kernel) is the same algorithm as the
+    pure-Python sequential sweep: equal to round-off on every case."""
+    a = solve_discrete(problem, "fast", {"method": "compiled"})
+    b = solve_discrete(problem, "fast", {"method": "sequential"})
+    assert a.message == "compiled"
+    np.testing.assert_allclose(a.b, b.b, rtol=1e-10, atol=1e-10 * float(np.max(b.b)))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_compiled_kernel_on_random_lattice_problems(seed):
+    """Random lattice-form problems (mixed forward/backward/vacuous rows, zero caps):
+    the kernel equals the sequential sweep, and its result is feasible."""
+    rng = np.random.default_rng(seed)
+    N, R = 300, 5
+    s = np.cumsum(np.r_[0.0, rng.uniform(0.1, 1.0, N)])
+    cap = rng.uniform(0.0, 100.0, N + 1)
+    cap[rng.random(N + 1) < 0.05] = 0.0
+    c1 = rng.normal(size=(N, R))
+    c2 = rng.normal(size=(N, R))
+    flip = c1 * c2 > 0
+    c2 = np.where(flip, -c2, c2)
+    c1[rng.random((N, R)) < 0.1] = 0.0
+    h = rng.uniform(0.0, 50.0, (N, R))
+    prob = DiscreteProblem(s=s, cap=cap, c1=c1, c2=c2, h=h, segment=np.zeros(N, int),
+                           row_axis=np.zeros(R, int), cap_code=np.zeros(N + 1, int),
+                           cap_axis=np.full(N + 1, -1), axes=("X",), accel_scale=1.0)
+    from optimal.backends.fast import sweep
+    a, _, how_a = sweep(prob, method="compiled")
+    b, _, how_b = sweep(prob, method="sequential")
+    assert (how_a, how_b) == ("compiled", "sequential")
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10 * float(np.max(b)))
+    lhs = c1 * a[:-1, None] + c2 * a[1:, None]
+    assert np.all(lhs <= h + 1e-9 * (np.abs(c1 * a[:-1, None]) + np.abs(c2 * a[1:, None]) + h))
+    assert np.all(a <= cap * (1 + 1e-12))
+
+
 @pytest.mark.parametrize("problem", PROBLEMS[:4])
 def test_sweep_result_is_feasible_and_maximal(problem):
     """Feasible, and no single node can be raised by 1e-6 relative without breaking a
