@@ -170,3 +170,38 @@ def split(grid: Grid, path: Path, mark: np.ndarray) -> Grid:
     seg = np.insert(grid.segment, idx + 1, grid.segment[idx])
     break_node = np.searchsorted(s, path.s_breaks)
     return Grid(s=s, segment=seg, break_node=break_node)
+
+
+def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces: int = 2) -> Grid:
+    """Split the marked intervals into ``pieces`` equal parts (a power of two).
+
+    Parameters
+    ----------
+    grid : Grid
+        Current grid.
+    path : Path
+        Its path.
+    mark : numpy.ndarray of bool, shape (N,)
+        Intervals to split.
+    pieces : int
+        2, 4, 8, ...
+
+    Returns
+    -------
+    Grid
+        The refined grid (the same object when nothing can be split).
+    """
+    if pieces < 2 or pieces & (pieces - 1):
+        raise ValueError(f"pieces = {pieces}: must be a power of two >= 2")
+    out = grid
+    marks = np.asarray(mark, bool)
+    for _ in range(pieces.bit_length() - 1):
+        new = split(out, path, marks)
+        if new is out:
+            break
+        # the halves of a marked interval are marked again
+        mid = 0.5 * (new.s[:-1] + new.s[1:])
+        parent = np.clip(np.searchsorted(out.s, mid) - 1, 0, out.n_intervals - 1)
+        marks = marks[parent]
+        out = new
+    return out

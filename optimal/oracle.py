@@ -35,7 +35,7 @@ from reference.core.rows import BlockRow, block_motion, block_rows
 
 from .backends import DEFAULT_BACKEND, get_backend
 from .bounds import lower_bound, node_bounds_on, verified_profile
-from .grid import Grid, initial_grid, split
+from .grid import Grid, initial_grid, subdivide
 from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, DiscreteProblem,
                       DiscreteResult, build_grid_problem, check_feed, interval_times)
 from .solution import IterationRecord, OptimalSolution
@@ -172,21 +172,30 @@ def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
 
 def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, lam: float,
                   report: ConstraintReport | None, budget: int, target_s: float
-                  ) -> np.ndarray:
-    """Intervals to halve: the fewest of the largest carriers of the gap whose halving is
-    predicted to bring the gap below ``target_s`` (a halved interval keeps about
-    :data:`REFINE_RESIDUAL` of its share), at most :data:`REFINE_GAP_SHARE` of it; plus
-    arc intervals of blocks where the checker needed time scaling."""
+                  ) -> tuple[np.ndarray, int]:
+    """Intervals to refine and into how many pieces (2 or 4).
+
+    The fewest of the largest carriers of the gap whose halving is predicted to bring
+    the gap below ``target_s`` (a halved interval keeps about :data:`REFINE_RESIDUAL` of
+    its share), at most :data:`REFINE_GAP_SHARE` of it; when halving that share is not
+    predicted to be enough, the carriers are quartered instead (keeping about
+    ``REFINE_RESIDUAL^2``), which saves a round. Plus the arc intervals of blocks where
+    the checker needed time scaling. At most ``budget`` new intervals.
+    """
     N = grid.n_intervals
     mark = np.zeros(N, bool)
+    pieces = 2
     d = np.maximum(lam * t_prim - t_lb, 0.0)
     disc = np.maximum(t_prim - t_lb, 0.0)
     total = float(disc.sum())
     if total > 0:
         order = np.argsort(-disc, kind="stable")
         cum = np.cumsum(disc[order])
-        need = (total - max(target_s, 0.0)) / (1.0 - REFINE_RESIDUAL)
-        share = min(max(need, 0.0), REFINE_GAP_SHARE * total)
+        excess = max(total - max(target_s, 0.0), 0.0)
+        share = excess / (1.0 - REFINE_RESIDUAL)
+        if share > REFINE_GAP_SHARE * total:
+            pieces = 4
+            share = min(excess / (1.0 - REFINE_RESIDUAL ** 2), REFINE_GAP_SHARE * total)
         n_take = int(np.searchsorted(cum, share)) + 1
         mark[order[:n_take]] = True
     scale_part = (lam - 1.0) * float(t_prim.sum())
@@ -205,13 +214,15 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
             blk = path.block[grid.segment]
             arc = path.radius[grid.segment] > 0
             mark |= np.isin(blk, list(bad_blocks)) & arc
+    if int(mark.sum()) * (pieces - 1) > budget:
+        pieces = 2
     n_mark = int(mark.sum())
     if n_mark > budget:
         idx = np.flatnonzero(mark)
         keep = idx[np.argsort(-d[idx], kind="stable")[:max(budget, 0)]]
         mark[:] = False
         mark[keep] = True
-    return mark
+    return mark, pieces
 
 
 def _dwell_part(holds: Holds) -> float:
@@ -322,6 +333,11 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         return _empty_solution(path, limits, t_start, backend, holds)
     check_feed(path)
     hold_t = holds.total_s          # every hold: a constant added to every motion's time
+    # grids, rows and bounds on the axes that move (exact: the others have zero
+    # derivatives and constrain nothing); the checker judges the profile on the path
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    lim = limits.for_axes(work.axes)
 
     grid = initial_grid(path, min(initial_intervals, max_grid))
     t_build = t_solve = t_check = t_bound = 0.0
@@ -335,7 +351,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     it = 0
     for it in range(1, max_iterations + 1):
         ta = time.perf_counter()
-        problem = build_grid_problem(path, lim, grid)
+        problem = build_grid_problem(work, lim, grid)
         tb = time.perf_counter()
         res = solve_fn(problem, backend_options)
         tc = time.perf_counter()
@@ -358,7 +374,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
                   if warm is not None else None)
         lb, t_lb, rel, b_hat = lower_bound(
-            path, lim, grid, b_node=b_node,
+            work, lim, grid, b_node=b_node,
             rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM)
         warm = _WarmStart(grid, b_hat, rel.b_bar)
         t_bound += time.perf_counter() - te
@@ -370,9 +386,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
         new_grid = None
         if not (disc_gap <= tol or last):
-            mark = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget,
-                                 REFINE_TARGET * tol * best_lb)
-            new_grid = split(grid, path, mark)
+            mark, pieces = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget,
+                                         REFINE_TARGET * tol * best_lb)
+            new_grid = subdivide(grid, path, mark, pieces)
             if new_grid is grid:
                 last, new_grid = True, None
         if new_grid is not None:
@@ -400,9 +416,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             break
         if last:
             break
-        mark = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget,
-                             REFINE_TARGET * tol * best_lb)
-        new_grid = split(grid, path, mark)
+        mark, pieces = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget,
+                                     REFINE_TARGET * tol * best_lb)
+        new_grid = subdivide(grid, path, mark, pieces)
         if new_grid is grid:
             break
         grid = new_grid

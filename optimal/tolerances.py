@@ -81,8 +81,9 @@ LB_ROUNDS_WARM = 1
 #: Stop the lower-bound rounds when the bound improves by less than this (relative).
 LB_ROUND_IMPROVEMENT = 1e-4
 
-#: Share of the bracket (sum over intervals of grid time minus lower-bound time) whose
-#: largest carriers are halved in each refinement round. With the second-order arc bound
+#: Largest share of the bracket (sum over intervals of grid time minus lower-bound time)
+#: whose largest carriers are refined in one round (halved, or quartered when halving
+#: that share is not predicted to reach the target: ``optimal.oracle._refine_marks``). With the second-order arc bound
 #: (:mod:`optimal.arc_bounds`) an interval's share falls about fourfold per halving, so
 #: refining nearly all of the bracket at once saves rounds: measured on the S-bend and
 #: CAM benchmarks (``tests/bench/bench_arcs.py``), 0.6 took 6-7 rounds, 0.9 4-5, for

@@ -760,6 +760,40 @@ class Path:
         return _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                              self.omega, self.theta0, idx, local, self.dradius, self.length)
 
+    def moving_axes(self) -> np.ndarray:
+        """Indices of the axes that move somewhere on the path (a non-zero in-plane or
+        linear component on some segment), in axis order."""
+        amp = (np.any(self.e1 != 0, axis=0) | np.any(self.e2 != 0, axis=0)
+               | np.any(self.d != 0, axis=0))
+        return np.flatnonzero(amp)
+
+    def restricted(self, axes: np.ndarray) -> "Path":
+        """The same path on a subset of its axes (columns ``axes``, in that order).
+
+        Exact when the dropped axes never move (:meth:`moving_axes`): their derivatives
+        are zero everywhere, so lengths, tangents, curvatures and every axis rule of the
+        kept axes are unchanged, and the dropped ones constrain nothing. Used by the
+        oracle to size its arrays by the axes that move (a 2-D contour on an XYZ machine
+        needs two columns, not three).
+
+        Parameters
+        ----------
+        axes : numpy.ndarray of int, shape (k,)
+            Column indices to keep.
+
+        Returns
+        -------
+        Path
+        """
+        ax = np.asarray(axes, dtype=np.int64)
+        return Path(axes=tuple(self.axes[i] for i in ax), geometry=self.geometry[ax],
+                    rotary=self.rotary[ax], origin=self.origin[:, ax], e1=self.e1[:, ax],
+                    e2=self.e2[:, ax], d=self.d[:, ax], radius=self.radius,
+                    omega=self.omega, theta0=self.theta0, length=self.length,
+                    block=self.block, kind=self.kind, feed=self.feed, rapid=self.rapid,
+                    stop=self.stop, stop_reason=self.stop_reason, blocks=self.blocks,
+                    source=self.source, dradius=self.dradius)
+
     def junction_tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """Tangents on both sides of every interior break.
 
