@@ -121,3 +121,30 @@ def test_path_evaluate_sides_at_breaks_and_junction_tangents():
     np.testing.assert_allclose(t_in[0, :3], [1, 0, 0])
     np.testing.assert_allclose(t_out[0, :3], [0, 1, 0])
     assert p.block_of(np.array([5.0, 15.0])).tolist() == [0, 1]
+
+
+def test_restricted_path_keeps_the_moving_axes_exactly():
+    """A 2-D contour on an XYZ path: ``moving_axes`` names X and Y (Z never moves),
+    and the restricted path has the same lengths, breaks and the very same X/Y values
+    of position, tangent, curvature and third derivative, junction tangents included."""
+    from reference.nc import parse_text
+    from reference.machine import load_machine
+    from reference.prepare import build_path
+
+    text = ("G90 G17 G1 X10 Y0 F3000\nG3 X20 Y10 CR=10\nG1 X20 Y30\n"
+            "G2 X10 Y40 CR=10\nG1 X0 Y40\nM30\n")
+    path = build_path(parse_text(text, "t.mpf"), load_machine(None))
+    mov = path.moving_axes()
+    assert [path.axes[i] for i in mov] == ["X", "Y"]
+    sub = path.restricted(mov)
+    assert sub.axes == ("X", "Y")
+    np.testing.assert_array_equal(sub.s_breaks, path.s_breaks)
+    s = np.linspace(0.0, path.total_length, 301)
+    for full, part in zip(path.evaluate(s), sub.evaluate(s)):
+        np.testing.assert_array_equal(part, full[:, mov])
+        # the dropped columns are constant (zero derivatives)
+    _, dq, ddq, d3 = path.evaluate(s)
+    rest = np.setdiff1d(np.arange(path.n_axes), mov)
+    assert not np.any(dq[:, rest]) and not np.any(ddq[:, rest]) and not np.any(d3[:, rest])
+    for full, part in zip(path.junction_tangents(), sub.junction_tangents()):
+        np.testing.assert_array_equal(part, full[:, mov])
