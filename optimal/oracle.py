@@ -64,10 +64,12 @@ class _Candidate:
         Duration of the verified profile plus the imposed holds, s.
     grid : Grid
         The grid of that round.
-    problem : DiscreteProblem
-        Its grid problem.
+    labels : tuple[str, ...]
+        The constraint active on each interval of its grid problem
+        (:func:`active_labels`; the problem itself is not kept: it is the largest object
+        of a round).
     result : DiscreteResult
-        The backend's solution of ``problem``.
+        The backend's solution of the grid problem.
     profile : Profile
         The grid profile after time scaling (the one ``check_profile`` accepted),
         without the holds.
@@ -81,7 +83,7 @@ class _Candidate:
 
     upper_bound_s: float
     grid: Grid
-    problem: DiscreteProblem
+    labels: tuple[str, ...]
     result: DiscreteResult
     profile: Profile
     time_scale: float
@@ -350,6 +352,19 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     frac = 0.0
     it = 0
     for it in range(1, max_iterations + 1):
+        # lower bound first (the relaxation is the largest object of a round; it is
+        # gone before the grid problem is built): while the grid optimum is farther
+        # than tol from it, the gap cannot be met and the checker can wait
+        problem = res = None
+        te = time.perf_counter()
+        b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
+                  if warm is not None else None)
+        lb, t_lb, rel, b_hat = lower_bound(
+            work, lim, grid, b_node=b_node,
+            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM)
+        warm = _WarmStart(grid, b_hat, rel.b_bar)
+        del rel, b_node
+        t_bound += time.perf_counter() - te
         ta = time.perf_counter()
         problem = build_grid_problem(work, lim, grid)
         tb = time.perf_counter()
@@ -368,16 +383,6 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             status = SolveStatus.SOLVER_ERROR
             msg = f"backend {backend!r}: {res.status} ({res.message})"
             break
-        # lower bound first: while the grid optimum itself is farther than tol from it,
-        # the gap cannot be met and the checker (the expensive part) can wait
-        te = time.perf_counter()
-        b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
-                  if warm is not None else None)
-        lb, t_lb, rel, b_hat = lower_bound(
-            work, lim, grid, b_node=b_node,
-            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM)
-        warm = _WarmStart(grid, b_hat, rel.b_bar)
-        t_bound += time.perf_counter() - te
         t_prim = interval_times(grid.s, res.b)
         t_grid = float(t_prim.sum()) + hold_t
         best_lb = max(best_lb, lb + hold_t)
@@ -405,7 +410,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         t_check += time.perf_counter() - td
         ub = prof.duration + hold_t
         if best is None or ub < best.upper_bound_s:
-            best = _Candidate(upper_bound_s=ub, grid=grid, problem=problem, result=res,
+            best = _Candidate(upper_bound_s=ub, grid=grid,
+                              labels=active_labels(problem, res.b), result=res,
                               profile=prof, time_scale=lam, report=report,
                               interval_times_s=t_prim)
         history.append(IterationRecord(grid.n_points, lb + hold_t, ub, t_grid, lam))
@@ -437,7 +443,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     prof_h = with_holds(best.profile, path, holds)
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
-    labels = active_labels(best.problem, best.result.b)
+    labels = best.labels
     rows = _block_rows(path, g, prof_h, labels, lam * best.interval_times_s, holds)
     gap = (ub - best_lb) / best_lb if best_lb > 0 else math.inf
     if status == SolveStatus.SOLVER_ERROR:
