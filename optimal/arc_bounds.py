@@ -70,6 +70,8 @@ import numpy as np
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays
 
+from .tolerances import ENVELOPE_CHUNK
+
 #: Divisor of ``sup|q''_j| M D^2`` in the remainder of an interval-exact row:
 #: ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 8`` (module docstring).
 REMAINDER_DIVISOR = 8.0
@@ -166,7 +168,7 @@ def _time_under(b0, r, beta_lo, beta_hi, B, t1):
     return part + np.maximum(t1 - te, 0.0) / np.sqrt(B)
 
 
-def envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
+def _envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
                    A: np.ndarray, dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
                    hi: np.ndarray, k3: np.ndarray, iterations: int = 8) -> np.ndarray:
     """Lower estimate of the time on every interval from one-axis comparison envelopes.
@@ -380,7 +382,7 @@ class LowerEnvelopes:
     g_b: np.ndarray       # g of the backward envelope, mm/s^2
 
 
-def lower_envelopes(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
+def _lower_envelopes(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
                     dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
                     hi: np.ndarray, k3: np.ndarray, slope: np.ndarray,
                     iterations: int = 8) -> LowerEnvelopes:
@@ -464,3 +466,45 @@ def lower_envelopes(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np
     phb[ok], psb[ok] = _phi_psi(kbo, d - ts)
     return LowerEnvelopes(ok, D, phf, psf, np.where(ok, gf1, 0.0), phb, psb,
                           np.where(ok, gb1, 0.0))
+
+
+# --------------------------------------------------------------------------- chunking
+def _chunked(fn, D, per_interval, shared, kwargs):
+    """Run the element-wise ``fn`` on chunks of :data:`ENVELOPE_CHUNK` intervals: its
+    temporaries are a few dozen ``(chunk, n + 1)`` arrays, so the memory it needs stays
+    bounded whatever the grid size (the results are the same: every interval is
+    computed on its own)."""
+    N = D.size
+    if N <= ENVELOPE_CHUNK:
+        return fn(D, *per_interval, *shared, **kwargs), None
+    parts = [fn(D[lo:lo + ENVELOPE_CHUNK], *(a[lo:lo + ENVELOPE_CHUNK] for a in per_interval),
+                *shared, **kwargs) for lo in range(0, N, ENVELOPE_CHUNK)]
+    return None, parts
+
+
+def envelope_times(D: np.ndarray, b0: np.ndarray, b1: np.ndarray, B: np.ndarray,
+                   A: np.ndarray, dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
+                   hi: np.ndarray, k3: np.ndarray, iterations: int = 8) -> np.ndarray:
+    """Lower estimate of the time on every interval from one-axis comparison envelopes
+    (the argument, parameters and returns: :func:`_envelope_times`), in chunks of
+    :data:`ENVELOPE_CHUNK` intervals."""
+    one, parts = _chunked(lambda d, x0, x1, b, dm, ddm, l, h, k, a: _envelope_times(
+        d, x0, x1, b, a, dm, ddm, l, h, k, iterations), D,
+        (b0, b1, B, dq_mid, ddq_mid, lo, hi, k3), (A,), {})
+    return one if parts is None else np.concatenate(parts)
+
+
+def lower_envelopes(D: np.ndarray, guide0: np.ndarray, guide1: np.ndarray, A: np.ndarray,
+                    dq_mid: np.ndarray, ddq_mid: np.ndarray, lo: np.ndarray,
+                    hi: np.ndarray, k3: np.ndarray, slope: np.ndarray,
+                    iterations: int = 8) -> "LowerEnvelopes":
+    """Choose the lower envelopes and the split of every interval
+    (:func:`_lower_envelopes` has the argument), in chunks of :data:`ENVELOPE_CHUNK`
+    intervals."""
+    one, parts = _chunked(lambda d, g0, g1, dm, ddm, l, h, k, m, a: _lower_envelopes(
+        d, g0, g1, a, dm, ddm, l, h, k, m, iterations), D,
+        (guide0, guide1, dq_mid, ddq_mid, lo, hi, k3, slope), (A,), {})
+    if parts is None:
+        return one
+    return LowerEnvelopes(*(np.concatenate([getattr(p, f) for p in parts])
+                            for f in LowerEnvelopes.__slots__))

@@ -477,15 +477,24 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
 def _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, kind):
     N = grid.n_intervals
     if cols_c1:
-        c1 = np.stack(cols_c1, axis=1)
-        c2 = np.stack(cols_c2, axis=1)
-        h = np.stack(cols_h, axis=1)
+        # column by column into one array each, releasing every column as it is copied
+        # (the rows are the largest arrays of a round)
+        out = []
+        for cols in (cols_c1, cols_c2, cols_h):
+            arr = np.empty((N, len(cols)))
+            for r in range(len(cols)):
+                arr[:, r] = cols[r]
+                cols[r] = None
+            cols.clear()
+            out.append(arr)
+        c1, c2, h = out
     else:
         c1 = c2 = h = np.zeros((N, 0))
     # rows with both coefficients <= 0 can never bind (b >= 0, h >= 0): blank them
     vac = (c1 <= 0) & (c2 <= 0)
-    c1 = np.where(vac, 0.0, c1)
-    c2 = np.where(vac, 0.0, c2)
+    c1[vac] = 0.0
+    c2[vac] = 0.0
+    del vac
     if not np.all(np.isfinite(caps.cap)):
         k = int(np.flatnonzero(~np.isfinite(caps.cap))[0])
         raise InfeasibleError(f"no finite speed limit at s = {grid.s[k]:.6g} mm "
