@@ -358,6 +358,12 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
         ``limits`` lacks an axis of the path.
     """
     lim = limits.for_axes(path.axes)
+    # judge the axes that move (exact: the others have zero derivatives everywhere, so
+    # every ratio of theirs is 0); a 2-D contour on an XYZ machine samples two columns
+    moving = path.moving_axes()
+    if 0 < moving.size < path.n_axes:
+        path = path.restricted(moving)
+        lim = limits.for_axes(path.axes)
     L = path.total_length
     if profile.s.size and (abs(profile.s[0]) > POS_TOL_MM or
                            abs(profile.s[-1] - L) > POS_TOL_MM * max(1.0, L)):
