@@ -1,9 +1,10 @@
 """The reference planner: composition of the stages into a :class:`ReferencePlan`.
 
-Stage order (spec/sinumerik-model.md 12.3; TRC, tangential control and rounding come
-in a later issue, G641..G645 behave as G64 and the stage trace says so):
+Stage order (spec/sinumerik-model.md 12.3; TRC and tangential control come in a later
+issue):
 
-``build_path`` (program -> path, :mod:`reference.prepare`) -> ``stops`` (acceleration
+``build_path`` (program -> path, :mod:`reference.prepare`, corner rounding of
+G641..G645 included, :mod:`reference.rounding`; the trace lists what it decided) -> ``stops`` (acceleration
 modes, forced stops) -> ``limit curves`` (segment caps, tangential limits) -> ``corners``
 (junction limits) -> ``lookahead`` (horizon caps, planning units, passes) -> ``profiles``
 (unit profiles) -> ``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation``
@@ -47,7 +48,25 @@ from .stops import ACCEL_MODES, SegmentModes, segment_modes
 
 Progress = Callable[[str, float], None]
 
-_ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
+
+
+def rounding_note(path: Path) -> str:
+    """Stage-trace note of the rounding stage (:func:`reference.rounding.round_corners`):
+    corners rounded per mode and, per reason, the corners left sharp."""
+    table = path.rounding
+    if table is None or table.n == 0:
+        return "no corner in G641..G645"
+    ins = table.inserted
+    modes = sorted(set(table.mode))
+    per_mode = ", ".join(f"{md} {sum(1 for i in np.flatnonzero(ins) if table.mode[i] == md)}"
+                         f"/{sum(1 for x in table.mode if x == md)}" for md in modes)
+    left = {}
+    for i in np.flatnonzero(~ins):
+        left[table.reason_text(i)] = left.get(table.reason_text(i), 0) + 1
+    why = "; ".join(f"{n} {r}" for r, n in sorted(left.items(), key=lambda x: -x[1]))
+    return (f"{int(ins.sum())} of {table.n} corners in G641..G645 rounded by tangent arcs "
+            f"({per_mode}; {float(table.length_mm.sum()):.6g} mm of rounding)"
+            + (f"; no rounding block: {why}" if why else ""))
 
 
 # ----------------------------------------------------------------- composition
@@ -112,11 +131,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     m = path.n_segments
     trace.append(("prepare", f"{len(path.blocks)} blocks, {m} segments, "
                              f"{path.total_length:.6g} mm"))
-    n_round = sum(1 for b in program.blocks if b.continuous_mode in _ROUNDING_MODES
-                  and b.motion is not None)
-    trace.append(("rounding", "not modelled yet: G641..G645 behave as G64 "
-                              f"({n_round} blocks in G641..G645; corners passed by the G64 "
-                              "rule or exact stop)"))
+    trace.append(("rounding", rounding_note(path)))
 
     report_progress("stops", 0.1)
     modes = segment_modes(program, path, machine)
