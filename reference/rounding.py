@@ -12,7 +12,8 @@ line and the rounding; the next block's span starts where the rounding ends.
 
 Per corner (break between two consecutive segments), in this order (5.2, 8):
 
-1. the mode of the block before the corner is G641..G645, else nothing is recorded;
+1. the block before the corner programs RND (non-modal) or RNDM (modal radius > 0) or is
+   in G641..G645, else nothing is recorded;
 2. no rounding where the axes stop anyway (5.2 group 1): a stop at the break (exact stop,
    auxiliary output before motion, M0, ...), a block without path motion between, a
    change of acceleration mode (BRISK/SOFT), geometry axes moving in one block only;
@@ -29,6 +30,8 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      tolerances times MD20560 G0_TOLERANCE_FACTOR (5.7);
    * G644 (thousands digit): 0xxx/4xxx MD33100 per axis, 1xxx/5xxx ADIS/ADISPOS
      (CTOL ignored, 5.6); 2xxx/3xxx not modelled yet (named);
+   * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
+     radius ``R`` is what RND defines; no speed check: it is contour, not smoothing);
    * clamp: ``d <= c min(L1, L2)`` with ``c = rounding_length_clamp`` (0.5: "the
      rounding distance cannot exceed half the length of the original participating
      blocks", the G644 excerpt; 5.3); ``d`` at or below MIN_SEGMENT_LENGTH_MM: too small;
@@ -67,6 +70,10 @@ ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
 #: Modes that round only where G64 would have to reduce the speed (4.3).
 _OVERLOAD_CHECKED = ("G641", "G642", "G645")
 
+#: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
+_RADIUS_MODES = ("RND", "RNDM")
+_ALL_MODES = ROUNDING_MODES + _RADIUS_MODES
+
 _LINE = KIND_CODES.index("line")
 _ROUNDING = KIND_CODES.index("rounding")
 
@@ -74,6 +81,41 @@ _ROUNDING = KIND_CODES.index("rounding")
 def _digit(value: int, place: int) -> int:
     """Decimal digit ``place`` (0 = units) of a machine-data digit map."""
     return (int(value) // 10 ** place) % 10
+
+
+def _block_attributes(program: Program, default_accel: str) -> dict[str, np.ndarray]:
+    """Per program block, shape (nb,): the mode governing the corner at its end (RND,
+    RNDM, else the group-10 mode), acceleration mode, ADIS, ADISPOS, CTOL (``nan`` if
+    unset) and programmed rounding radius (mm).
+
+    Consecutive blocks share one :class:`~reference.nc.program.Modal` object while
+    nothing modal changes, so the modal values are read once per distinct object.
+    """
+    blocks = program.blocks
+    nb = len(blocks)
+    index: dict[int, int] = {}
+    uniq = []
+    code = np.empty(nb, dtype=np.int64)
+    for i, blk in enumerate(blocks):
+        md = blk.modal
+        j = index.get(id(md))
+        if j is None:
+            j = index[id(md)] = len(uniq)
+            uniq.append(md)
+        code[i] = j
+    rnd = np.array([blk.extra.rnd_mm for blk in blocks], dtype=np.float64)
+    mode = np.array([md.continuous_mode for md in uniq], dtype=object)[code]
+    rndm = np.array([md.rndm_mm for md in uniq], dtype=np.float64)[code]
+    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode))
+    return {
+        "mode": mode,
+        "accel": np.array([md.accel_mode or default_accel for md in uniq], dtype=object)[code],
+        "adis": np.array([md.adis_mm for md in uniq], dtype=np.float64)[code],
+        "adispos": np.array([md.adispos_mm for md in uniq], dtype=np.float64)[code],
+        "ctol": np.array([np.nan if md.contour_tol_mm is None else md.contour_tol_mm
+                          for md in uniq], dtype=np.float64)[code],
+        "radius": np.where(rnd > 0, rnd, rndm),
+    }
 
 
 def round_corners(path: Path, program: Program, machine: Machine) -> Path:
@@ -99,14 +141,16 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     blocks = program.blocks
     if m < 2:
         return path
-    mode_seg = [blocks[int(b)].continuous_mode for b in path.block]
-    cand = np.flatnonzero([mode_seg[j] in ROUNDING_MODES for j in range(m - 1)])
+    ch = machine.channel
+    attrs = _block_attributes(program, ch.acceleration_mode)
+    cand = np.flatnonzero(np.isin(attrs["mode"][path.block[:-1]], _ALL_MODES))
     if cand.size == 0:
         return path
     a, b = cand, cand + 1                 # segments before and after each corner
     brk = cand + 1                        # break index of each corner
     ka, kb = path.block[a], path.block[b]
-    mode = tuple(mode_seg[j] for j in a)
+    mode_arr = attrs["mode"][ka]
+    mode = tuple(mode_arr)
     reason = np.full(a.size, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
@@ -116,10 +160,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     # --- 5.2 group 1: the axes stop between the blocks anyway -----------------------
     decide(path.stop[brk], "stop between the blocks")
     decide(kb - ka > 1, "block without path motion between")
-    ch = machine.channel
-    acc = np.array([(blocks[int(x)].accel_mode or ch.acceleration_mode) != (
-        blocks[int(y)].accel_mode or ch.acceleration_mode) for x, y in zip(ka, kb)], bool)
-    decide(acc, "acceleration mode change (BRISK/SOFT)")
+    decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
     is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
     da, db = path.d[a], path.d[b]
     geo_a = np.where(path.kind[a] == _LINE, np.linalg.norm(da[:, geo], axis=1) > MOVING_AXIS_TOL,
@@ -137,7 +178,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
     # --- rounding distance by mode ----------------------------------------------------
     theta = deflection_angle(t1, t2)
-    d = _distances(path, program, machine, a, b, ka, mode, t1, t2, theta, decide)
+    d = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, decide)
     lens = np.minimum(path.length[a], path.length[b])
     cap = ch.rounding_length_clamp * lens
     clamped = d > cap
@@ -160,12 +201,11 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
             v_axis = np.min(lim.v_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
                             axis=1)
         v_prog = np.minimum(feed, v_axis)
-        soft = np.array([(blocks[int(x)].accel_mode or ch.acceleration_mode) == "SOFT"
-                         for x in ka[o]], bool)
+        soft = attrs["accel"][ka[o]] == "SOFT"
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], radius[o],
                                                         lim, machine.limits.t_ipo_s, soft))
-        ovl = np.array([mode[i] in _OVERLOAD_CHECKED for i in o]) & (
-            not ch.ignore_ovl_factor_for_adis)
+        ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
+        radius_mode = np.isin(mode_arr[o], _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
         sub[o] = ovl & (v64[o] >= v_prog)
         decide(sub, "G64 passes the corner without reduction (overload factor)")
@@ -174,7 +214,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
             a_path = np.min(lim.a_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
                             axis=1)
         sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, radius[o] * theta[o], 2 * d[o])
-                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0))
+                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0)) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
     ins = reason == 0
@@ -187,41 +227,37 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], table)
 
 
-def _distances(path: Path, program: Program, machine: Machine, a: np.ndarray,
-               b: np.ndarray, ka: np.ndarray, mode: tuple[str, ...], t1: np.ndarray,
+def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
+               b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
                t2: np.ndarray, theta: np.ndarray, decide) -> np.ndarray:
     """Tangent distance per corner by mode, before the block-length clamp, mm."""
-    blocks = program.blocks
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
     ra, rb = path.rapid[a], path.rapid[b]
-    adis = np.array([blocks[int(x)].adis_mm for x in ka])
-    adispos = np.array([blocks[int(x)].adispos_mm for x in ka])
-    ctol = np.array([np.nan if blocks[int(x)].contour_tol_mm is None
-                     else blocks[int(x)].contour_tol_mm for x in ka])
+    adis, adispos, ctol = attrs["adis"][ka], attrs["adispos"][ka], attrs["ctol"][ka]
+    radius = attrs["radius"][ka]
     # how each corner's distance is found: "adis", "tol" (MD33100 per axis and maybe a
-    # contour tolerance), or "none" (not modelled)
-    how = []
+    # contour tolerance), "radius" (RND/RNDM) or "none" (not modelled)
+    how = np.full(k, "none", dtype=object)
     contour = np.full(k, np.inf)
     use_axis_tol = np.ones(k, bool)
-    for i, md in enumerate(mode):
-        if md == "G641":
-            how.append("adis")
-        elif md == "G644":
-            dig = _digit(sm, 3)
-            how.append("adis" if dig in (1, 5) else "tol" if dig in (0, 4) else "none")
-        else:
-            dig = _digit(sm, 0 if md == "G643" else 1)
-            if dig == 4:
-                how.append("adis")
-                continue
-            how.append("tol")
-            if not np.isnan(ctol[i]):          # CTOL overrides MD/SD values (5.7)
-                contour[i], use_axis_tol[i] = ctol[i], False
-            elif dig in (1, 3):
-                contour[i], use_axis_tol[i] = ch.smooth_contour_tol_mm, False
-    how = np.array(how)
+    how[np.isin(mode, _RADIUS_MODES)] = "radius"
+    how[mode == "G641"] = "adis"
+    dig644 = _digit(sm, 3)
+    how[mode == "G644"] = "adis" if dig644 in (1, 5) else "tol" if dig644 in (0, 4) else "none"
+    for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
+        sel = mode == md
+        dig = _digit(sm, place)
+        if dig == 4:
+            how[sel] = "adis"
+            continue
+        how[sel] = "tol"
+        has_ctol = sel & ~np.isnan(ctol)           # CTOL overrides MD/SD values (5.7)
+        contour[has_ctol], use_axis_tol[has_ctol] = ctol[has_ctol], False
+        if dig in (1, 3):
+            rest = sel & np.isnan(ctol)
+            contour[rest], use_axis_tol[rest] = ch.smooth_contour_tol_mm, False
     d = np.zeros(k)
     # G641-type: ADIS for G1/G2/G3, ADISPOS for G0, the smaller if one block is G0 (5.3)
     dist = np.where(ra & rb, adispos, np.where(ra | rb, np.minimum(adis, adispos), adis))
@@ -239,6 +275,8 @@ def _distances(path: Path, program: Program, machine: Machine, a: np.ndarray,
         dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
         d = np.where(is_tol & (dev > 0), distance_for_deviation(theta, np.maximum(dev, 0.0)), d)
+    # RND/RNDM: the programmed radius, d = R tan(theta/2)
+    d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
     decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
     return np.where(np.isfinite(d), d, 0.0)
 
@@ -360,17 +398,15 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     for k in np.flatnonzero(path.stop):
         reasons[int(first[k])] = path.stop_reason[k]
     sb = np.concatenate(([0.0], np.cumsum(new["length"])))
-    spans = []
-    for sp in path.blocks:
-        if sp.n_segments:
-            j0, j1 = sp.first_segment, sp.first_segment + sp.n_segments
-            f, e = int(first[j0]), int(first[j1])
-        else:
-            f = e = int(first[sp.first_segment])
-        spans.append(BlockSpan(block=sp.block, line=sp.line, label=sp.label, kind=sp.kind,
-                               s_start=float(sb[f]), s_end=float(sb[e]), first_segment=f,
-                               n_segments=e - f, feed_mm_s=sp.feed_mm_s,
-                               stop_reason=sp.stop_reason, dwell_s=sp.dwell_s))
+    # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
+    j0 = np.array([sp.first_segment for sp in path.blocks], dtype=np.int64)
+    j1 = j0 + np.array([sp.n_segments for sp in path.blocks], dtype=np.int64)
+    f, e = first[j0], first[j1]
+    # positional arguments: 10^5 spans, and keywords cost a third more
+    spans = [BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi,
+                       sp.feed_mm_s, sp.stop_reason, sp.dwell_s)
+             for sp, s0, s1, fi, ei in zip(path.blocks, sb[f].tolist(), sb[e].tolist(),
+                                           f.tolist(), e.tolist())]
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
                 rapid=rapid, stop=np.array([bool(r) for r in reasons]),
                 stop_reason=tuple(reasons), blocks=tuple(spans), source=path.source,

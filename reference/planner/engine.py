@@ -303,6 +303,22 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
 
 
 # ----------------------------------------------------------------- rows
+def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Index of the first largest value in each contiguous group ``[lo, lo + n)``.
+
+    Vectorised (a rounded program has one multi-segment block per corner: 10^5 of them
+    must not cost a Python loop each). ``n >= 1``; shapes (g,) -> (g,).
+    """
+    starts = np.cumsum(n) - n
+    idx = np.repeat(lo, n) + (np.arange(int(n.sum())) - np.repeat(starts, n))
+    vals = values[idx]
+    top = np.maximum.reduceat(vals, starts)
+    hit = np.flatnonzero(vals == np.repeat(top, n))
+    group = np.repeat(np.arange(lo.size), n)[hit]
+    _, first_hit = np.unique(group, return_index=True)
+    return idx[hit[first_hit]]
+
+
 def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits, junc,
           units: Units, speeds: NodeSpeeds, prof: UnitProfiles, profile: Profile,
           horizon: np.ndarray, holds: Holds) -> tuple[BlockTable, CornerTable]:
@@ -365,10 +381,7 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     main = first.copy()
     multi = np.flatnonzero(nseg > 1)
     if multi.size:
-        seg_time = profile.segment_times(path)
-        for i in multi:
-            lo, hi = first[i], first[i] + nseg[i]
-            main[i] = lo + int(np.argmax(seg_time[lo:hi]))
+        main[multi] = _group_argmax(profile.segment_times(path), first[multi], nseg[multi])
     mainc = np.clip(main, 0, max(m - 1, 0))
     t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
     kb = np.clip(first, 0, m)
@@ -377,8 +390,8 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     v_pk = v_entry.copy()
     if m:
         v_pk[moving] = v_peak_seg[mainc[moving]]
-        for i in multi:
-            v_pk[i] = float(np.max(v_peak_seg[first[i]:first[i] + nseg[i]]))
+        if multi.size:
+            v_pk[multi] = v_peak_seg[_group_argmax(v_peak_seg, first[multi], nseg[multi])]
     stop_here = modes.stop[kb] & (t_blk > 0)
     cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
     cause_code = np.where(moving | stop_here, cause_code, -1)
