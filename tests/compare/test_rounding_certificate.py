@@ -39,3 +39,18 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
     assert lb <= ub <= lb * (1 + 2e-3) + 1e-12
     assert not ref["violations"], ref["violations"]
     assert t_ref >= lb
+
+
+def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, capsys) -> None:
+    """Issue 13 item 5: inspect lists length, deviation and mode per corner, and why no
+    rounding was inserted where none was."""
+    prog = tmp_path / "sq.mpf"
+    prog.write_text("G90 G641 ADIS=0.5 BRISK F3000\nG1 X0 Y0\nX50\nY50 G9\nX0\nY0\n")
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    assert "rounding: 2 of 3 corners in G641..G645 rounded" in out
+    rows = [r.split() for r in out.splitlines() if r.strip().startswith(("3/4", "4/5", "5/6"))]
+    # 90 degree corners, ADIS 0.5: d = R = 0.5, length pi/4, deviation 0.5 (sqrt 2 - 1)
+    assert rows[0][:6] == ["3/4", "G641", "0.5000", "0.7854", "0.20711", "0.5000"]
+    assert rows[0][6] == "rounded"
+    assert " ".join(rows[1][6:]) == "none: stop between the blocks"

@@ -272,3 +272,100 @@ def test_negative_rnd_is_bad_input():
     from reference.core.errors import NCSyntaxError
     with pytest.raises(NCSyntaxError, match="RND=-1"):
         parse_text("G1 X10 RND=-1\n")
+
+
+# ------------------------------------------------------------------ seeded polylines
+@pytest.mark.parametrize("seed", range(6))
+def test_seeded_polylines_round_into_a_continuous_path(seed):
+    """Random corners (1..179 degrees, some reversals and G0 blocks), every mode: the
+    rounded path is continuous in position and tangent at every rounding, each block
+    keeps one span, no line is shortened by more than its length, and the rounded path
+    is never longer than the programmed one."""
+    rng = np.random.default_rng(seed)
+    modes = ["G641 ADIS=0.3 ADISPOS=0.6", "G642", "G642 CTOL=0.1", "G643", "G645",
+             "G644", "G64 RNDM=0.4"]
+    lines = [f"G90 BRISK {modes[seed % len(modes)]} F5000", "G1 X0 Y0 Z0"]
+    x = y = z = 0.0
+    for _ in range(60):
+        x, y = x + rng.uniform(-3, 3), y + rng.uniform(-3, 3)
+        if rng.random() < 0.1:
+            z += rng.uniform(-1, 1)
+        word = "G0" if rng.random() < 0.15 else "G1"
+        lines.append(f"{word} X{x:.4f} Y{y:.4f} Z{z:.4f}")
+    prog = parse_text("\n".join(lines) + "\n")
+    mach = machine(IGNORE_OVL_FACTOR_FOR_ADIS=True)
+    path = build_path(prog, mach)
+    programmed = build_path(parse_text("\n".join(lines).replace(modes[seed % len(modes)],
+                                                                "G64") + "\n"), mach)
+    assert [s.block for s in path.blocks] == [b.index for b in prog.blocks]
+    _check_tangent_continuity(path)
+    for k in range(path.n_segments - 1):
+        np.testing.assert_allclose(path.segment(k).end, path.segment(k + 1).start,
+                                   atol=1e-9)
+    assert path.total_length <= programmed.total_length + 1e-9
+    t = path.rounding
+    assert t is not None and t.n > 0
+    assert t.inserted.any() and np.all(t.distance_mm[t.inserted] > 0)
+
+
+def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
+    """spec 5.3: "every block, the rounding block included, needs at least one
+    interpolation point, so the path velocity is limited to about ADIS / T_ipo". A 20
+    degree corner, ADIS = 0.01 mm: R = 0.01 / tan(10 deg), the rounding is R * 20 deg =
+    0.0198 mm long, so at most 0.0198 mm / 4 ms = 4.95 mm/s inside it (the centripetal
+    limit, sqrt(0.75 * 2000 * R), is near 9 mm/s and does not bind)."""
+    d = copy.deepcopy(BASE)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = 1.0          # G64 would stop: the rounding is taken
+    mach = machine_from_dict(d)
+    y = 50.0 * math.tan(math.radians(20.0))
+    prog = parse_text(f"G90 G641 ADIS=0.01 BRISK F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y{y!r}\n")
+    path = build_path(prog, mach)
+    assert list(path.rounding.inserted) == [True]
+    R = 0.01 / math.tan(math.radians(10.0))
+    length = R * math.radians(20.0)
+    assert path.rounding.length_mm[0] == pytest.approx(length, rel=1e-9)
+    k = int(np.flatnonzero(path.kind == ROUNDING)[0])
+    res = plan(prog, mach, path=path)
+    s = np.linspace(path.s_breaks[k], path.s_breaks[k + 1], 201)
+    v = res.profile.state(res.profile.time_at(s))[1]
+    assert v.max() <= length / 0.004 * (1 + 1e-9)
+    assert v.max() == pytest.approx(length / 0.004, rel=1e-6)
+
+
+@pytest.mark.parametrize("mode, smoothing, expect", [
+    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given"
+    ("G644 ADIS=0.4", 1000, ("distance", 0.4)),
+    ("G644 ADIS=0.4", 5000, ("distance", 0.4)),
+    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL"
+    ("G644 ADIS=0.4", 0, ("deviation", 0.01 * math.sqrt(2))),
+    # 2xxx / 3xxx (frequency, maximum dynamics) are named as not modelled
+    ("G644 ADIS=0.4", 3000, ("reason", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")),
+    # spec 5.4 table, value 4 [M]: "rounding distance from ADIS/ADISPOS, as for G641"
+    ("G642 ADIS=0.3", 40, ("distance", 0.3)),
+    ("G643 ADIS=0.3", 4, ("distance", 0.3)),
+    # units digit configures G643, tens digit G642: 10 leaves G643 on MD33100
+    ("G643", 10, ("deviation", 0.01 * math.sqrt(2))),
+])
+def test_smoothing_mode_digits(mode, smoothing, expect):
+    """spec 5.9 "MD20480 SMOOTHING_MODE digit map": G643 by the units digit, G642 by the
+    tens digit, G644 by the thousands digit."""
+    _, _, path = rounded(square(mode), machine(SMOOTHING_MODE=smoothing))
+    t = path.rounding
+    what, value = expect
+    if what == "reason":
+        assert reasons(path) == [value] * 3
+    elif what == "distance":
+        np.testing.assert_allclose(t.distance_mm, value, rtol=1e-12)
+    else:
+        np.testing.assert_allclose(t.deviation_mm, value, rtol=1e-12)
+
+
+def test_g0_tolerance_factor_widens_the_g642_tolerance():
+    """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
+    factor 3 x COMPRESS_POS_TOL)"."""
+    text = "G90 G642 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    _, _, path = rounded(text, machine(G0_TOLERANCE_FACTOR=3.0))
+    np.testing.assert_allclose(path.rounding.deviation_mm[0], 3 * 0.01 * math.sqrt(2),
+                               rtol=1e-12)
+    np.testing.assert_allclose(path.rounding.deviation_mm[1], 0.01 * math.sqrt(2), rtol=1e-12)
