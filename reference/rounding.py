@@ -41,7 +41,7 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    TRUE skips it, G643 and G644 never make it); every mode rounds only when the
    rounding is estimated to pass the corner in less time than G64
    (:func:`corner_time_loss`), with ``v_round`` = min of the centripetal limit
-   ``sqrt(A_i R / rho_i)``, the one-IPO-cycle limit ``R theta / T_ipo`` (5.3: "about
+   ``sqrt(CENTRIPETAL_SHARE A_i R / rho_i)``, the one-IPO-cycle limit ``R theta / T_ipo`` (5.3: "about
    ADIS/T_ipo"), under SOFT the curvature-jump limit of the shared rule (6.3) and the
    in-arc jerk limit ``(J_i R^2 / rho_i)^(1/3)``, and the feed.
 
@@ -73,6 +73,12 @@ _OVERLOAD_CHECKED = ("G641", "G642", "G645")
 #: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
 _RADIUS_MODES = ("RND", "RNDM")
 _ALL_MODES = ROUNDING_MODES + _RADIUS_MODES
+
+#: Share of the axis acceleration the rounding-speed estimate grants the centripetal part:
+#: the heuristic's default ``PlannerParameters.arc_centripetal_share`` (a test keeps the two
+#: equal). The path must not depend on planner parameters (the oracle runs on it too), so
+#: the decision uses the default, not the parameter of a particular plan.
+CENTRIPETAL_SHARE = 0.75
 
 _LINE = KIND_CODES.index("line")
 _ROUNDING = KIND_CODES.index("rounding")
@@ -224,6 +230,11 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         distance_mm=d * zero, length_mm=radius * theta * zero,
         deviation_mm=d * np.tan(theta / 4.0) * zero, radius_mm=radius * zero,
         clamped=clamped & ins, v_g64=v64, v_round=v_round)
+    if not ins.any():                     # nothing to insert: same path, with the table
+        keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
+                "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
+                "blocks", "source", "dradius")
+        return Path(rounding=table, **{f: getattr(path, f) for f in keep})
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], table)
 
 
@@ -320,8 +331,9 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, radius: n
     normal /= np.linalg.norm(normal, axis=1)[:, None]
     rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
     with np.errstate(divide="ignore", invalid="ignore"):
-        v_c = np.where(rho > 0, np.sqrt(lim.a_max[None, :] * radius[:, None]
-                                        / np.where(rho > 0, rho, 1.0)), np.inf).min(axis=1)
+        a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
+        v_c = np.where(rho > 0, np.sqrt(a_c * radius[:, None] / np.where(rho > 0, rho, 1.0)),
+                       np.inf).min(axis=1)
         v_j = np.where(rho > 0, np.cbrt(lim.j_max[None, :] * radius[:, None] ** 2
                                         / np.where(rho > 0, rho, 1.0)), np.inf).min(axis=1)
     v_ipo = radius * theta / t_ipo

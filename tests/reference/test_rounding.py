@@ -32,9 +32,13 @@ BASE = {
 ROUNDING = KIND_CODES.index("rounding")
 
 
-def machine(**channel):
+def machine(ovl: float = 1.2, **channel):
+    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner, so every
+    parameterised corner is rounded and a test sees the geometry alone."""
     d = copy.deepcopy(BASE)
     d["channel"].update(channel)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = ovl
     return machine_from_dict(d)
 
 
@@ -43,8 +47,9 @@ def square(mode: str, extra: str = "") -> str:
 
 
 def rounded(text: str, mach=None):
+    """Program, machine (default: G64 stops, the geometry alone decides) and its path."""
     prog = parse_text(text)
-    mach = mach or machine()
+    mach = mach or machine(ovl=1.0)
     return prog, mach, build_path(prog, mach)
 
 
@@ -104,7 +109,8 @@ def test_ctol_sets_the_contour_deviation():
 
 def test_smoothing_mode_tens_digit_one_uses_smooth_contur_tol():
     """spec 5.4 table: tens digit 1 of MD20480: "contour tolerance SD42465" for G642."""
-    _, _, path = rounded(square("G642"), machine(SMOOTHING_MODE=10, SMOOTH_CONTUR_TOL=0.03))
+    _, _, path = rounded(square("G642"), machine(1.0, SMOOTHING_MODE=10,
+                                                       SMOOTH_CONTUR_TOL=0.03))
     np.testing.assert_allclose(path.rounding.deviation_mm, 0.03, rtol=1e-12)
 
 
@@ -170,7 +176,7 @@ def test_adispos_for_g0_and_the_smaller_distance_for_mixed_blocks():
 def test_no_rounding_block_and_why(text, why):
     """spec 5.2 "When no rounding block is inserted": each case, named per corner, in the
     planner trace, and the path keeps the sharp corner."""
-    prog, mach, path = rounded(text)
+    prog, mach, path = rounded(text, machine())
     assert reasons(path) == [why]
     assert not np.any(path.kind == ROUNDING)
     note = dict((e.stage, e.note) for e in plan(prog, mach, path=path).trace)["rounding"]
@@ -188,7 +194,7 @@ def test_ignore_ovl_factor_for_adis_rounds_even_a_small_kink():
 def test_g643_ignores_the_overload_factor():
     """spec 5.5: G643 "The overload factor is never taken into account"."""
     text = "G90 G643 CTOL=0.05 F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y0.436330\n"
-    _, _, path = rounded(text)
+    _, _, path = rounded(text, machine())
     assert reasons(path) == ["rounded"]
 
 
@@ -213,7 +219,7 @@ def test_rows_list_every_block_once_and_the_rounding_belongs_to_the_corner_block
 def test_rounded_contour_is_faster_than_g64_and_keeps_the_limits(mode):
     """Issue 13 item 3: with rounding, a contour is faster than under G64 and the
     heuristic never breaks its own limits on the rounded path (check_profile)."""
-    prog64, mach, _ = rounded(square("G64"))
+    prog64, mach, _ = rounded(square("G64"), machine())
     r64 = plan(prog64, mach)
     prog, _, path = rounded(square(mode), mach)
     assert path.rounding.inserted.all()
@@ -350,7 +356,7 @@ def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
 def test_smoothing_mode_digits(mode, smoothing, expect):
     """spec 5.9 "MD20480 SMOOTHING_MODE digit map": G643 by the units digit, G642 by the
     tens digit, G644 by the thousands digit."""
-    _, _, path = rounded(square(mode), machine(SMOOTHING_MODE=smoothing))
+    _, _, path = rounded(square(mode), machine(1.0, SMOOTHING_MODE=smoothing))
     t = path.rounding
     what, value = expect
     if what == "reason":
@@ -365,7 +371,32 @@ def test_g0_tolerance_factor_widens_the_g642_tolerance():
     """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
     factor 3 x COMPRESS_POS_TOL)"."""
     text = "G90 G642 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
-    _, _, path = rounded(text, machine(G0_TOLERANCE_FACTOR=3.0))
+    _, _, path = rounded(text, machine(1.0, G0_TOLERANCE_FACTOR=3.0))
     np.testing.assert_allclose(path.rounding.deviation_mm[0], 3 * 0.01 * math.sqrt(2),
                                rtol=1e-12)
     np.testing.assert_allclose(path.rounding.deviation_mm[1], 0.01 * math.sqrt(2), rtol=1e-12)
+
+
+def test_the_rounding_speed_estimate_uses_the_planner_default_centripetal_share():
+    from reference.planner.parameters import DEFAULT_PARAMETERS
+    from reference.rounding import CENTRIPETAL_SHARE
+    assert CENTRIPETAL_SHARE == DEFAULT_PARAMETERS.arc_centripetal_share
+
+
+def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
+    """spec 5.2 group 2 "Rounding would slow the program down": BRISK, MD33100 0.01 mm,
+    90 degree corners at F3000: the arc (R = 0.034 mm) is crossed at sqrt(0.75 * 2000 *
+    R) = 7.2 mm/s against 1.6 mm/s by G64, yet crawling 0.054 mm at 7.2 mm/s costs more
+    than it saves. Planned both ways, G64 is the faster, and that is what is kept."""
+    mach = machine()
+    prog = parse_text(square("G642"))
+    path = build_path(prog, mach)
+    assert reasons(path) == ["rounding would be slower than G64"] * 3
+    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    assert not forced.rounding.inserted.any()          # the time check is not the ovl one
+    # the same roundings, inserted (as on a machine where G64 must stop) and planned on
+    # this machine: slower than the sharp corners
+    t_sharp = plan(prog, mach, path=path).time_s
+    rounded_path = build_path(prog, machine(ovl=1.0))
+    assert rounded_path.rounding.inserted.all()
+    assert plan(prog, mach, path=rounded_path).time_s > t_sharp
