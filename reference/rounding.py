@@ -144,7 +144,6 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         with ``rounding`` set to the per-corner :class:`RoundingTable`.
     """
     m = path.n_segments
-    blocks = program.blocks
     if m < 2:
         return path
     ch = machine.channel
