@@ -13,7 +13,7 @@ from typing import Sequence
 
 from reference.core.budget import DEFAULT_MAX_GRID_POINTS
 from reference.core.errors import FeedOracleError
-from reference.prepare import prepare
+from reference.prepare import build_path, prepare
 
 from .commands import number_at_least
 from .pipeline import load_inputs
@@ -57,6 +57,7 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         out.write(f"{blk.line:>6} {span.label[:8]:<8} {span.kind:<5} {span.n_segments:>4} "
                   f"{span.length:>11.4f} {feed_s:>11} {blk.continuous_mode:<5} "
                   f"{stop[:30]:<30} {src}\n")
+    _write_rounding(out, program, machine)
     for w in inputs.warnings:
         print(str(w), file=sys.stderr)
     if path.n_segments == 0:
@@ -64,6 +65,32 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         print(f"{program.file}: note: the program has no motion (no block moves an axis)",
               file=sys.stderr)
     return EXIT_OK
+
+
+def _write_rounding(out, program, machine) -> None:
+    """The rounding stage's decision per corner in G641..G645: the rounding's tangent
+    distance, length, contour deviation and radius, or why no rounding was inserted."""
+    try:
+        table = build_path(program, machine).rounding
+    except FeedOracleError as exc:    # e.g. an axis without machine data: listed above
+        out.write(f"rounding: not evaluated ({exc})\n")
+        return
+    if table is None or table.n == 0:
+        return
+    lines = {b.index: b.line for b in program.blocks}
+    out.write(f"rounding: {int(table.inserted.sum())} of {table.n} corners in G641..G645 "
+              "rounded (tangent arcs)\n")
+    out.write(f"{'corner':>13} {'mode':<5} {'d_mm':>9} {'length_mm':>10} {'dev_mm':>9} "
+              f"{'radius_mm':>10} result\n")
+    for i in range(table.n):
+        corner = f"{lines[int(table.block[i])]}/{lines[int(table.next_block[i])]}"
+        if table.inserted[i]:
+            what = "rounded" + (" (clamped to the block length)" if table.clamped[i] else "")
+        else:
+            what = "none: " + table.reason_text(i)
+        out.write(f"{corner:>13} {table.mode[i]:<5} {table.distance_mm[i]:>9.4f} "
+                  f"{table.length_mm[i]:>10.4f} {table.deviation_mm[i]:>9.5f} "
+                  f"{table.radius_mm[i]:>10.4f} {what}\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -33,6 +33,7 @@ from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_M
                               POS_TOL_MM)
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
+from .rounding import round_corners
 
 _PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
 _STOP_AT_END_M = {0: "M0 programmed stop", 1: "M1 optional stop", 2: "M2 program end",
@@ -301,9 +302,10 @@ def build_path(program: Program, machine: Machine) -> Path:
 
     The heuristic (:func:`reference.planner.plan`), the oracle's callers and the
     comparison all take their path from here, so the gap measures velocity planning
-    alone (DESIGN section 1). Today this is the programmed contour (:func:`prepare`)
-    over the axes the machine knows (:func:`restrict_to_machine`); corner rounding and
-    tool radius compensation, once modelled, belong here too.
+    alone (DESIGN section 1): the programmed contour (:func:`prepare`) over the axes the
+    machine knows (:func:`restrict_to_machine`), with the corners of blocks in
+    G641..G645 rounded (:func:`reference.rounding.round_corners`); tool radius
+    compensation, once modelled, belongs here too.
 
     Parameters
     ----------
@@ -325,6 +327,7 @@ def build_path(program: Program, machine: Machine) -> Path:
     """
     path = restrict_to_machine(prepare(program), machine.limits)
     _check_motion_times(path)
+    path = round_corners(path, program, machine)
     return path
 
 

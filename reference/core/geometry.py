@@ -41,6 +41,7 @@ from typing import Literal
 import numpy as np
 
 from .errors import PathError
+from .rounding import RoundingTable
 from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
 
 SegmentKind = Literal["line", "arc", "rounding", "trc", "tlift"]
@@ -635,6 +636,10 @@ class Path:
     dradius : numpy.ndarray, shape (m,)
         Spiral rate ``dr/dt``, mm per rad of swept angle (0 for lines and circles; the
         default ``None`` means all zero).
+    rounding : RoundingTable or None
+        What the corner-rounding stage decided per corner
+        (:class:`reference.core.rounding.RoundingTable`); ``None`` when the stage did
+        not run or no block is in a rounding mode.
     """
 
     axes: tuple[str, ...]
@@ -657,6 +662,7 @@ class Path:
     blocks: tuple[BlockSpan, ...]
     source: str = ""
     dradius: np.ndarray | None = None
+    rounding: RoundingTable | None = None
     s_breaks: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:

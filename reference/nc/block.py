@@ -314,10 +314,17 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     if "AR" in named:
         raise ip.err(st, named["AR"][1], "arcs by opening angle (AR=) are not supported; "
                                          "program the end point with I/J/K or CR=")
-    for word, why in (("RND", "the rounding it inserts is not modelled; the corner stays "
-                                "sharp"),
-                      ("RNDM", "the rounding it inserts is not modelled; corners stay sharp"),
-                      ("OFFN", "the contour offset is not applied"),
+    rnd = 0.0
+    for word in ("RND", "RNDM"):
+        if word in named:
+            v, col = named[word]
+            if v < 0:
+                raise ip.err(st, col, f"{word}={v:g}: a rounding radius must be >= 0")
+            if word == "RND":
+                rnd = v * ip.lin("X")
+            else:
+                ip.rndm = v * ip.lin("X")
+    for word, why in (("OFFN", "the contour offset is not applied"),
                       ("STOLF", "the G0 tolerance factor is not modelled"),
                       ("SF", "the thread start angle is not modelled")):
         if word in named:
@@ -478,7 +485,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     tang = ip.tang_defs.get(ip.tang_active) if ip.tang_active else None
     modal_values = (ip.plane, ip.mode10, ip.criterion, ip.adis, ip.adispos, ip.ctol, ip.otol,
                     tuple(sorted(ip.atol.items())), ip.naive_cam, ip.accel_mode, ip.trc,
-                    ip.trc_corner, ip.disc, ip.tool, ip.offset_no, tang)
+                    ip.trc_corner, ip.disc, ip.tool, ip.offset_no, tang, ip.rndm)
     if ip.last_modal_values == modal_values:
         modal = ip.modal
     else:
@@ -486,12 +493,13 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         ip.last_modal_values = modal_values
         ip.modal = modal
     if (centre_out is None and not turns and dwell is None and not aux and message is None
-            and not st.comment and not kept and plane_basis is None):
+            and not st.comment and not kept and plane_basis is None and not rnd):
         extra = NO_EXTRA
     else:
         extra = BlockExtra(center=centre_out, turns=turns, dwell_s=dwell, aux=tuple(aux),
                            message=message, comment=st.comment, kept_unmodelled=tuple(kept),
-                           column_of_motion=motion_word_col, plane_basis=plane_basis)
+                           column_of_motion=motion_word_col, plane_basis=plane_basis,
+                           rnd_mm=rnd)
     ip.last_end = end
     ip.out.append(Block(len(ip.out), st.line, st.text, st.label, motion, start, end,
                         ip.feed if block_feed is None else block_feed,

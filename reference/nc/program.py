@@ -75,9 +75,9 @@ class Tangential:
 _MODAL_FIELDS = ("plane", "continuous_mode", "exact_stop_criterion", "adis_mm", "adispos_mm",
                  "contour_tol_mm", "orientation_tol_deg", "axis_tol", "naive_cam_tol_mm",
                  "accel_mode", "tool_compensation", "trc_corner", "disc", "tool",
-                 "tool_offset", "tangential")
+                 "tool_offset", "tangential", "rndm_mm")
 _EXTRA_FIELDS = ("center", "turns", "dwell_s", "aux", "message", "comment",
-                 "kept_unmodelled", "column_of_motion", "plane_basis")
+                 "kept_unmodelled", "column_of_motion", "plane_basis", "rnd_mm")
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,6 +118,9 @@ class Modal:
         Active tool offset (D on SINUMERIK, H/D on NGC).
     tangential : Tangential or None
         Active tangential control, ``None`` if off.
+    rndm_mm : float
+        Modal rounding radius RNDM, mm (0 = off): every corner between lines gets a
+        tangent arc of this radius.
     """
 
     plane: Plane = "G17"
@@ -136,6 +139,7 @@ class Modal:
     tool: int | str | None = None
     tool_offset: int | None = None
     tangential: Tangential | None = None
+    rndm_mm: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -166,6 +170,8 @@ class BlockExtra:
     plane_basis : tuple of two 3-tuples or None
         Unit vectors (in X, Y, Z) of the arc plane from its first to its second axis,
         when a rotated frame tilts the plane out of G17/G18/G19; ``None`` otherwise.
+    rnd_mm : float
+        Non-modal rounding radius RND of the corner at this block's end, mm (0 = none).
     """
 
     center: tuple[float, ...] | None = None
@@ -177,6 +183,7 @@ class BlockExtra:
     kept_unmodelled: tuple[str, ...] = ()
     column_of_motion: int = 1
     plane_basis: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+    rnd_mm: float = 0.0
 
 
 NO_EXTRA = BlockExtra()

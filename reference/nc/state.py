@@ -96,6 +96,7 @@ class _Interp:
         self.adis = 0.0
         self.adispos = 0.0
         self.ctol: float | None = None
+        self.rndm = 0.0              # RNDM, mm (0 = off)
         self.otol: float | None = None
         self.atol: dict[str, float] = {}
         self.naive_cam: float | None = None

@@ -1,9 +1,10 @@
 """The reference planner: composition of the stages into a :class:`ReferencePlan`.
 
-Stage order (spec/sinumerik-model.md 12.3; TRC, tangential control and rounding come
-in a later issue, G641..G645 behave as G64 and the stage trace says so):
+Stage order (spec/sinumerik-model.md 12.3; TRC and tangential control come in a later
+issue):
 
-``build_path`` (program -> path, :mod:`reference.prepare`) -> ``stops`` (acceleration
+``build_path`` (program -> path, :mod:`reference.prepare`, corner rounding of
+G641..G645 included, :mod:`reference.rounding`; the trace lists what it decided) -> ``stops`` (acceleration
 modes, forced stops) -> ``limit curves`` (segment caps, tangential limits) -> ``corners``
 (junction limits) -> ``lookahead`` (horizon caps, planning units, passes) -> ``profiles``
 (unit profiles) -> ``smoothing`` (LOOKAH_SMOOTH_FACTOR) -> ``adaptation``
@@ -47,7 +48,25 @@ from .stops import ACCEL_MODES, SegmentModes, segment_modes
 
 Progress = Callable[[str, float], None]
 
-_ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
+
+
+def rounding_note(path: Path) -> str:
+    """Stage-trace note of the rounding stage (:func:`reference.rounding.round_corners`):
+    corners rounded per mode and, per reason, the corners left sharp."""
+    table = path.rounding
+    if table is None or table.n == 0:
+        return "no corner in G641..G645"
+    ins = table.inserted
+    modes = sorted(set(table.mode))
+    per_mode = ", ".join(f"{md} {sum(1 for i in np.flatnonzero(ins) if table.mode[i] == md)}"
+                         f"/{sum(1 for x in table.mode if x == md)}" for md in modes)
+    left = {}
+    for i in np.flatnonzero(~ins):
+        left[table.reason_text(i)] = left.get(table.reason_text(i), 0) + 1
+    why = "; ".join(f"{n} {r}" for r, n in sorted(left.items(), key=lambda x: -x[1]))
+    return (f"{int(ins.sum())} of {table.n} corners in G641..G645 rounded by tangent arcs "
+            f"({per_mode}; {float(table.length_mm.sum()):.6g} mm of rounding)"
+            + (f"; no rounding block: {why}" if why else ""))
 
 
 # ----------------------------------------------------------------- composition
@@ -112,11 +131,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     m = path.n_segments
     trace.append(("prepare", f"{len(path.blocks)} blocks, {m} segments, "
                              f"{path.total_length:.6g} mm"))
-    n_round = sum(1 for b in program.blocks if b.continuous_mode in _ROUNDING_MODES
-                  and b.motion is not None)
-    trace.append(("rounding", "not modelled yet: G641..G645 behave as G64 "
-                              f"({n_round} blocks in G641..G645; corners passed by the G64 "
-                              "rule or exact stop)"))
+    trace.append(("rounding", rounding_note(path)))
 
     report_progress("stops", 0.1)
     modes = segment_modes(program, path, machine)
@@ -288,6 +303,22 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
 
 
 # ----------------------------------------------------------------- rows
+def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Index of the first largest value in each contiguous group ``[lo, lo + n)``.
+
+    Vectorised (a rounded program has one multi-segment block per corner: 10^5 of them
+    must not cost a Python loop each). ``n >= 1``; shapes (g,) -> (g,).
+    """
+    starts = np.cumsum(n) - n
+    idx = np.repeat(lo, n) + (np.arange(int(n.sum())) - np.repeat(starts, n))
+    vals = values[idx]
+    top = np.maximum.reduceat(vals, starts)
+    hit = np.flatnonzero(vals == np.repeat(top, n))
+    group = np.repeat(np.arange(lo.size), n)[hit]
+    _, first_hit = np.unique(group, return_index=True)
+    return idx[hit[first_hit]]
+
+
 def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits, junc,
           units: Units, speeds: NodeSpeeds, prof: UnitProfiles, profile: Profile,
           horizon: np.ndarray, holds: Holds) -> tuple[BlockTable, CornerTable]:
@@ -350,10 +381,7 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     main = first.copy()
     multi = np.flatnonzero(nseg > 1)
     if multi.size:
-        seg_time = profile.segment_times(path)
-        for i in multi:
-            lo, hi = first[i], first[i] + nseg[i]
-            main[i] = lo + int(np.argmax(seg_time[lo:hi]))
+        main[multi] = _group_argmax(profile.segment_times(path), first[multi], nseg[multi])
     mainc = np.clip(main, 0, max(m - 1, 0))
     t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
     kb = np.clip(first, 0, m)
@@ -362,8 +390,8 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     v_pk = v_entry.copy()
     if m:
         v_pk[moving] = v_peak_seg[mainc[moving]]
-        for i in multi:
-            v_pk[i] = float(np.max(v_peak_seg[first[i]:first[i] + nseg[i]]))
+        if multi.size:
+            v_pk[multi] = v_peak_seg[_group_argmax(v_peak_seg, first[multi], nseg[multi])]
     stop_here = modes.stop[kb] & (t_blk > 0)
     cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
     cause_code = np.where(moving | stop_here, cause_code, -1)

@@ -271,8 +271,16 @@ def test_cycles_system_variables_and_subprogram_calls_are_kept_with_a_warning():
 
 
 def test_path_changing_words_that_are_not_modelled_warn():
-    p = sin("G1 X1 F60 RND=2\nX2 Y1\n")
-    assert [w.line for w in p.warnings] == [1] and "RND=2" in p.warnings[0].message
+    p = sin("G1 X1 F60 OFFN=2\nX2 Y1\n")
+    assert [w.line for w in p.warnings] == [1] and "OFFN=2" in p.warnings[0].message
+
+
+def test_rnd_is_non_modal_and_rndm_modal():
+    # RND and RNDM are modelled (reference/rounding.py): carried, not warned about
+    p = sin("G1 X1 F60 RND=2\nX2 Y1 RNDM=0.5\nX3\nX4 RNDM=0\n")
+    assert p.warnings == () or list(p.warnings) == []
+    assert [b.rnd_mm for b in p.blocks] == [2.0, 0.0, 0.0, 0.0]
+    assert [b.rndm_mm for b in p.blocks] == [0.0, 0.5, 0.5, 0.0]
 
 
 def test_settable_work_offsets_warn_and_harmless_words_do_not():

@@ -1,0 +1,427 @@
+"""Stage: corner rounding (G641..G645), between the path geometry and velocity planning.
+
+sinumerik-model 5.1: "the neighbouring blocks are shortened and one or two intermediate
+blocks are inserted". :func:`round_corners` does this on the :class:`Path` that both
+planners share (DESIGN section 1): at every corner it rounds, it inserts one segment of
+kind ``"rounding"`` -- the circular arc tangent to both lines
+(:mod:`reference.core.rounding`) -- and shortens the two lines by the tangent distance
+``d``. The segment is attributed to the block whose end is the corner ("synchronisation
+events are referred to the end of the shortened first block", 5.1), so every program
+block keeps exactly one :class:`BlockSpan`: that block's span now covers its shortened
+line and the rounding; the next block's span starts where the rounding ends.
+
+Per corner (break between two consecutive segments), in this order (5.2, 8):
+
+1. the block before the corner programs RND (non-modal) or RNDM (modal radius > 0) or is
+   in G641..G645, else nothing is recorded;
+2. no rounding where the axes stop anyway (5.2 group 1): a stop at the break (exact stop,
+   auxiliary output before motion, M0, ...), a block without path motion between, a
+   change of acceleration mode (BRISK/SOFT), geometry axes moving in one block only;
+3. model limits of this version: only line-to-line corners of geometry axes are rounded
+   (arc transitions and corners where other axes move are passed as under G64, named);
+4. the rounding distance ``d`` by mode (5.3 .. 5.7):
+
+   * G641: ``d = ADIS`` (G1/G2/G3), ``ADISPOS`` (G0), the smaller if one block is G0;
+     0 means not parameterised;
+   * G642/G645 (tens digit of MD20480 SMOOTHING_MODE), G643 (units digit): the largest
+     ``d`` whose deviation keeps every axis within MD33100 COMPRESS_POS_TOL (digit 0, 2)
+     or the contour within SD42465 SMOOTH_CONTUR_TOL (digit 1, 3); a programmed CTOL
+     replaces both for the geometry axes (5.7); digit 4: ``d`` as G641. Both blocks G0:
+     tolerances times MD20560 G0_TOLERANCE_FACTOR (5.7);
+   * G644 (thousands digit): 0xxx/4xxx MD33100 per axis, 1xxx/5xxx ADIS/ADISPOS
+     (CTOL ignored, 5.6); 2xxx/3xxx not modelled yet (named);
+   * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
+     radius ``R`` is what RND defines; no speed check: it is contour, not smoothing);
+   * clamp: ``d <= c min(L1, L2)`` with ``c = rounding_length_clamp`` (0.5: "the
+     rounding distance cannot exceed half the length of the original participating
+     blocks", the G644 excerpt; 5.3); ``d`` at or below MIN_SEGMENT_LENGTH_MM: too small;
+5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
+   junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
+   and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
+   TRUE skips it, G643 and G644 never make it); every mode rounds only when the
+   rounding is estimated to pass the corner in less time than G64
+   (:func:`corner_time_loss`), with ``v_round`` = min of the centripetal limit
+   ``sqrt(CENTRIPETAL_SHARE A_i R / rho_i)``, the one-IPO-cycle limit ``R theta / T_ipo`` (5.3: "about
+   ADIS/T_ipo"), under SOFT the curvature-jump limit of the shared rule (6.3) and the
+   in-arc jerk limit ``(J_i R^2 / rho_i)^(1/3)``, and the feed.
+
+Model limits, stated: the rounding is a tangent arc (G1 continuous, curvature jump
+``1/R`` at both ends), also for G642/G645 where the control inserts a smoother polynomial;
+G643/G644 insert the same segment (the control rounds axis-wise inside the blocks);
+G645's rounding of tangential transitions with curvature jumps and rounding across
+several short blocks are not modelled.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .core.geometry import KIND_CODES, BlockSpan, Path
+from .core.limits import AxisArrays
+from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
+                            deflection_angle, distance_for_deviation, fillet_pieces)
+from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junction_speed_cap
+from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
+from .machine import Machine
+from .nc.program import Program
+
+#: Group-10 modes that round corners.
+ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
+#: Modes that round only where G64 would have to reduce the speed (4.3).
+_OVERLOAD_CHECKED = ("G641", "G642", "G645")
+
+#: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
+_RADIUS_MODES = ("RND", "RNDM")
+_ALL_MODES = ROUNDING_MODES + _RADIUS_MODES
+
+#: Share of the axis acceleration the rounding-speed estimate grants the centripetal part:
+#: the heuristic's default ``PlannerParameters.arc_centripetal_share`` (a test keeps the two
+#: equal). The path must not depend on planner parameters (the oracle runs on it too), so
+#: the decision uses the default, not the parameter of a particular plan.
+CENTRIPETAL_SHARE = 0.75
+
+_LINE = KIND_CODES.index("line")
+_ROUNDING = KIND_CODES.index("rounding")
+
+
+def _digit(value: int, place: int) -> int:
+    """Decimal digit ``place`` (0 = units) of a machine-data digit map."""
+    return (int(value) // 10 ** place) % 10
+
+
+def _block_attributes(program: Program, default_accel: str) -> dict[str, np.ndarray]:
+    """Per program block, shape (nb,): the mode governing the corner at its end (RND,
+    RNDM, else the group-10 mode), acceleration mode, ADIS, ADISPOS, CTOL (``nan`` if
+    unset) and programmed rounding radius (mm).
+
+    Consecutive blocks share one :class:`~reference.nc.program.Modal` object while
+    nothing modal changes, so the modal values are read once per distinct object.
+    """
+    blocks = program.blocks
+    nb = len(blocks)
+    index: dict[int, int] = {}
+    uniq = []
+    code = np.empty(nb, dtype=np.int64)
+    for i, blk in enumerate(blocks):
+        md = blk.modal
+        j = index.get(id(md))
+        if j is None:
+            j = index[id(md)] = len(uniq)
+            uniq.append(md)
+        code[i] = j
+    rnd = np.array([blk.extra.rnd_mm for blk in blocks], dtype=np.float64)
+    mode = np.array([md.continuous_mode for md in uniq], dtype=object)[code]
+    rndm = np.array([md.rndm_mm for md in uniq], dtype=np.float64)[code]
+    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode))
+    return {
+        "mode": mode,
+        "accel": np.array([md.accel_mode or default_accel for md in uniq], dtype=object)[code],
+        "adis": np.array([md.adis_mm for md in uniq], dtype=np.float64)[code],
+        "adispos": np.array([md.adispos_mm for md in uniq], dtype=np.float64)[code],
+        "ctol": np.array([np.nan if md.contour_tol_mm is None else md.contour_tol_mm
+                          for md in uniq], dtype=np.float64)[code],
+        "radius": np.where(rnd > 0, rnd, rndm),
+    }
+
+
+def round_corners(path: Path, program: Program, machine: Machine) -> Path:
+    """Insert rounding segments at the corners of blocks in G641..G645.
+
+    Parameters
+    ----------
+    path : Path
+        The programmed contour over the machine's axes
+        (:func:`reference.prepare.restrict_to_machine`).
+    program : Program
+        Its program (modes, ADIS/ADISPOS, CTOL, acceleration modes).
+    machine : Machine
+        Tolerances (MD33100, SD42465, MD20480, MD20560, MD20490), limits.
+
+    Returns
+    -------
+    Path
+        ``path`` itself when no block is in a rounding mode; otherwise the rounded path
+        with ``rounding`` set to the per-corner :class:`RoundingTable`.
+    """
+    m = path.n_segments
+    if m < 2:
+        return path
+    ch = machine.channel
+    attrs = _block_attributes(program, ch.acceleration_mode)
+    cand = np.flatnonzero(np.isin(attrs["mode"][path.block[:-1]], _ALL_MODES))
+    if cand.size == 0:
+        return path
+    a, b = cand, cand + 1                 # segments before and after each corner
+    brk = cand + 1                        # break index of each corner
+    ka, kb = path.block[a], path.block[b]
+    mode_arr = attrs["mode"][ka]
+    mode = tuple(mode_arr)
+    reason = np.full(a.size, -1, dtype=np.int64)
+
+    def decide(mask: np.ndarray, why: str) -> None:
+        reason[(reason < 0) & mask] = REASON_CODE[why]
+
+    geo = path.geometry
+    # --- 5.2 group 1: the axes stop between the blocks anyway -----------------------
+    decide(path.stop[brk], "stop between the blocks")
+    decide(kb - ka > 1, "block without path motion between")
+    decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
+    is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
+    da, db = path.d[a], path.d[b]
+    geo_a = np.where(path.kind[a] == _LINE, np.linalg.norm(da[:, geo], axis=1) > MOVING_AXIS_TOL,
+                     True)
+    geo_b = np.where(path.kind[b] == _LINE, np.linalg.norm(db[:, geo], axis=1) > MOVING_AXIS_TOL,
+                     True)
+    decide(geo_a != geo_b, "geometry axes move in one block only")
+    # --- model limits of this version ------------------------------------------------
+    decide(~is_line, "arc transition: rounding not modelled yet")
+    other = (np.abs(da[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL) | (
+        np.abs(db[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL)
+    decide(other, "non-geometry axes move: rounding not modelled yet")
+    t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
+    decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
+
+    # --- rounding distance by mode ----------------------------------------------------
+    theta = deflection_angle(t1, t2)
+    d = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, decide)
+    lens = np.minimum(path.length[a], path.length[b])
+    cap = ch.rounding_length_clamp * lens
+    clamped = d > cap
+    d = np.minimum(d, cap)
+    decide(~(d > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = np.where(reason < 0, d / np.tan(theta / 2.0), 0.0)
+    decide(~(radius * theta > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
+
+    # --- speeds: G64 against rounding (4.3, 5.2 group 2, 5.8) -------------------------
+    lim = machine.limits.for_axes(path.axes)
+    open_ = reason < 0
+    v64 = np.full(a.size, np.nan)
+    v_round = np.full(a.size, np.nan)
+    if open_.any():
+        o = np.flatnonzero(open_)
+        v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
+        feed = np.minimum(path.feed[a[o]], path.feed[b[o]])
+        with np.errstate(divide="ignore"):
+            v_axis = np.min(lim.v_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
+                            axis=1)
+        v_prog = np.minimum(feed, v_axis)
+        soft = attrs["accel"][ka[o]] == "SOFT"
+        v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], radius[o],
+                                                        lim, machine.limits.t_ipo_s, soft))
+        ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
+        radius_mode = np.isin(mode_arr[o], _RADIUS_MODES)
+        sub = np.zeros(a.size, bool)
+        sub[o] = ovl & (v64[o] >= v_prog)
+        decide(sub, "G64 passes the corner without reduction (overload factor)")
+        sub[:] = False
+        with np.errstate(divide="ignore"):
+            a_path = np.min(lim.a_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
+                            axis=1)
+        sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, radius[o] * theta[o], 2 * d[o])
+                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0)) & ~radius_mode
+        decide(sub, "rounding would be slower than G64")
+    reason[reason < 0] = REASON_CODE["rounded"]
+    ins = reason == 0
+    zero = np.where(ins, 1.0, 0.0)
+    table = RoundingTable(
+        block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
+        distance_mm=d * zero, length_mm=radius * theta * zero,
+        deviation_mm=d * np.tan(theta / 4.0) * zero, radius_mm=radius * zero,
+        clamped=clamped & ins, v_g64=v64, v_round=v_round)
+    if not ins.any():                     # nothing to insert: same path, with the table
+        keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
+                "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
+                "blocks", "source", "dradius")
+        return Path(rounding=table, **{f: getattr(path, f) for f in keep})
+    return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], table)
+
+
+def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
+               b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
+               t2: np.ndarray, theta: np.ndarray, decide) -> np.ndarray:
+    """Tangent distance per corner by mode, before the block-length clamp, mm."""
+    ch = machine.channel
+    sm = ch.smoothing_mode
+    k = a.size
+    ra, rb = path.rapid[a], path.rapid[b]
+    adis, adispos, ctol = attrs["adis"][ka], attrs["adispos"][ka], attrs["ctol"][ka]
+    radius = attrs["radius"][ka]
+    # how each corner's distance is found: "adis", "tol" (MD33100 per axis and maybe a
+    # contour tolerance), "radius" (RND/RNDM) or "none" (not modelled)
+    how = np.full(k, "none", dtype=object)
+    contour = np.full(k, np.inf)
+    use_axis_tol = np.ones(k, bool)
+    how[np.isin(mode, _RADIUS_MODES)] = "radius"
+    how[mode == "G641"] = "adis"
+    dig644 = _digit(sm, 3)
+    how[mode == "G644"] = "adis" if dig644 in (1, 5) else "tol" if dig644 in (0, 4) else "none"
+    for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
+        sel = mode == md
+        dig = _digit(sm, place)
+        if dig == 4:
+            how[sel] = "adis"
+            continue
+        how[sel] = "tol"
+        has_ctol = sel & ~np.isnan(ctol)           # CTOL overrides MD/SD values (5.7)
+        contour[has_ctol], use_axis_tol[has_ctol] = ctol[has_ctol], False
+        if dig in (1, 3):
+            rest = sel & np.isnan(ctol)
+            contour[rest], use_axis_tol[rest] = ch.smooth_contour_tol_mm, False
+    d = np.zeros(k)
+    # G641-type: ADIS for G1/G2/G3, ADISPOS for G0, the smaller if one block is G0 (5.3)
+    dist = np.where(ra & rb, adispos, np.where(ra | rb, np.minimum(adis, adispos), adis))
+    is_adis = how == "adis"
+    decide(is_adis & (dist <= 0) & ((ra & rb) | ((ra | rb) & (adispos <= adis))),
+           "rounding not parameterised (ADISPOS = 0)")
+    decide(is_adis & (dist <= 0), "rounding not parameterised (ADIS = 0)")
+    d = np.where(is_adis, dist, d)
+    # tolerance type (5.4): per-axis MD33100 on the axes it applies to, contour tolerance
+    is_tol = how == "tol"
+    if is_tol.any():
+        tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
+        tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
+        g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
+        dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
+        decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
+        d = np.where(is_tol & (dev > 0), distance_for_deviation(theta, np.maximum(dev, 0.0)), d)
+    # RND/RNDM: the programmed radius, d = R tan(theta/2)
+    d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
+    decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
+    return np.where(np.isfinite(d), d, 0.0)
+
+
+def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarray,
+                     inserted: np.ndarray | float, replaced: np.ndarray | float) -> np.ndarray:
+    """Estimated time a corner costs against passing it at the programmed speed, s.
+
+    Braking from ``v_p`` to ``v`` and accelerating back at the constant path
+    acceleration ``a`` costs ``(v_p - v)^2 / (a v_p)`` against covering the same
+    distance at ``v_p`` (both sides together); a rounding of length ``l`` that replaces
+    ``2 d`` of the contour and is traversed at ``v`` (a SOFT profile crosses its
+    curvature-jump ends at zero path acceleration, so it stays near ``v`` on it) adds
+    ``l / v - 2 d / v_p``. This is the model's reading of "rounding would slow the
+    program down" (5.2 group 2): an estimate for the decision only; the heuristic then
+    plans whichever contour results exactly. Jerk-limited ramps are not in the estimate.
+
+    Parameters
+    ----------
+    v_prog, v_corner, a_path : numpy.ndarray, shape (k,)
+        mm/s, mm/s, mm/s^2.
+    inserted, replaced : numpy.ndarray or float
+        Rounding length ``l`` and the replaced contour length ``2 d``, mm (0 for G64).
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+    """
+    v = np.minimum(v_corner, v_prog)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ramps = np.where(np.isfinite(v_prog), (v_prog - v) ** 2 / (a_path * v_prog), 0.0)
+        path = np.where(np.asarray(inserted) > 0, np.asarray(inserted) / v, 0.0) - np.where(
+            np.isfinite(v_prog), np.asarray(replaced) / v_prog, 0.0)
+    return np.where(v > 0, ramps + path, np.inf)
+
+
+def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, radius: np.ndarray,
+                    lim: AxisArrays, t_ipo: float, soft: np.ndarray) -> np.ndarray:
+    """Model speed through tangent-arc roundings (5.8, 6.3, 6.4), mm/s, shape (k,)."""
+    normal = t2 - np.sum(t2 * t1, axis=1)[:, None] * t1
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
+        v_c = np.where(rho > 0, np.sqrt(a_c * radius[:, None] / np.where(rho > 0, rho, 1.0)),
+                       np.inf).min(axis=1)
+        v_j = np.where(rho > 0, np.cbrt(lim.j_max[None, :] * radius[:, None] ** 2
+                                        / np.where(rho > 0, rho, 1.0)), np.inf).min(axis=1)
+    v_ipo = radius * theta / t_ipo
+    # the curvature vector jumps from 0 to n/R at the start and from the rotated normal
+    # to 0 at the end (same magnitude per axis bounded by rho/R): the shared rule on both
+    k_end = (normal * np.cos(theta)[:, None] - t1 * np.sin(theta)[:, None]) / radius[:, None]
+    zero = np.zeros_like(t1)
+    v_k = np.minimum(
+        curvature_jump_speed_cap(zero, normal / radius[:, None], lim.path_trans_jerk, t_ipo),
+        curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
+    out = np.minimum(v_c, v_ipo)
+    return np.where(soft, np.minimum(out, np.minimum(v_j, v_k)), out)
+
+
+def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
+              table: RoundingTable) -> Path:
+    """The rounded path: lines shortened, arcs inserted after segments ``a``, spans moved.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of int, shape (r,)
+        Segment before each inserted rounding (the corner is at its end).
+    d : numpy.ndarray, shape (r,)
+        Tangent distances, mm.
+    t1, t2 : numpy.ndarray, shape (r, n)
+        Unit directions of the lines before and after.
+    """
+    m = path.n_segments
+    trim_start = np.zeros(m)
+    trim_end = np.zeros(m)
+    trim_end[a] = d
+    trim_start[a + 1] = d
+    length = path.length - trim_start - trim_end
+    # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
+    # meet tangentially and the line is dropped
+    keep = length > MIN_SEGMENT_LENGTH_MM
+    has_arc = np.zeros(m, bool)
+    has_arc[a] = True
+    count = keep.astype(np.int64) + has_arc
+    first = np.concatenate(([0], np.cumsum(count)))          # new index of old seg's pieces
+    total = int(first[-1])
+    n = path.n_axes
+    corner = path.origin[a] + path.d[a] * path.length[a][:, None]
+    arcs = fillet_pieces(corner, t1, t2, d, path.block[a], _ROUNDING)
+
+    line_pos = first[:-1][keep]
+    arc_pos = first[:-1][has_arc] + keep[has_arc]
+    new = {}
+    for key in ("origin", "e1", "e2", "d"):
+        arr = np.zeros((total, n))
+        src = getattr(path, key)
+        arr[line_pos] = src[keep]
+        arr[arc_pos] = arcs[key]
+        new[key] = arr
+    # shortened lines (a trimmed arc never occurs: only line-line corners are rounded)
+    new["origin"][line_pos] += path.d[keep] * trim_start[keep][:, None]
+    for key, dtype in (("radius", np.float64), ("omega", np.float64),
+                       ("theta0", np.float64), ("length", np.float64),
+                       ("block", np.int64), ("kind", np.int8), ("dradius", np.float64)):
+        arr = np.zeros(total, dtype=dtype)
+        src = length if key == "length" else getattr(path, key)
+        arr[line_pos] = src[keep]
+        arr[arc_pos] = arcs[key]
+        new[key] = arr
+    feed = np.zeros(total)
+    feed[line_pos] = path.feed[keep]
+    feed[arc_pos] = np.minimum(path.feed[a], path.feed[a + 1])
+    rapid = np.zeros(total, bool)
+    rapid[line_pos] = path.rapid[keep]
+    rapid[arc_pos] = path.rapid[a] & path.rapid[a + 1]
+    # breaks: old break k (k = 0..m) is new break first[k]; the new interior breaks
+    # (line -> rounding -> line) carry no stop (a corner with a stop is never rounded)
+    reasons = [""] * (total + 1)
+    for k in np.flatnonzero(path.stop):
+        reasons[int(first[k])] = path.stop_reason[k]
+    sb = np.concatenate(([0.0], np.cumsum(new["length"])))
+    # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
+    j0 = np.array([sp.first_segment for sp in path.blocks], dtype=np.int64)
+    j1 = j0 + np.array([sp.n_segments for sp in path.blocks], dtype=np.int64)
+    f, e = first[j0], first[j1]
+    # positional arguments: 10^5 spans, and keywords cost a third more
+    spans = [BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi,
+                       sp.feed_mm_s, sp.stop_reason, sp.dwell_s)
+             for sp, s0, s1, fi, ei in zip(path.blocks, sb[f].tolist(), sb[e].tolist(),
+                                           f.tolist(), e.tolist())]
+    return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
+                rapid=rapid, stop=np.array([bool(r) for r in reasons]),
+                stop_reason=tuple(reasons), blocks=tuple(spans), source=path.source,
+                rounding=table, **new)
+
+
+__all__ = ["ROUNDING_MODES", "corner_time_loss", "round_corners"]

@@ -1,0 +1,56 @@
+"""Rounded paths on every bundled machine: compare exits 0/1, the oracle is optimal
+within its bracket on the same rounded path, the heuristic keeps its limits and is never
+faster than the certified lower bound (issue 13 item 3)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from compare import cli
+from test_corpus_machines import MACHINES, _machine_file
+
+PROGRAMS = {
+    "g642_ctol": "G90 G642 CTOL=0.05 BRISK F4000\nG1 X0 Y0\nX40\nY30\nX10 Y35\nX0 Y0\nM30\n",
+    "g641_adis": "G90 G641 ADIS=0.5 ADISPOS=1 BRISK F3000\nG0 X0 Y0\nG0 X20\nG1 Y20\nX0\nY0\nM30\n",
+    "g642_soft": "G90 G642 SOFT F6000\nG1 X0 Y0\nX30\nY30 Z-2\nX0\nM30\n",
+    "rnd": "G90 G64 F3000\nG1 X0 Y0\nX30 RND=3\nY30 RND=1\nX0 Y10\nM30\n",
+}
+
+
+@pytest.mark.parametrize("machine", sorted(MACHINES))
+@pytest.mark.parametrize("name", sorted(PROGRAMS))
+def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
+                                                     tmp_path: Path, capsys) -> None:
+    prog = tmp_path / f"{name}.mpf"
+    prog.write_text(PROGRAMS[name])
+    mfile = _machine_file(tmp_path, machine, prog.name)
+    out = tmp_path / "r.json"
+    rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report",
+                   "--quiet", "--json", str(out)])
+    err = capsys.readouterr().err
+    assert rc in (0, 1), err
+    doc = json.loads(out.read_text())
+    ora, ref = doc["oracle"], doc["reference"]
+    assert ora["status"] == "optimal", ora
+    lb, ub, t_ref = ora["lower_bound_s"], ora["upper_bound_s"], ref["time_s"]
+    assert lb <= ub <= lb * (1 + 2e-3) + 1e-12
+    assert not ref["violations"], ref["violations"]
+    assert t_ref >= lb
+
+
+def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, capsys) -> None:
+    """Issue 13 item 5: inspect lists length, deviation and mode per corner, and why no
+    rounding was inserted where none was."""
+    prog = tmp_path / "sq.mpf"
+    prog.write_text("G90 G641 ADIS=0.5 BRISK F3000\nG1 X0 Y0\nX50\nY50 G9\nX0\nY0\n")
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    assert "rounding: 2 of 3 corners in G641..G645 rounded" in out
+    rows = [r.split() for r in out.splitlines() if r.strip().startswith(("3/4", "4/5", "5/6"))]
+    # 90 degree corners, ADIS 0.5: d = R = 0.5, length pi/4, deviation 0.5 (sqrt 2 - 1)
+    assert rows[0][:6] == ["3/4", "G641", "0.5000", "0.7854", "0.20711", "0.5000"]
+    assert rows[0][6] == "rounded"
+    assert " ".join(rows[1][6:]) == "none: stop between the blocks"

@@ -1,0 +1,402 @@
+"""Corner rounding (reference/rounding.py): every documented property against hand geometry.
+
+The rounding is a tangent arc (first version, reference/core/rounding.py). For a corner
+with deflection angle theta and tangent distance d, by hand: radius R = d / tan(theta/2),
+arc length R theta, deviation of the rounded path from the corner R (1/cos(theta/2) - 1).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+
+from reference.core.constraints import BOUND_SETS, check_profile
+from reference.core.geometry import KIND_CODES
+from reference.core.rounding import ROUNDING_REASONS
+from reference.machine import load_machine, machine_from_dict
+from reference.nc import parse_text
+from reference.planner import plan
+from reference.prepare import build_path
+
+BASE = {
+    "machine": {"name": "t", "ipo_cycle_ms": 4.0},
+    "channel": {"lookahead_blocks": 50, "acceleration_mode": "BRISK"},
+    "axis": {ax: {"MAX_AX_VELO": 30000.0, "MAX_AX_ACCEL": 2.0, "MAX_AX_JERK": 40.0,
+                  "MAX_ACCEL_OVL_FACTOR": 1.2, "LOOKAH_FREQUENCY": 20.0,
+                  "COMPRESS_POS_TOL": 0.01}
+             for ax in "XYZ"},
+}
+ROUNDING = KIND_CODES.index("rounding")
+
+
+def machine(ovl: float = 1.2, **channel):
+    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner, so every
+    parameterised corner is rounded and a test sees the geometry alone."""
+    d = copy.deepcopy(BASE)
+    d["channel"].update(channel)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = ovl
+    return machine_from_dict(d)
+
+
+def square(mode: str, extra: str = "") -> str:
+    return (f"G17 G90 {mode} {extra} F3000\nG1 X0 Y0\nG1 X50\nG1 Y50\nG1 X0\nG1 Y0\n")
+
+
+def rounded(text: str, mach=None):
+    """Program, machine (default: G64 stops, the geometry alone decides) and its path."""
+    prog = parse_text(text)
+    mach = mach or machine(ovl=1.0)
+    return prog, mach, build_path(prog, mach)
+
+
+def reasons(path) -> list[str]:
+    t = path.rounding
+    return [t.reason_text(i) for i in range(t.n)]
+
+
+def _check_tangent_continuity(path) -> None:
+    """Positions meet and tangents agree at every break next to a rounding segment."""
+    for k in range(path.n_segments - 1):
+        if ROUNDING not in (path.kind[k], path.kind[k + 1]):
+            continue
+        a, b = path.segment(k), path.segment(k + 1)
+        np.testing.assert_allclose(a.end, b.start, atol=1e-12)
+        np.testing.assert_allclose(a.end_tangent, b.start_tangent, atol=1e-12)
+
+
+# ------------------------------------------------------------------ G642 tolerances
+def test_g642_axis_deviation_is_compress_pos_tol_by_hand():
+    """spec 5.4: "The maximum deviation for G642/G643 is set per axis in MD33100
+    COMPRESS_POS_TOL". 90 degree corner, tol 0.01 mm on X and Y: the corner moves by
+    0.01 mm on each axis, |C - M| = 0.01 sqrt(2), d = |C - M| / tan(22.5 deg)."""
+    prog, mach, path = rounded(square("G642"))
+    t = path.rounding
+    assert list(t.inserted) == [True] * 3
+    dev = 0.01 * math.sqrt(2.0)
+    d = dev / math.tan(math.pi / 8)
+    R = d / math.tan(math.pi / 4)
+    np.testing.assert_allclose(t.deviation_mm, dev, rtol=1e-12)
+    np.testing.assert_allclose(t.distance_mm, d, rtol=1e-12)
+    np.testing.assert_allclose(t.radius_mm, R, rtol=1e-12)
+    np.testing.assert_allclose(t.length_mm, R * math.pi / 2, rtol=1e-12)
+    # the geometry itself: the arc's midpoint and its nearest approach to the corner
+    k = int(np.flatnonzero(path.kind == ROUNDING)[0])
+    seg = path.segment(k)
+    mid = seg.evaluate(seg.length / 2)[0][0]
+    np.testing.assert_allclose(np.abs(mid[:2] - [50.0, 0.0]), [0.01, 0.01], rtol=1e-9)
+    q = seg.evaluate(np.linspace(0, seg.length, 2001))[0]
+    assert np.min(np.linalg.norm(q[:, :2] - [50.0, 0.0], axis=1)) == pytest.approx(dev, rel=1e-6)
+    # starts d before the corner on the first line and ends d after it on the second
+    np.testing.assert_allclose(seg.start[:2], [50.0 - d, 0.0], atol=1e-12)
+    np.testing.assert_allclose(seg.end[:2], [50.0, d], atol=1e-12)
+    _check_tangent_continuity(path)
+    assert path.total_length == pytest.approx(200.0 - 3 * (2 * d - R * math.pi / 2), rel=1e-12)
+
+
+def test_ctol_sets_the_contour_deviation():
+    """spec 5.7: CTOL overrides MD/SD values and applies to all rounding types except
+    G641, G644: with CTOL=0.05 the corner deviates by exactly 0.05 mm."""
+    _, _, path = rounded(square("G642", "CTOL=0.05"))
+    np.testing.assert_allclose(path.rounding.deviation_mm, 0.05, rtol=1e-12)
+    # G644 ignores CTOL (spec 5.6): MD33100 per axis
+    _, _, p644 = rounded(square("G644", "CTOL=0.05"))
+    np.testing.assert_allclose(p644.rounding.deviation_mm, 0.01 * math.sqrt(2), rtol=1e-12)
+
+
+def test_smoothing_mode_tens_digit_one_uses_smooth_contur_tol():
+    """spec 5.4 table: tens digit 1 of MD20480: "contour tolerance SD42465" for G642."""
+    _, _, path = rounded(square("G642"), machine(1.0, SMOOTHING_MODE=10,
+                                                       SMOOTH_CONTUR_TOL=0.03))
+    np.testing.assert_allclose(path.rounding.deviation_mm, 0.03, rtol=1e-12)
+
+
+# ------------------------------------------------------------------ G641 distances
+def test_g641_rounding_starts_adis_before_the_corner():
+    """spec 5.3: "ADIS ... the earliest point before the block end where rounding may
+    start, and the latest point after it where rounding must be finished"."""
+    _, _, path = rounded(square("G641", "ADIS=0.5"))
+    t = path.rounding
+    np.testing.assert_allclose(t.distance_mm, 0.5)
+    k = int(np.flatnonzero(path.kind == ROUNDING)[0])
+    seg = path.segment(k)
+    np.testing.assert_allclose(seg.start[:2], [49.5, 0.0], atol=1e-12)
+    np.testing.assert_allclose(seg.end[:2], [50.0, 0.5], atol=1e-12)
+    np.testing.assert_allclose(t.radius_mm, 0.5, rtol=1e-12)          # tan(45 deg) = 1
+    _check_tangent_continuity(path)
+
+
+def test_g641_clamp_to_half_the_shorter_block():
+    """G644 excerpt: "The rounding distance cannot exceed half the length of the original
+    participating blocks." (spec 5.3 model: d = min(ADIS, 0.5 L_k, 0.5 L_k+1))."""
+    text = "G90 G641 ADIS=2 F3000\nG1 X0 Y0\nG1 X50\nG1 Y1\nG1 X0\n"
+    _, _, path = rounded(text)
+    t = path.rounding
+    np.testing.assert_allclose(t.distance_mm, [0.5, 0.5])
+    assert list(t.clamped) == [True, True]
+    # the 1 mm block is used up by its two roundings: only the two arcs remain of it
+    span = next(s for s in path.blocks if s.line == 4)
+    assert span.n_segments == 1 and path.kind[span.first_segment] == ROUNDING
+    _check_tangent_continuity(path)
+
+
+def test_adispos_for_g0_and_the_smaller_distance_for_mixed_blocks():
+    """spec 5.3: "ADISPOS is the same for G0"; "If only one of the two blocks is G0,
+    the smaller distance applies"."""
+    text = "G90 G641 ADIS=0.5 ADISPOS=0.2 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    _, _, path = rounded(text)
+    np.testing.assert_allclose(path.rounding.distance_mm[:2], [0.2, 0.2])
+
+
+# ------------------------------------------------------------------ no rounding block
+@pytest.mark.parametrize("text, why", [
+    # 5.2 group 1 "the axes stop between the blocks anyway"
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50 G9\nG1 Y50\n", "stop between the blocks"),
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nR1=5\nG1 Y50\n",
+     "block without path motion between"),
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nSOFT G1 Y50\n",
+     "acceleration mode change (BRISK/SOFT)"),
+    # 5.2 group 3 "rounding is not parameterised: G641 with ADIS = 0"
+    ("G90 G641 F3000\nG1 X0 Y0\nG1 X50\nG1 Y50\n", "rounding not parameterised (ADIS = 0)"),
+    ("G90 G641 ADIS=0.5 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\n",
+     "rounding not parameterised (ADISPOS = 0)"),
+    # 5.2 group 2 "when G64 can pass the transition without a velocity reduction":
+    # a 0.5 degree kink (the FB1 excerpt's example) at F3000
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y0.436330\n",
+     "G64 passes the corner without reduction (overload factor)"),
+    ("G90 G641 ADIS=0.0000005 F3000\nG1 X0 Y0\nG1 X50\nG1 Y50\n",
+     "rounding distance too small"),
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 X60\n", "tangential transition"),
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG2 X60 Y0 I5 J0\n",
+     "arc transition: rounding not modelled yet"),
+])
+def test_no_rounding_block_and_why(text, why):
+    """spec 5.2 "When no rounding block is inserted": each case, named per corner, in the
+    planner trace, and the path keeps the sharp corner."""
+    prog, mach, path = rounded(text, machine())
+    assert reasons(path) == [why]
+    assert not np.any(path.kind == ROUNDING)
+    note = dict((e.stage, e.note) for e in plan(prog, mach, path=path).trace)["rounding"]
+    assert why in note
+
+
+def test_ignore_ovl_factor_for_adis_rounds_even_a_small_kink():
+    """spec 4.3: "Setting MD20490 IGNORE_OVL_FACTOR_FOR_ADIS = TRUE makes G641/G642
+    behave like G643 here (always round)"."""
+    text = "G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y0.436330\n"
+    _, _, path = rounded(text, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    assert reasons(path) == ["rounded"]
+
+
+def test_g643_ignores_the_overload_factor():
+    """spec 5.5: G643 "The overload factor is never taken into account"."""
+    text = "G90 G643 CTOL=0.05 F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y0.436330\n"
+    _, _, path = rounded(text, machine())
+    assert reasons(path) == ["rounded"]
+
+
+def test_every_reason_is_reachable_words():
+    assert len(set(ROUNDING_REASONS)) == len(ROUNDING_REASONS)
+
+
+# ------------------------------------------------------------------ consequences
+def test_rows_list_every_block_once_and_the_rounding_belongs_to_the_corner_block():
+    prog, mach, path = rounded(square("G642", "CTOL=0.05"))
+    assert [s.block for s in path.blocks] == [b.index for b in prog.blocks]
+    res = plan(prog, mach, path=path)
+    assert [r.block for r in res.blocks] == [b.index for b in prog.blocks]
+    for k in np.flatnonzero(path.kind == ROUNDING):
+        span = next(s for s in path.blocks if s.block == path.block[k])
+        assert span.first_segment <= k < span.first_segment + span.n_segments
+        # the corner is the end of that block's programmed line
+        assert span.n_segments == 2 and k == span.first_segment + 1
+
+
+@pytest.mark.parametrize("mode", ["G642 CTOL=0.05", "G641 ADIS=0.5"])
+def test_rounded_contour_is_faster_than_g64_and_keeps_the_limits(mode):
+    """Issue 13 item 3: with rounding, a contour is faster than under G64 and the
+    heuristic never breaks its own limits on the rounded path (check_profile)."""
+    prog64, mach, _ = rounded(square("G64"), machine())
+    r64 = plan(prog64, mach)
+    prog, _, path = rounded(square(mode), mach)
+    assert path.rounding.inserted.all()
+    res = plan(prog, mach, path=path)
+    assert res.time_s < r64.time_s
+    rep = check_profile(path, mach.limits, res.profile)
+    assert rep.ok(BOUND_SETS[res.bound_set]), rep
+
+
+def test_overload_factor_one_rounds_where_g64_must_stop():
+    """With MAX_ACCEL_OVL_FACTOR = 1.0 G64 stops at every corner; G641 rounds it."""
+    d = copy.deepcopy(BASE)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = 1.0
+    mach = machine_from_dict(d)
+    prog64 = parse_text(square("G64"))
+    prog = parse_text(square("G641", "ADIS=0.5"))
+    path = build_path(prog, mach)
+    assert path.rounding.inserted.all()
+    assert plan(prog, mach, path=path).time_s < plan(prog64, mach).time_s
+
+
+def test_g64_programs_are_unchanged():
+    prog = parse_text(square("G64"))
+    mach = load_machine()
+    assert build_path(prog, mach).rounding is None
+
+
+# ------------------------------------------------------------------ RND / RNDM
+def test_rnd_inserts_a_tangent_arc_of_the_programmed_radius():
+    """spec 5.1: rounding "does not replace RND/RNDM"; RND (non-modal) rounds the corner
+    at the end of its block with a tangent arc of the programmed radius (issue 13)."""
+    text = "G90 G64 F3000\nG1 X0 Y0\nG1 X50 RND=2\nG1 Y50\nG1 X0\n"
+    _, _, path = rounded(text)
+    t = path.rounding
+    assert t.mode == ("RND",) and list(t.inserted) == [True]
+    np.testing.assert_allclose(t.radius_mm, 2.0, rtol=1e-12)
+    np.testing.assert_allclose(t.distance_mm, 2.0, rtol=1e-12)       # 2 tan(45 deg)
+    np.testing.assert_allclose(t.deviation_mm, 2.0 * (math.sqrt(2) - 1), rtol=1e-12)
+    _check_tangent_continuity(path)
+
+
+def test_rndm_is_modal_until_rndm_0():
+    text = ("G90 G64 F3000\nG1 X0 Y0 RNDM=1\nG1 X50\nG1 Y50\nG1 X0 RNDM=0\nG1 Y0\n"
+            "G1 X-10\n")
+    _, _, path = rounded(text)
+    t = path.rounding
+    assert t.mode == ("RNDM", "RNDM") and list(t.inserted) == [True, True]
+    # a 60 degree deflection: d = R tan(30 deg)
+    text = "G90 F3000\nG1 X0 Y0 RNDM=1\nG1 X50\nG1 X75 Y43.30127018922193\n"
+    _, _, path = rounded(text)
+    np.testing.assert_allclose(path.rounding.distance_mm, math.tan(math.pi / 6), rtol=1e-9)
+
+
+def test_negative_rnd_is_bad_input():
+    from reference.core.errors import NCSyntaxError
+    with pytest.raises(NCSyntaxError, match="RND=-1"):
+        parse_text("G1 X10 RND=-1\n")
+
+
+# ------------------------------------------------------------------ seeded polylines
+@pytest.mark.parametrize("seed", range(6))
+def test_seeded_polylines_round_into_a_continuous_path(seed):
+    """Random corners (1..179 degrees, some reversals and G0 blocks), every mode: the
+    rounded path is continuous in position and tangent at every rounding, each block
+    keeps one span, no line is shortened by more than its length, and the rounded path
+    is never longer than the programmed one."""
+    rng = np.random.default_rng(seed)
+    modes = ["G641 ADIS=0.3 ADISPOS=0.6", "G642", "G642 CTOL=0.1", "G643", "G645",
+             "G644", "G64 RNDM=0.4"]
+    lines = [f"G90 BRISK {modes[seed % len(modes)]} F5000", "G1 X0 Y0 Z0"]
+    x = y = z = 0.0
+    for _ in range(60):
+        x, y = x + rng.uniform(-3, 3), y + rng.uniform(-3, 3)
+        if rng.random() < 0.1:
+            z += rng.uniform(-1, 1)
+        word = "G0" if rng.random() < 0.15 else "G1"
+        lines.append(f"{word} X{x:.4f} Y{y:.4f} Z{z:.4f}")
+    prog = parse_text("\n".join(lines) + "\n")
+    mach = machine(IGNORE_OVL_FACTOR_FOR_ADIS=True)
+    path = build_path(prog, mach)
+    programmed = build_path(parse_text("\n".join(lines).replace(modes[seed % len(modes)],
+                                                                "G64") + "\n"), mach)
+    assert [s.block for s in path.blocks] == [b.index for b in prog.blocks]
+    _check_tangent_continuity(path)
+    for k in range(path.n_segments - 1):
+        np.testing.assert_allclose(path.segment(k).end, path.segment(k + 1).start,
+                                   atol=1e-9)
+    assert path.total_length <= programmed.total_length + 1e-9
+    t = path.rounding
+    assert t is not None and t.n > 0
+    assert t.inserted.any() and np.all(t.distance_mm[t.inserted] > 0)
+
+
+def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
+    """spec 5.3: "every block, the rounding block included, needs at least one
+    interpolation point, so the path velocity is limited to about ADIS / T_ipo". A 20
+    degree corner, ADIS = 0.01 mm: R = 0.01 / tan(10 deg), the rounding is R * 20 deg =
+    0.0198 mm long, so at most 0.0198 mm / 4 ms = 4.95 mm/s inside it (the centripetal
+    limit, sqrt(0.75 * 2000 * R), is near 9 mm/s and does not bind)."""
+    d = copy.deepcopy(BASE)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = 1.0          # G64 would stop: the rounding is taken
+    mach = machine_from_dict(d)
+    y = 50.0 * math.tan(math.radians(20.0))
+    prog = parse_text(f"G90 G641 ADIS=0.01 BRISK F3000\nG1 X0 Y0\nG1 X50\nG1 X100 Y{y!r}\n")
+    path = build_path(prog, mach)
+    assert list(path.rounding.inserted) == [True]
+    R = 0.01 / math.tan(math.radians(10.0))
+    length = R * math.radians(20.0)
+    assert path.rounding.length_mm[0] == pytest.approx(length, rel=1e-9)
+    k = int(np.flatnonzero(path.kind == ROUNDING)[0])
+    res = plan(prog, mach, path=path)
+    s = np.linspace(path.s_breaks[k], path.s_breaks[k + 1], 201)
+    v = res.profile.state(res.profile.time_at(s))[1]
+    assert v.max() <= length / 0.004 * (1 + 1e-9)
+    assert v.max() == pytest.approx(length / 0.004, rel=1e-6)
+
+
+@pytest.mark.parametrize("mode, smoothing, expect", [
+    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given"
+    ("G644 ADIS=0.4", 1000, ("distance", 0.4)),
+    ("G644 ADIS=0.4", 5000, ("distance", 0.4)),
+    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL"
+    ("G644 ADIS=0.4", 0, ("deviation", 0.01 * math.sqrt(2))),
+    # 2xxx / 3xxx (frequency, maximum dynamics) are named as not modelled
+    ("G644 ADIS=0.4", 3000, ("reason", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")),
+    # spec 5.4 table, value 4 [M]: "rounding distance from ADIS/ADISPOS, as for G641"
+    ("G642 ADIS=0.3", 40, ("distance", 0.3)),
+    ("G643 ADIS=0.3", 4, ("distance", 0.3)),
+    # units digit configures G643, tens digit G642: 10 leaves G643 on MD33100
+    ("G643", 10, ("deviation", 0.01 * math.sqrt(2))),
+])
+def test_smoothing_mode_digits(mode, smoothing, expect):
+    """spec 5.9 "MD20480 SMOOTHING_MODE digit map": G643 by the units digit, G642 by the
+    tens digit, G644 by the thousands digit."""
+    _, _, path = rounded(square(mode), machine(1.0, SMOOTHING_MODE=smoothing))
+    t = path.rounding
+    what, value = expect
+    if what == "reason":
+        assert reasons(path) == [value] * 3
+    elif what == "distance":
+        np.testing.assert_allclose(t.distance_mm, value, rtol=1e-12)
+    else:
+        np.testing.assert_allclose(t.deviation_mm, value, rtol=1e-12)
+
+
+def test_g0_tolerance_factor_widens_the_g642_tolerance():
+    """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
+    factor 3 x COMPRESS_POS_TOL)"."""
+    text = "G90 G642 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    _, _, path = rounded(text, machine(1.0, G0_TOLERANCE_FACTOR=3.0))
+    np.testing.assert_allclose(path.rounding.deviation_mm[0], 3 * 0.01 * math.sqrt(2),
+                               rtol=1e-12)
+    np.testing.assert_allclose(path.rounding.deviation_mm[1], 0.01 * math.sqrt(2), rtol=1e-12)
+
+
+def test_the_rounding_speed_estimate_uses_the_planner_default_centripetal_share():
+    from reference.planner.parameters import DEFAULT_PARAMETERS
+    from reference.rounding import CENTRIPETAL_SHARE
+    assert CENTRIPETAL_SHARE == DEFAULT_PARAMETERS.arc_centripetal_share
+
+
+def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
+    """spec 5.2 group 2 "Rounding would slow the program down": BRISK, MD33100 0.01 mm,
+    90 degree corners at F3000: the arc (R = 0.034 mm) is crossed at sqrt(0.75 * 2000 *
+    R) = 7.2 mm/s against 1.6 mm/s by G64, yet crawling 0.054 mm at 7.2 mm/s costs more
+    than it saves. Planned both ways, G64 is the faster, and that is what is kept."""
+    mach = machine()
+    prog = parse_text(square("G642"))
+    path = build_path(prog, mach)
+    assert reasons(path) == ["rounding would be slower than G64"] * 3
+    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    assert not forced.rounding.inserted.any()          # the time check is not the ovl one
+    # the same roundings, inserted (as on a machine where G64 must stop) and planned on
+    # this machine: slower than the sharp corners
+    t_sharp = plan(prog, mach, path=path).time_s
+    rounded_path = build_path(prog, machine(ovl=1.0))
+    assert rounded_path.rounding.inserted.all()
+    assert plan(prog, mach, path=rounded_path).time_s > t_sharp
