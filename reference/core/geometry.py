@@ -798,7 +798,7 @@ class Path:
                     omega=self.omega, theta0=self.theta0, length=self.length,
                     block=self.block, kind=self.kind, feed=self.feed, rapid=self.rapid,
                     stop=self.stop, stop_reason=self.stop_reason, blocks=self.blocks,
-                    source=self.source, dradius=self.dradius)
+                    source=self.source, dradius=self.dradius, rounding=self.rounding)
 
     def junction_tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """Tangents on both sides of every interior break.
