@@ -367,8 +367,9 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
                            abs(profile.s[-1] - L) > POS_TOL_MM * max(1.0, L)):
         raise ProfileError(f"profile starts at s = {profile.s[0]:.6g} mm and ends at s = "
                            f"{profile.s[-1]:.6g} mm but the path is {L:.6g} mm long")
-    n_blocks = max([b.block + 1 for b in path.blocks] +
-                   [int(path.block.max()) + 1 if path.n_segments else 0])
+    # (a generator: a list would hold 10^6 ints for one maximum)
+    n_blocks = max(max((b.block + 1 for b in path.blocks), default=0),
+                   int(path.block.max()) + 1 if path.n_segments else 0)
     worst = {c: _Worst(n_blocks) for c in CONSTRAINTS}
     jerk_step = _Worst(n_blocks)
     prof = _drop_empty(profile)
@@ -673,13 +674,18 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
     # crosses the exact break at sqrt(2 a 1e-13) ~ 1e-5 mm/s: so take the smallest |v|
     # of the knots within the profile's position tolerance of the break.
     win = POS_TOL_MM * max(1.0, path.total_length)
-    k_lo = np.clip(np.searchsorted(p.s, sb - win, side="left"), 0, K)
-    k_hi = np.maximum(np.searchsorted(p.s, sb + win, side="right"), k_lo + 1)
-    k_lo = np.minimum(k_lo, k_hi - 1)
-    knots = _ranges(k_lo, k_hi)
-    v_b = np.minimum.reduceat(np.abs(p.v[knots]),
-                              np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
-    k_first = k_lo
+    # in chunks of breaks (bounded temporaries; each break's knots are its own)
+    v_b = np.empty(m + 1)
+    k_first = np.empty(m + 1, dtype=np.int64)
+    for lo in range(0, m + 1, _WORK_CHUNK):
+        c_sb = sb[lo:lo + _WORK_CHUNK]
+        k_lo = np.clip(np.searchsorted(p.s, c_sb - win, side="left"), 0, K)
+        k_hi = np.maximum(np.searchsorted(p.s, c_sb + win, side="right"), k_lo + 1)
+        k_lo = np.minimum(k_lo, k_hi - 1)
+        knots = _ranges(k_lo, k_hi)
+        v_b[lo:lo + c_sb.size] = np.minimum.reduceat(
+            np.abs(p.v[knots]), np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
+        k_first[lo:lo + c_sb.size] = k_lo
     blk_b = path.block[np.clip(np.arange(m + 1) - 1, 0, m - 1)]   # block ending there
     stop = np.flatnonzero(path.stop)
     if stop.size:

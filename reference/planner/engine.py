@@ -35,7 +35,7 @@ from ..prepare import build_path
 from . import causes as C
 from .adaptation import adaptation_factors, adapted_units
 from .corners import junction_limits
-from .limit_curves import SegmentLimits, segment_limits
+from .limit_curves import segment_limits
 from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planning_units
 from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
 from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
@@ -247,45 +247,57 @@ def _exclusive_cumsum(x: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Planning units assembled at a time by :func:`_assemble` (its unit x phase
+#: temporaries stay a few MB; the result does not depend on it).
+_ASSEMBLE_CHUNK = 1 << 16
+
+
 def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
     """The motion Profile: unit phases in order (the holds are inserted afterwards by
     :func:`reference.core.holds.with_holds`, as on the oracle's side)."""
-    h = prof.duration
-    a0 = prof.a0
-    jj = prof.jerk
-    # In place, one temporary at a time: every (units x phases) array is some 50 MB for
-    # 10^6 blocks. Same operations in the same order as the plain formulas
-    # dv = a0 h + jj h^2 / 2, ds = v_start h + a0 h^2 / 2 + jj h^3 / 6 (bitwise equal).
-    dv = a0 * h
-    tmp = jj * h
-    tmp *= h
-    tmp /= 2
-    dv += tmp
-    v_start = _exclusive_cumsum(dv)
-    del dv
-    v_start += prof.v_in[:, None]
-    ds = v_start * h
-    np.multiply(a0, h, out=tmp)
-    tmp *= h
-    tmp /= 2
-    ds += tmp
-    del tmp
-    tmp = h ** 3
-    tmp *= jj
-    tmp /= 6
-    ds += tmp
-    del tmp
-    s_start = _exclusive_cumsum(ds)
-    del ds
-    s_start += units.s_start[:, None]
-    keep = h > 0
-    hh = h[keep]
+    h_all = prof.duration
+    keep = h_all > 0
+    s_parts, v_parts = [], []
+    # In chunks of units, in place, one temporary at a time: every (units x phases) array
+    # is some 50 MB for 10^6 blocks. Same operations in the same order as the plain
+    # formulas dv = a0 h + jj h^2 / 2, ds = v_start h + a0 h^2 / 2 + jj h^3 / 6 (bitwise
+    # equal), all within a unit's row.
+    for lo in range(0, h_all.shape[0], _ASSEMBLE_CHUNK):
+        hi = lo + _ASSEMBLE_CHUNK
+        h, a0, jj = h_all[lo:hi], prof.a0[lo:hi], prof.jerk[lo:hi]
+        dv = a0 * h
+        tmp = jj * h
+        tmp *= h
+        tmp /= 2
+        dv += tmp
+        v_start = _exclusive_cumsum(dv)
+        del dv
+        v_start += prof.v_in[lo:hi, None]
+        ds = v_start * h
+        np.multiply(a0, h, out=tmp)
+        tmp *= h
+        tmp /= 2
+        ds += tmp
+        del tmp
+        tmp = h ** 3
+        tmp *= jj
+        tmp /= 6
+        ds += tmp
+        del tmp
+        s_start = _exclusive_cumsum(ds)
+        del ds
+        s_start += units.s_start[lo:hi, None]
+        k = keep[lo:hi]
+        s_parts.append(s_start[k])
+        v_parts.append(np.maximum(v_start[k], 0.0))
+    hh = h_all[keep]
     t = np.concatenate(([0.0], np.cumsum(hh)))
-    s = np.concatenate((s_start[keep], [path.total_length]))
-    del s_start
-    v = np.concatenate((np.maximum(v_start[keep], 0.0), [0.0]))
-    del v_start
-    return Profile(t=t, s=s, v=v, a=a0[keep], j=jj[keep], block=np.full(hh.size, -1))
+    s = np.concatenate(s_parts + [np.array([path.total_length])])
+    del s_parts
+    v = np.concatenate(v_parts + [np.zeros(1)])
+    del v_parts
+    return Profile(t=t, s=s, v=v, a=prof.a0[keep], j=prof.jerk[keep],
+                   block=np.full(hh.size, -1))
 
 
 # ----------------------------------------------------------------- rows
