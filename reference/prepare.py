@@ -111,13 +111,17 @@ def prepare(program: Program) -> Path:
     geo = np.sqrt(np.sum(delta[:, geometry] ** 2, axis=1))
     allax = np.sqrt(np.sum(delta ** 2, axis=1))
     line_len = np.where(geo > POS_TOL_MM, geo, allax)
+    del delta, geo, allax
     moving_line = is_motion & ~is_arc & (line_len > POS_TOL_MM)
     moving = moving_line | is_arc  # arcs decided below (a full circle has start == end)
 
     # --- packed parameters, one row per moving block, in block order -------------
     rows = np.flatnonzero(moving)
-    lines = line_segments(starts[rows], ends[rows], geometry, rows)
-    packed = {k: v.copy() for k, v in lines.items()}
+    # line_segments builds fresh arrays from these fresh copies (origin is the copy
+    # itself), except block, which is ``rows``: only that one is copied before the arcs
+    # are written in (10^6 segments: a copy of all would be some 150 MB at once)
+    packed = line_segments(starts[rows], ends[rows], geometry, rows)
+    packed["block"] = packed["block"].copy()
     arc_i = np.flatnonzero(is_arc[rows])           # positions among the moving rows
     if arc_i.size:
         arc_rows = rows[arc_i]
@@ -148,6 +152,7 @@ def prepare(program: Program) -> Path:
             raise PathError(f"{program.file}:{b.line}: {exc}", b.index) from None
         for k in packed:
             packed[k][arc_i] = arcs[k]
+    del starts, ends           # the spans below are 10^6 objects: make room first
     keep = packed["length"] > POS_TOL_MM
     if not np.all(keep):
         rows = rows[keep]
@@ -164,9 +169,15 @@ def prepare(program: Program) -> Path:
     reasons = [""] * (m + 1)
     spans: list[BlockSpan] = []
     next_break = 0            # break index in front of the next segment
-    s_breaks = np.concatenate(([0.0], np.cumsum(packed["length"])))
+    # Python numbers taken once from the arrays: a block's start is the very float
+    # object of the previous block's end, and equal feeds share one object (10^6 spans
+    # would otherwise hold some 3e6 floats of their own)
+    s_at = np.concatenate(([0.0], np.cumsum(packed["length"]))).tolist()
+    seg_list = seg_of_block.tolist()
+    feeds: dict[float, float] = {}
+    feed_list = [feeds.setdefault(f, f) for f in feed.tolist()]
     for b in blocks:
-        seg = seg_of_block[b.index]
+        seg = seg_list[b.index]
         if seg >= 0:
             at_start, at_end = _aux_stops(b)
             if at_start and not reasons[seg]:
@@ -179,9 +190,9 @@ def prepare(program: Program) -> Path:
                 reasons[seg + 1] = end_reason
             spans.append(BlockSpan(
                 block=b.index, line=b.line, label=b.label, kind=b.motion or "none",
-                s_start=float(s_breaks[seg]), s_end=float(s_breaks[seg + 1]),
-                first_segment=int(seg), n_segments=1,
-                feed_mm_s=float(feed[seg]), stop_reason=end_reason))
+                s_start=s_at[seg], s_end=s_at[seg + 1],
+                first_segment=seg, n_segments=1,
+                feed_mm_s=feed_list[seg], stop_reason=end_reason))
             next_break = seg + 1
         else:
             why = _idle_stop(b)
@@ -190,7 +201,7 @@ def prepare(program: Program) -> Path:
             kind = "none" if b.motion is None else b.motion
             spans.append(BlockSpan(
                 block=b.index, line=b.line, label=b.label, kind=kind,
-                s_start=float(s_breaks[next_break]), s_end=float(s_breaks[next_break]),
+                s_start=s_at[next_break], s_end=s_at[next_break],
                 first_segment=next_break, n_segments=0, stop_reason=why,
                 dwell_s=float(b.dwell_s or 0.0)))
     reasons[0] = reasons[0] or "start"

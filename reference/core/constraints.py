@@ -139,6 +139,10 @@ MIN_ARC_SAMPLES = 8
 #: Evaluation points per chunk. 65 536 points of n axes need about 0.5 MB per (N, n)
 #: array and axis; a chunk uses some 20 of them, so a few tens of MB at most.
 CHUNK_SAMPLES = 65_536
+#: Items (intervals, arcs, processes) per step where a whole-array formula is only
+#: split to bound its temporaries: the results do not depend on it (unlike
+#: ``CHUNK_SAMPLES``, which also sets how a long arc interval is cut into pieces).
+_WORK_CHUNK = CHUNK_SAMPLES
 
 #: Path accelerations below this fraction of the profile's largest |s''| count as zero
 #: when cutting the motion into velocity-change processes. It absorbs the round-off of
@@ -369,8 +373,9 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
                            abs(profile.s[-1] - L) > POS_TOL_MM * max(1.0, L)):
         raise ProfileError(f"profile starts at s = {profile.s[0]:.6g} mm and ends at s = "
                            f"{profile.s[-1]:.6g} mm but the path is {L:.6g} mm long")
-    n_blocks = max([b.block + 1 for b in path.blocks] +
-                   [int(path.block.max()) + 1 if path.n_segments else 0])
+    # (a generator: a list would hold 10^6 ints for one maximum)
+    n_blocks = max(max((b.block + 1 for b in path.blocks), default=0),
+                   int(path.block.max()) + 1 if path.n_segments else 0)
     worst = {c: _Worst(n_blocks) for c in CONSTRAINTS}
     jerk_step = _Worst(n_blocks)
     prof = _drop_empty(profile)
@@ -466,18 +471,26 @@ def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
     path = ctx.path
     k_all = np.flatnonzero(ctx.h > 0)
     arc = path.radius[ctx.seg[k_all]] > 0
-    vpk_all, _, _ = _speed_peak(ctx, k_all)
-    n_uni = np.where(arc, np.maximum(
-        MIN_ARC_SAMPLES,
-        np.ceil(plane_amplitudes(path).omega_max[ctx.seg[k_all]] * vpk_all * ctx.h[k_all]
-                / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1), 0)
+    # samples per arc interval (lines need none), from its peak speed; formed in chunks
+    # of arc intervals (the speed peak's temporaries are a dozen arrays per interval)
+    n_uni = np.zeros(k_all.size, dtype=np.int64)
+    arc_i = np.flatnonzero(arc)
+    if arc_i.size:
+        omega_max = plane_amplitudes(path).omega_max
+        for lo in range(0, arc_i.size, _WORK_CHUNK):
+            ii = arc_i[lo:lo + _WORK_CHUNK]
+            k = k_all[ii]
+            vpk, _, _ = _speed_peak(ctx, k)
+            n_uni[ii] = np.maximum(
+                MIN_ARC_SAMPLES,
+                np.ceil(omega_max[ctx.seg[k]] * vpk * ctx.h[k]
+                        / ARC_SAMPLE_STEP_RAD).astype(np.int64) + 1)
     # An arc interval needing more than a chunk of samples (a long helix run in few
     # intervals) is cut into pieces of time, each sampled at the same density; so every
     # chunk stays about CHUNK_SAMPLES points whatever the number of turns.
-    n_piece = np.maximum(1, -(-n_uni // CHUNK_SAMPLES))
-    piece_k = np.repeat(k_all, n_piece)
-    piece_first = np.ones(piece_k.size, bool)
-    if piece_k.size > k_all.size:
+    if np.any(n_uni > CHUNK_SAMPLES):
+        n_piece = np.maximum(1, -(-n_uni // CHUNK_SAMPLES))
+        piece_k = np.repeat(k_all, n_piece)
         start = np.concatenate(([0], np.cumsum(n_piece)[:-1]))
         idx = np.arange(piece_k.size) - np.repeat(start, n_piece)
         piece_first = idx == 0
@@ -487,8 +500,11 @@ def _check_intervals(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
         arc_p = np.repeat(arc, n_piece)
         n_rows = np.where(arc_p, n_rows, 0)
     else:
-        frac0 = np.zeros(k_all.size)
-        frac1 = np.ones(k_all.size)
+        # one piece per interval: the whole interval (read-only views, no copies)
+        piece_k = k_all
+        piece_first = np.broadcast_to(True, k_all.shape)
+        frac0 = np.broadcast_to(0.0, k_all.shape)
+        frac1 = np.broadcast_to(1.0, k_all.shape)
         n_rows, arc_p = n_uni, arc
     # cost: one row per line interval; uniform + stationary + 3 refinement rows per arc
     cost = np.where(arc_p, n_rows + 4, 1)
@@ -664,13 +680,18 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
     # crosses the exact break at sqrt(2 a 1e-13) ~ 1e-5 mm/s: so take the smallest |v|
     # of the knots within the profile's position tolerance of the break.
     win = POS_TOL_MM * max(1.0, path.total_length)
-    k_lo = np.clip(np.searchsorted(p.s, sb - win, side="left"), 0, K)
-    k_hi = np.maximum(np.searchsorted(p.s, sb + win, side="right"), k_lo + 1)
-    k_lo = np.minimum(k_lo, k_hi - 1)
-    knots = _ranges(k_lo, k_hi)
-    v_b = np.minimum.reduceat(np.abs(p.v[knots]),
-                              np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
-    k_first = k_lo
+    # in chunks of breaks (bounded temporaries; each break's knots are its own)
+    v_b = np.empty(m + 1)
+    k_first = np.empty(m + 1, dtype=np.int64)
+    for lo in range(0, m + 1, _WORK_CHUNK):
+        c_sb = sb[lo:lo + _WORK_CHUNK]
+        k_lo = np.clip(np.searchsorted(p.s, c_sb - win, side="left"), 0, K)
+        k_hi = np.maximum(np.searchsorted(p.s, c_sb + win, side="right"), k_lo + 1)
+        k_lo = np.minimum(k_lo, k_hi - 1)
+        knots = _ranges(k_lo, k_hi)
+        v_b[lo:lo + c_sb.size] = np.minimum.reduceat(
+            np.abs(p.v[knots]), np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
+        k_first[lo:lo + c_sb.size] = k_lo
     blk_b = path.block[np.clip(np.arange(m + 1) - 1, 0, m - 1)]   # block ending there
     stop = np.flatnonzero(path.stop)
     if stop.size:
@@ -681,10 +702,10 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
         return
     # the tangents every side uses (Path.junction_tangents), so the planner's and the
     # oracle's corner caps are judged on the very numbers they were computed from
-    t_in, t_out = path.junction_tangents()
     for lo, hi in _chunks(np.full(m - 1, 16)):
         b = np.arange(lo, hi) + 1
-        dv = axis_velocity_jumps(t_in[b - 1], t_out[b - 1], v_b[b])
+        t_in, t_out = path.junction_tangents(lo, hi)
+        dv = axis_velocity_jumps(t_in, t_out, v_b[b])
         jump = np.broadcast_to(lim.jump, dv.shape)
         worst["velocity_jump"].update(jump_ratio(dv, jump), dv, jump, sb[b], p.t[k_first[b]],
                                       blk_b[b], path.axes)
@@ -695,35 +716,56 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     p, path, lim = ctx.prof, ctx.path, ctx.lim
     h = ctx.h
     a0, j = p.a, p.j
-    a1 = a0 + j * h
-    scale = float(max(np.max(np.abs(a0)), np.max(np.abs(a1))))
+    K = h.size
+    # Per-interval and per-piece work in chunks of intervals: 10^6 blocks make ~5e6
+    # pieces, and a dozen whole-length temporaries would be some 400 MB at once.
+    step = _WORK_CHUNK
+    scale = 0.0
+    for lo in range(0, K, step):
+        hi = min(K, lo + step)
+        a1 = a0[lo:hi] + j[lo:hi] * h[lo:hi]
+        scale = max(scale, float(np.max(np.abs(a0[lo:hi]))), float(np.max(np.abs(a1))))
     if scale == 0.0:
         return
     tol = FREQ_ACCEL_TOL_REL * scale
-    # pieces: intervals cut where a(tau), linear in tau, changes sign clearly (both ends
-    # beyond tol); an end within tol of zero is a touch, not a change of sign, so that
-    # round-off at the end of a ramp (a = -1e-13 instead of 0) cannot split a process
-    cross = (j != 0) & (a0 * a1 < 0) & (np.abs(a0) > tol) & (np.abs(a1) > tol)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tz = np.where(cross, -a0 / np.where(cross, j, 1.0), 0.0)
-    npc = 1 + cross.astype(np.int64)
-    parent = np.repeat(np.arange(h.size), npc)
-    second = np.zeros(parent.size, bool)
-    second[np.cumsum(npc)[cross] - 1] = True
-    first_of_two = np.repeat(cross, npc) & ~second
-    tau0 = np.where(second, tz[parent], 0.0)
-    tau1 = np.where(first_of_two, tz[parent], h[parent])
-    pa0 = a0[parent] + j[parent] * tau0
-    pa1 = a0[parent] + j[parent] * tau1
-    amax = np.maximum(np.abs(pa0), np.abs(pa1))
-    moving = (p.s[1:] > p.s[:-1])[parent]
-    dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
-    sign = np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8)
-    # one array per piece is a few bytes per piece; 10^6 blocks make ~5e6 pieces, so the
-    # per-piece temporaries go as soon as the signs are known
-    del pa0, pa1, amax, moving, dominant, first_of_two, second, tz, npc
+    parents, signs, taus0, taus1 = [], [], [], []
+    for lo in range(0, K, step):
+        hi = min(K, lo + step)
+        c_a0, c_j, c_h = a0[lo:hi], j[lo:hi], h[lo:hi]
+        c_a1 = c_a0 + c_j * c_h
+        # pieces: intervals cut where a(tau), linear in tau, changes sign clearly (both
+        # ends beyond tol); an end within tol of zero is a touch, not a change of sign, so
+        # that round-off at the end of a ramp (a = -1e-13 instead of 0) cannot split a
+        # process
+        cross = (c_j != 0) & (c_a0 * c_a1 < 0) & (np.abs(c_a0) > tol) & (np.abs(c_a1) > tol)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tz = np.where(cross, -c_a0 / np.where(cross, c_j, 1.0), 0.0)
+        npc = 1 + cross.astype(np.int64)
+        local = np.repeat(np.arange(hi - lo), npc)
+        second = np.zeros(local.size, bool)
+        second[np.cumsum(npc)[cross] - 1] = True
+        first_of_two = np.repeat(cross, npc) & ~second
+        tau0 = np.where(second, tz[local], 0.0)
+        tau1 = np.where(first_of_two, tz[local], c_h[local])
+        pa0 = c_a0[local] + c_j[local] * tau0
+        pa1 = c_a0[local] + c_j[local] * tau1
+        amax = np.maximum(np.abs(pa0), np.abs(pa1))
+        moving = (p.s[lo + 1:hi + 1] > p.s[lo:hi])[local]
+        dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
+        signs.append(np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8))
+        parents.append(local + lo)
+        taus0.append(tau0)
+        taus1.append(tau1)
+    sign = np.concatenate(signs)
+    del signs
     if not np.any(sign):
         return
+    parent = np.concatenate(parents)
+    del parents
+    tau0 = np.concatenate(taus0)
+    del taus0
+    tau1 = np.concatenate(taus1)
+    del taus1
     starts = np.concatenate(([0], np.flatnonzero(np.diff(sign)) + 1))
     ends = np.concatenate((starts[1:], [sign.size]))
     nz = sign[starts] != 0
@@ -736,21 +778,29 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     rw = path.radius * np.abs(path.omega)
     reach = np.abs(path.d) + rw[:, None] * (np.abs(path.e1) + np.abs(path.e2))
     seg_moving = (reach > MOVING_AXIS_TOL).astype(np.uint8)
-    run_moving = np.maximum.reduceat(seg_moving[seg[parent]], starts, axis=0).astype(bool)
+    del rw, reach
+    piece_moving = seg_moving[seg[parent]]
+    run_moving = np.maximum.reduceat(piece_moving, starts, axis=0).astype(bool)
+    del piece_moving, seg_moving
     f = np.where(run_moving, lim.frequency_hz[None, :], np.inf)
+    del run_moving
     f_min = f.min(axis=1)
     ax = f.argmin(axis=1)
+    del f
     ok = nz & np.isfinite(f_min) & (dur > 0)
     if not np.any(ok):
         return
     starts, ends, dur, f_min, ax = starts[ok], ends[ok], dur[ok], f_min[ok], ax[ok]
     t0_start = t0_start[ok]
     ratio = (1.0 / f_min) / dur
-    # per block: every block a process touches
-    run_of_piece = np.repeat(np.arange(starts.size), ends - starts)
-    pieces = _ranges(starts, ends)
+    # per block: every block a process touches (in chunks of processes)
     if w.per_block.size:
-        np.maximum.at(w.per_block, path.block[seg[parent[pieces]]], ratio[run_of_piece])
+        for r0 in range(0, starts.size, step):
+            r1 = min(starts.size, r0 + step)
+            n_r = ends[r0:r1] - starts[r0:r1]
+            pieces = _ranges(starts[r0:r1], ends[r0:r1])
+            np.maximum.at(w.per_block, path.block[seg[parent[pieces]]],
+                          np.repeat(ratio[r0:r1], n_r))
     i = int(np.argmax(ratio))
     pc = starts[i]
     k = parent[pc]

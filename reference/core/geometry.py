@@ -800,25 +800,35 @@ class Path:
                     stop=self.stop, stop_reason=self.stop_reason, blocks=self.blocks,
                     source=self.source, dradius=self.dradius, rounding=self.rounding)
 
-    def junction_tangents(self) -> tuple[np.ndarray, np.ndarray]:
-        """Tangents on both sides of every interior break.
+    def junction_tangents(self, lo: int = 0, hi: int | None = None
+                          ) -> tuple[np.ndarray, np.ndarray]:
+        """Tangents on both sides of every interior break (or of breaks ``lo + 1`` to
+        ``hi``: junctions ``lo:hi``, for callers that work in chunks).
+
+        Parameters
+        ----------
+        lo, hi : int, optional
+            Junction range; junction ``k`` lies between segments ``k`` and ``k + 1``.
+            Default: all ``m - 1``.
 
         Returns
         -------
-        t_in, t_out : numpy.ndarray, shape (m - 1, n)
+        t_in, t_out : numpy.ndarray, shape (hi - lo, n)
             ``q'`` at the end of segment ``k`` and at the start of segment ``k + 1``.
         """
         m = self.n_segments
-        if m < 2:
+        hi = m - 1 if hi is None else min(hi, m - 1)
+        lo = max(0, lo)
+        if hi <= lo:
             z = np.zeros((0, self.n_axes))
             return z, z
-        idx_in = np.arange(m - 1)
+        idx_in = np.arange(lo, hi)
         idx_out = idx_in + 1
         _, t_in, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                      self.omega, self.theta0, idx_in, self.length[:-1],
+                                      self.omega, self.theta0, idx_in, self.length[lo:hi],
                                       self.dradius, self.length)
         _, t_out, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                       self.omega, self.theta0, idx_out, np.zeros(m - 1),
+                                       self.omega, self.theta0, idx_out, np.zeros(hi - lo),
                                        self.dradius, self.length)
         return t_in, t_out
 

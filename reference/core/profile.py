@@ -28,6 +28,9 @@ from .arrays import readonly
 from .errors import ProfileError
 from .tolerances import POS_TOL_MM, VEL_TOL_MM_S
 
+#: Intervals checked at a time by :class:`Profile` (bounds the checks' temporaries to a
+#: few MB whatever the profile's length).
+_CHECK_CHUNK = 1 << 16
 
 
 
@@ -73,30 +76,51 @@ class Profile:
             if not np.all(np.isfinite(arr)):
                 k = int(np.flatnonzero(~np.isfinite(arr))[0])
                 raise ProfileError(f"profile {name}[{k}] is not finite ({arr[k]})")
-        h = np.diff(self.t)
-        if np.any(h < 0):
-            k = int(np.flatnonzero(h < 0)[0])
-            raise ProfileError(f"time runs backwards at knot {k + 1}")
+        # In chunks: a plan of 10^6 blocks has some 4e6 intervals, and the whole-array
+        # formulas would hold half a dozen temporaries of 35 MB each at once.
+        K1 = self.t.size
+        for lo in range(0, max(K, 0), _CHECK_CHUNK):
+            hi = min(K, lo + _CHECK_CHUNK)
+            h = self.t[lo + 1:hi + 1] - self.t[lo:hi]
+            if np.any(h < 0):
+                k = lo + int(np.flatnonzero(h < 0)[0])
+                raise ProfileError(f"time runs backwards at knot {k + 1}")
         if np.any(self.v < -VEL_TOL_MM_S):
             k = int(np.argmin(self.v))
             raise ProfileError(f"negative path velocity {self.v[k]:.6g} mm/s at knot {k}")
-        s_end, v_end = self._integrate_end(h)
-        scale = max(1.0, float(np.max(np.abs(self.s)))) if self.s.size else 1.0
-        ds = np.abs(s_end - self.s[1:])
-        if ds.size and ds.max() > POS_TOL_MM * scale:
-            k = int(np.argmax(ds))
-            raise ProfileError(f"interval {k}: integrated position {s_end[k]:.9g} mm does "
+        if K1:
+            scale = max(1.0, abs(float(self.s.max())), abs(float(self.s.min())))
+            vscale = max(1.0, abs(float(self.v.max())), abs(float(self.v.min())))
+        else:
+            scale = vscale = 1.0
+        ds_max, dv_max = (-1.0, -1), (-1.0, -1)      # (largest mismatch, its interval)
+        for lo in range(0, K, _CHECK_CHUNK):
+            hi = min(K, lo + _CHECK_CHUNK)
+            s_end, v_end = self._integrate_end(self.t[lo + 1:hi + 1] - self.t[lo:hi], lo, hi)
+            ds = np.abs(s_end - self.s[lo + 1:hi + 1])
+            dv = np.abs(v_end - self.v[lo + 1:hi + 1])
+            k, q = int(np.argmax(ds)), int(np.argmax(dv))
+            if ds[k] > ds_max[0]:
+                ds_max = (float(ds[k]), lo + k)
+            if dv[q] > dv_max[0]:
+                dv_max = (float(dv[q]), lo + q)
+        if ds_max[0] > POS_TOL_MM * scale:
+            k = ds_max[1]
+            s_k = self._integrate_end(self.t[k + 1:k + 2] - self.t[k:k + 1], k, k + 1)[0][0]
+            raise ProfileError(f"interval {k}: integrated position {s_k:.9g} mm does "
                                f"not meet the next knot {self.s[k + 1]:.9g} mm")
-        vscale = max(1.0, float(np.max(np.abs(self.v)))) if self.v.size else 1.0
-        dv = np.abs(v_end - self.v[1:])
-        if dv.size and dv.max() > 1e-6 * vscale:
-            k = int(np.argmax(dv))
-            raise ProfileError(f"interval {k}: integrated velocity {v_end[k]:.9g} mm/s does "
+        if dv_max[0] > 1e-6 * vscale:
+            k = dv_max[1]
+            v_k = self._integrate_end(self.t[k + 1:k + 2] - self.t[k:k + 1], k, k + 1)[1][0]
+            raise ProfileError(f"interval {k}: integrated velocity {v_k:.9g} mm/s does "
                                f"not meet the next knot {self.v[k + 1]:.9g} mm/s")
 
-    def _integrate_end(self, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        s_end = self.s[:-1] + self.v[:-1] * h + self.a * h * h / 2 + self.j * h ** 3 / 6
-        v_end = self.v[:-1] + self.a * h + self.j * h * h / 2
+    def _integrate_end(self, h: np.ndarray, lo: int, hi: int
+                       ) -> tuple[np.ndarray, np.ndarray]:
+        """Position and velocity at the end of intervals ``lo:hi`` of durations ``h``."""
+        s0, v0, a, j = self.s[lo:hi], self.v[lo:hi], self.a[lo:hi], self.j[lo:hi]
+        s_end = s0 + v0 * h + a * h * h / 2 + j * h ** 3 / 6
+        v_end = v0 + a * h + j * h * h / 2
         return s_end, v_end
 
     # ------------------------------------------------------------ constructors
@@ -277,6 +301,20 @@ class Profile:
         return (t, *self.state(t))
 
     # ------------------------------------------------------------ accounting
+    def _cuts(self, s_cuts):
+        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
+        time and position of each cut), or ``None`` when no cut falls inside an
+        interval."""
+        cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
+        cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
+        cuts = cuts[~np.isin(cuts, self.s)]
+        if cuts.size == 0 or self.n_intervals == 0:
+            return None
+        tc = self.time_at(cuts)
+        k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
+        order = np.argsort(tc, kind="stable")
+        return k[order], tc[order], cuts[order]
+
     def split_at(self, s_cuts) -> "Profile":
         """Same motion with extra knots where it first crosses each ``s_cuts`` value.
 
@@ -290,16 +328,11 @@ class Profile:
         Profile
             Equivalent profile whose moving intervals never straddle a cut.
         """
-        cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
-        cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
-        cuts = cuts[~np.isin(cuts, self.s)]
-        if cuts.size == 0 or self.n_intervals == 0:
+        cut = self._cuts(s_cuts)
+        if cut is None:
             return self
-        tc = self.time_at(cuts)
-        k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
-        sc, vc, ac, _ = self.state(tc)
-        order = np.argsort(tc, kind="stable")
-        tc, k, sc, vc, ac = tc[order], k[order], cuts[order], vc[order], ac[order]
+        k, tc, sc = cut
+        _, vc, ac, _ = self.state(tc)
         t = np.insert(self.t, k + 1, tc)
         s = np.insert(self.s, k + 1, sc)
         v = np.insert(self.v, k + 1, np.maximum(vc, 0.0))
@@ -325,27 +358,15 @@ class Profile:
         -------
         numpy.ndarray of int, shape (K,)
         """
-        blk = self.block.copy()
-        todo = blk < 0
-        if not np.any(todo) or not path.blocks:
-            return blk
-        mid = 0.5 * (self.s[:-1] + self.s[1:])
-        moving = self.s[1:] > self.s[:-1]
-        if path.n_segments:
-            by_pos = path.block_of(mid)
-        else:
-            by_pos = np.full(mid.size, path.blocks[-1].block)
-        ends = np.array([b.s_end for b in path.blocks])
-        ids = np.array([b.block for b in path.blocks])
-        # last block (program order) whose end is at or before each hold position
-        last_end = np.searchsorted(ends, self.s[:-1], side="right") - 1
-        hold_blk = ids[np.clip(last_end, 0, len(ids) - 1)]
-        blk[todo & moving] = by_pos[todo & moving]
-        blk[todo & ~moving] = hold_blk[todo & ~moving]
-        return blk
+        return _interval_blocks(self.s, self.block, path)
 
     def block_times(self, path) -> np.ndarray:
         """Time spent in each NC block; sums to :attr:`duration`.
+
+        The same sums as ``split_at`` at every block end followed by
+        :meth:`interval_blocks`, formed from the split knots' times and positions alone
+        (a plan of 10^6 blocks would otherwise build a second profile of some 4e6
+        intervals to read two of its six arrays).
 
         Parameters
         ----------
@@ -359,9 +380,17 @@ class Profile:
         """
         n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
         cuts = [b.s_end for b in path.blocks if b.s_end > b.s_start]
-        prof = self.split_at(cuts)
-        blk = prof.interval_blocks(path)
-        return np.bincount(blk, weights=np.diff(prof.t), minlength=n_blocks)
+        cut = self._cuts(cuts)
+        if cut is None:
+            t, s, blk = self.t, self.s, self.block
+        else:
+            k, tc, sc = cut
+            t = np.insert(self.t, k + 1, tc)
+            s = np.insert(self.s, k + 1, sc)
+            blk = np.insert(self.block, k + 1, self.block[k])
+        iv = _interval_blocks(s, blk, path)
+        del s, blk
+        return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
 
     def segment_times(self, path) -> np.ndarray:
         """Time spent moving through each segment (holds excluded), shape ``(m,)``, s."""
@@ -371,3 +400,34 @@ class Profile:
         seg = path.segment_index(mid)
         return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
                            minlength=path.n_segments)
+
+
+#: Intervals labelled at a time by :func:`_interval_blocks` (bounded temporaries).
+_LABEL_CHUNK = 1 << 18
+
+
+def _interval_blocks(s: np.ndarray, block: np.ndarray, path) -> np.ndarray:
+    """:meth:`Profile.interval_blocks` of knots ``s`` (shape (K + 1,)) and labels
+    ``block`` (shape (K,)), worked in chunks of intervals."""
+    blk = np.array(block, dtype=np.int64)
+    if not np.any(blk < 0) or not path.blocks:
+        return blk
+    ends = np.array([b.s_end for b in path.blocks])
+    ids = np.array([b.block for b in path.blocks])
+    last = path.blocks[-1].block
+    for lo in range(0, blk.size, _LABEL_CHUNK):
+        hi = min(blk.size, lo + _LABEL_CHUNK)
+        part = blk[lo:hi]                       # a view: written in place
+        todo = part < 0
+        if not np.any(todo):
+            continue
+        s0, s1 = s[lo:hi], s[lo + 1:hi + 1]
+        moving = s1 > s0
+        mid = 0.5 * (s0 + s1)
+        by_pos = path.block_of(mid) if path.n_segments else np.full(mid.size, last)
+        # last block (program order) whose end is at or before each hold position
+        last_end = np.searchsorted(ends, s0, side="right") - 1
+        hold_blk = ids[np.clip(last_end, 0, len(ids) - 1)]
+        part[todo & moving] = by_pos[todo & moving]
+        part[todo & ~moving] = hold_blk[todo & ~moving]
+    return blk

@@ -18,7 +18,7 @@ _INF = float("inf")
 _MAX_F = MAX_FEED_MM_MIN / MM_PER_INCH     # in either unit: the full path checks exactly
 
 
-def _fast_block(ip: _Interp, st: Stmt, fast: list) -> bool:
+def _fast_block(ip: _Interp, st: Stmt, fast: list[tuple[str, str]]) -> bool:
     """Plain G0/G1/G2/G3 line of X/Y/Z/I/J/K/F/S/M words (NGC also R) with no frame
     active: the bulk of CAM output.
 

@@ -42,7 +42,7 @@ from ..core.errors import NCSyntaxError
 from .block import _block
 from .fastlane import _fast_block
 from .flow import _LazyLabels, _jump, _match_blocks, _oword
-from .lines import Stmt
+from .lines import Stmt, fast_pairs
 from .program import Block, BlockExtra, Program
 from .state import ROTARY, _Interp
 
@@ -116,8 +116,7 @@ def _execute(ip: _Interp, max_repeats: int = MAX_EXECUTED_BLOCKS) -> None:
                                 f"{max_repeats} lines executed again by loops and jumps; "
                                 f"it jumps back here from line {ip.jump_line or st.line})")
         if k == "block":
-            fast = st.fast
-            if fast is not None and _fast_block(ip, st, fast):
+            if st.fast is not None and _fast_block(ip, st, fast_pairs(st)):
                 i += 1
                 continue
             if not st.empty:

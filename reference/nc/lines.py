@@ -54,14 +54,23 @@ class Stmt:
     ``kind`` is ``"block"`` for ordinary lines and the control keyword otherwise
     (``"IF"``, ``"ENDWHILE"``, ``"O:IF"`` for NGC O-words, ...).
 
-    Plain word lines (the bulk of CAM output) take a fast lane: they carry ``fast``, a
-    list of ``(letter, number text)`` pairs, and build their :class:`Word` list (with columns)
-    only when the interpreter needs it. The class attributes below are the (immutable)
-    defaults of such lines; :meth:`__init__` gives full-grammar lines fresh lists.
+    Plain word lines (the bulk of CAM output) take a fast lane and are instances of this
+    class: they keep the line, its text and where its words lie (``fast``, ``fast_end``:
+    a span of :func:`normalized` text), and nothing else; the interpreter reads their
+    ``(letter, number text)`` pairs with :func:`fast_pairs` when it executes them, and
+    :attr:`words` builds :class:`Word` objects (with columns) only when asked. The class
+    attributes below are the (immutable) defaults of such lines. Lines that need the
+    full grammar are :class:`FullStmt`, which holds every field itself.
+
+    Every field is a slot: a program of 10^6 lines holds 10^6 of these at once while
+    it is interpreted, about 100 bytes each (a ``__dict__`` and the word pairs would be
+    some 600).
     """
 
+    __slots__ = ("line", "text", "label", "comment", "dialect", "fast", "fast_end",
+                 "_words")
+
     kind = "block"
-    label = ""
     assigns: list = ()          # (target, AST, col)
     calls: list = ()            # (NAME, raw args, col)
     flags: list = ()            # (NAME, col)
@@ -69,27 +78,9 @@ class Stmt:
     target = ""                 # GOTO label / O-word name
     case: list = ()             # [(value AST or None, label)]
     decl: list = ()             # DEF names
-    comment = ""
     message: str | None = None
     empty = False
     colmap: list | None = None  # NGC: code offset -> line column
-    fast: list | None = None    # fast lane: [(letter, number text), ...]
-    dialect = "sinumerik"
-
-    def __init__(self, line: int, text: str, kind: str = "block", label: str = "",
-                 comment: str = "", message: str | None = None) -> None:
-        self.line = line
-        self.text = text
-        self.kind = kind
-        self.label = label
-        self.comment = comment
-        self.message = message
-        self._words = []
-        self.assigns = []
-        self.calls = []
-        self.flags = []
-        self.case = []
-        self.decl = []
 
     @property
     def words(self) -> list:
@@ -101,6 +92,36 @@ class Stmt:
     @words.setter
     def words(self, value: list) -> None:
         self._words = value
+
+
+class FullStmt(Stmt):
+    """A line parsed with the full grammar: every field of :class:`Stmt` is its own
+    (fresh lists for words, assignments, calls, ...)."""
+
+    __slots__ = ("kind", "assigns", "calls", "flags", "cond", "target", "case", "decl",
+                 "message", "empty", "colmap")
+
+    def __init__(self, line: int, text: str, kind: str = "block", label: str = "",
+                 comment: str = "", message: str | None = None) -> None:
+        self.line = line
+        self.text = text
+        self.kind = kind
+        self.label = label
+        self.comment = comment
+        self.message = message
+        self.dialect = "sinumerik"
+        self.fast = None
+        self.fast_end = 0
+        self._words = []
+        self.assigns = []
+        self.calls = []
+        self.flags = []
+        self.cond = None
+        self.target = ""
+        self.case = []
+        self.decl = []
+        self.empty = False
+        self.colmap = None
 
 
 _NEW = object.__new__
@@ -156,37 +177,47 @@ _GLUED_E = re.compile(r"[\d.]E")          # an exponent, or X1E5: the full gramm
 
 
 def _fast_stmt(lineno: int, raw: str, label: str | None, comment: str | None,
-               pairs: list, dialect: str) -> Stmt:
+               span: tuple[int, int], dialect: str) -> Stmt:
     """A fast-lane :class:`Stmt` (class-level defaults for everything else)."""
     st = _NEW(Stmt)
     st.line = lineno
     st.text = raw
+    st.label = label or ""
+    st.comment = comment.strip() if comment else ""
+    st.dialect = dialect
+    st.fast, st.fast_end = span
     st._words = None
-    st.fast = pairs
-    if label:
-        st.label = label
-    if comment:
-        st.comment = comment.strip()
-    if dialect == "ngc":
-        st.dialect = "ngc"
     return st
+
+
+def normalized(st: Stmt) -> str:
+    """The text a fast-lane line's word span indexes: upper case, and for NGC without
+    blanks (LinuxCNC ignores them, also inside numbers)."""
+    raw = st.text
+    if st.dialect == "ngc":
+        return raw.replace(" ", "").replace("\t", "").upper()
+    return raw.upper()
+
+
+def fast_pairs(st: Stmt) -> list[tuple[str, str]]:
+    """``(letter, number text)`` of a fast-lane line, in source order.
+
+    Read again from the text each time the line runs rather than kept from parsing: a
+    program's lines are all held at once while it runs, and the pairs would triple
+    their size."""
+    return _SIMPLE_WORD.findall(normalized(st), st.fast, st.fast_end)
 
 
 def _fast_words(st: Stmt) -> list:
     """:class:`Word` objects (with 1-based columns) of a fast-lane line."""
-    raw = st.text
+    up = normalized(st)
     if st.dialect == "ngc":
-        cols = [i for i, ch in enumerate(raw) if ch not in " \t"]
-        up = raw.replace(" ", "").replace("\t", "").upper()
-        m = _SIMPLE_NGC.match(up)
-        span = m.span(2)
+        cols = [i for i, ch in enumerate(st.text) if ch not in " \t"]
     else:
         cols = None
-        up = raw.upper()
-        span = _SIMPLE_SIN.match(up).span(3)
     return [Word(w.group(1), ("num", float(w.group(2))),
                  (cols[w.start()] if cols is not None else w.start()) + 1)
-            for w in _SIMPLE_WORD.finditer(up, *span)]
+            for w in _SIMPLE_WORD.finditer(up, st.fast, st.fast_end)]
 
 
 def _simple_sin(lineno: int, raw: str) -> Stmt | None:
@@ -202,8 +233,8 @@ def _simple_sin(lineno: int, raw: str) -> Stmt | None:
         if len(up) != len(raw):          # upper-casing changed the length (rare letters)
             return None
         comment = raw[m.start(4):]
-    return _fast_stmt(lineno, raw, m.group(2) or m.group(1), comment,
-                      _SIMPLE_WORD.findall(up, m.start(3), m.end(3)), "sinumerik")
+    return _fast_stmt(lineno, raw, m.group(2) or m.group(1), comment, m.span(3),
+                      "sinumerik")
 
 
 def _simple_ngc(lineno: int, raw: str) -> Stmt | None:
@@ -214,8 +245,7 @@ def _simple_ngc(lineno: int, raw: str) -> Stmt | None:
     m = _SIMPLE_NGC.match(up)
     if m is None:
         return None
-    return _fast_stmt(lineno, raw, m.group(1), None,
-                      _SIMPLE_WORD.findall(up, m.start(2), m.end(2)), "ngc")
+    return _fast_stmt(lineno, raw, m.group(1), None, m.span(2), "ngc")
 
 
 def parse_sinumerik(lineno: int, raw: str) -> Stmt:
@@ -232,7 +262,7 @@ _SKIP_LEVEL = re.compile(r"/[0-9]?")
 def parse_sinumerik_full(lineno: int, raw: str) -> Stmt:
     """Parse one SINUMERIK line with the full grammar."""
     code, comment = _split_comment_sin(raw)
-    st = Stmt(line=lineno, text=raw, comment=comment)
+    st = FullStmt(line=lineno, text=raw, comment=comment)
     up = code.upper()
     cur = Cursor(up)
     cur.ws()
@@ -497,7 +527,7 @@ def parse_ngc(lineno: int, raw: str) -> Stmt:
 def parse_ngc_full(lineno: int, raw: str) -> Stmt:
     """Parse one RS274/NGC line with the full grammar."""
     code, cols, comment, msg = _strip_ngc(raw)
-    st = Stmt(line=lineno, text=raw, comment=comment, message=msg)
+    st = FullStmt(line=lineno, text=raw, comment=comment, message=msg)
     st.dialect = "ngc"
     if code.startswith("/"):
         code, cols = code[1:], cols[1:]

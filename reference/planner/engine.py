@@ -21,7 +21,7 @@ the stage trace and derives the per-block and per-corner rows. The result types 
 from __future__ import annotations
 
 import time
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -36,7 +36,7 @@ from ..prepare import build_path
 from . import causes as C
 from .adaptation import adaptation_factors, adapted_units
 from .corners import junction_limits
-from .limit_curves import SegmentLimits, segment_limits
+from .limit_curves import segment_limits
 from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planning_units
 from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
 from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
@@ -209,13 +209,14 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
 
     report_progress("assemble", 0.85)
     profile = with_holds(_assemble(path, units, prof), path, holds)
-    rows, corners = _rows(program, path, modes, seg, junc, units, speeds, prof, profile,
-                          horizon, holds)
+    at_segments, corners = _segment_rows(path, junc, units, speeds, prof, profile, horizon)
     bound_set = modes.bound_set
-    # the planning stages' arrays are done with: freed before the checker's own (with
-    # 10^6 blocks both together would be about a gigabyte)
-    del modes, seg, junc, horizon, base_units, units, speeds, prof
+    # the planning stages' arrays are done with: freed before the block rows and the
+    # checker build their own (with 10^6 blocks all together would be gigabytes)
+    del seg, horizon, base_units, units, speeds, prof
     sm = fac = new_units = None     # noqa: F841 - the smoothing's and adaptation's copies
+    rows = _block_rows(path, modes, junc, at_segments, profile, holds)
+    del modes, junc, at_segments
     report = None
     if check:
         report_progress("check", 0.9)
@@ -261,45 +262,57 @@ def _exclusive_cumsum(x: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Planning units assembled at a time by :func:`_assemble` (its unit x phase
+#: temporaries stay a few MB; the result does not depend on it).
+_ASSEMBLE_CHUNK = 1 << 16
+
+
 def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
     """The motion Profile: unit phases in order (the holds are inserted afterwards by
     :func:`reference.core.holds.with_holds`, as on the oracle's side)."""
-    h = prof.duration
-    a0 = prof.a0
-    jj = prof.jerk
-    # In place, one temporary at a time: every (units x phases) array is some 50 MB for
-    # 10^6 blocks. Same operations in the same order as the plain formulas
-    # dv = a0 h + jj h^2 / 2, ds = v_start h + a0 h^2 / 2 + jj h^3 / 6 (bitwise equal).
-    dv = a0 * h
-    tmp = jj * h
-    tmp *= h
-    tmp /= 2
-    dv += tmp
-    v_start = _exclusive_cumsum(dv)
-    del dv
-    v_start += prof.v_in[:, None]
-    ds = v_start * h
-    np.multiply(a0, h, out=tmp)
-    tmp *= h
-    tmp /= 2
-    ds += tmp
-    del tmp
-    tmp = h ** 3
-    tmp *= jj
-    tmp /= 6
-    ds += tmp
-    del tmp
-    s_start = _exclusive_cumsum(ds)
-    del ds
-    s_start += units.s_start[:, None]
-    keep = h > 0
-    hh = h[keep]
+    h_all = prof.duration
+    keep = h_all > 0
+    s_parts, v_parts = [], []
+    # In chunks of units, in place, one temporary at a time: every (units x phases) array
+    # is some 50 MB for 10^6 blocks. Same operations in the same order as the plain
+    # formulas dv = a0 h + jj h^2 / 2, ds = v_start h + a0 h^2 / 2 + jj h^3 / 6 (bitwise
+    # equal), all within a unit's row.
+    for lo in range(0, h_all.shape[0], _ASSEMBLE_CHUNK):
+        hi = lo + _ASSEMBLE_CHUNK
+        h, a0, jj = h_all[lo:hi], prof.a0[lo:hi], prof.jerk[lo:hi]
+        dv = a0 * h
+        tmp = jj * h
+        tmp *= h
+        tmp /= 2
+        dv += tmp
+        v_start = _exclusive_cumsum(dv)
+        del dv
+        v_start += prof.v_in[lo:hi, None]
+        ds = v_start * h
+        np.multiply(a0, h, out=tmp)
+        tmp *= h
+        tmp /= 2
+        ds += tmp
+        del tmp
+        tmp = h ** 3
+        tmp *= jj
+        tmp /= 6
+        ds += tmp
+        del tmp
+        s_start = _exclusive_cumsum(ds)
+        del ds
+        s_start += units.s_start[lo:hi, None]
+        k = keep[lo:hi]
+        s_parts.append(s_start[k])
+        v_parts.append(np.maximum(v_start[k], 0.0))
+    hh = h_all[keep]
     t = np.concatenate(([0.0], np.cumsum(hh)))
-    s = np.concatenate((s_start[keep], [path.total_length]))
-    del s_start
-    v = np.concatenate((np.maximum(v_start[keep], 0.0), [0.0]))
-    del v_start
-    return Profile(t=t, s=s, v=v, a=a0[keep], j=jj[keep], block=np.full(hh.size, -1))
+    s = np.concatenate(s_parts + [np.array([path.total_length])])
+    del s_parts
+    v = np.concatenate(v_parts + [np.zeros(1)])
+    del v_parts
+    return Profile(t=t, s=s, v=v, a=prof.a0[keep], j=prof.jerk[keep],
+                   block=np.full(hh.size, -1))
 
 
 # ----------------------------------------------------------------- rows
@@ -319,10 +332,20 @@ def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarr
     return idx[hit[first_hit]]
 
 
-def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits, junc,
-          units: Units, speeds: NodeSpeeds, prof: UnitProfiles, profile: Profile,
-          horizon: np.ndarray, holds: Holds) -> tuple[BlockTable, CornerTable]:
-    """Per-block and per-corner rows with speeds and limiting causes."""
+class _SegmentRows(NamedTuple):
+    """Per-segment and per-break results the block rows are made of (shapes (m,) and
+    (m + 1,)), kept apart so that the planning units can be freed before them."""
+
+    v_break: np.ndarray
+    v_peak_seg: np.ndarray
+    seg_cause: np.ndarray
+    case_seg: np.ndarray
+
+
+def _segment_rows(path: Path, junc, units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
+                  profile: Profile, horizon: np.ndarray
+                  ) -> tuple[_SegmentRows, CornerTable]:
+    """Speeds and limiting causes at every segment and break, and the corner rows."""
     m = path.n_segments
     tol = CAUSE_REL_TOL
     u = units.n_units
@@ -369,7 +392,21 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
         seg_cause = np.zeros(m, dtype=np.int64)
         brk_cause = np.full(m + 1, C.FORCED_STOP)
         case_seg = np.zeros(m, dtype=np.int64)
+    k = np.arange(1, m) if m >= 2 else np.zeros(0, dtype=np.int64)
+    own = np.minimum(junc.cap, horizon)
+    corners = CornerTable(
+        index=k, s=path.s_breaks[k], block_before=path.block[k - 1] if k.size else k,
+        block_after=path.block[k] if k.size else k, v=v_break[k], v_limit=own[k],
+        v_g64=junc.g64[k], tangential=junc.tangential[k], cause_code=brk_cause[k])
+    return _SegmentRows(v_break, v_peak_seg, seg_cause, case_seg), corners
 
+
+def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile: Profile,
+                holds: Holds) -> BlockTable:
+    """Per-block rows: times, speeds and limiting causes."""
+    m = path.n_segments
+    v_break, v_peak_seg, seg_cause, case_seg = (at.v_break, at.v_peak_seg, at.seg_cause,
+                                                at.case_seg)
     times = profile.block_times(path) if path.blocks else np.zeros(0)
     spans = path.blocks
     nb = len(spans)
@@ -400,20 +437,13 @@ def _rows(program: Program, path: Path, modes: SegmentModes, seg: SegmentLimits,
     cause_code = np.where(is_dwell & (t_blk > 0), C.DWELL, cause_code)
     mode_code = np.where(moving, modes.mode[mainc] if m else 0, -1)
     case_code = np.where(moving, case_seg[mainc] if m else 0, -1)
-    rows = BlockTable(
+    return BlockTable(
         block=ids, line=np.array([sp.line for sp in spans], dtype=np.int64),
         label=tuple(sp.label for sp in spans), kind=tuple(sp.kind for sp in spans),
         length_mm=np.array([sp.s_end - sp.s_start for sp in spans], dtype=np.float64),
         v_entry=v_entry, v_exit=v_exit, v_peak=v_pk, time_s=t_blk, cause_code=cause_code,
         mode_code=mode_code, case_code=case_code,
         hold_s=holds.per_block(int(ids.max()) + 1)[ids] if nb else np.zeros(0))
-    k = np.arange(1, m) if m >= 2 else np.zeros(0, dtype=np.int64)
-    own = np.minimum(junc.cap, horizon)
-    corners = CornerTable(
-        index=k, s=path.s_breaks[k], block_before=path.block[k - 1] if k.size else k,
-        block_after=path.block[k] if k.size else k, v=v_break[k], v_limit=own[k],
-        v_g64=junc.g64[k], tangential=junc.tangential[k], cause_code=brk_cause[k])
-    return rows, corners
 
 
 def _accel_cause(units: Units, prof: UnitProfiles, up: bool) -> np.ndarray:

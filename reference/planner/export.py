@@ -49,21 +49,28 @@ def to_json_dict(plan: ReferencePlan) -> dict:
             "blocks": blocks}
 
 
+#: Rows converted to Python objects at a time by :func:`iter_json_rows`.
+_ROW_CHUNK = 1 << 16
+
+
 def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
     """The ``blocks`` rows of :func:`to_json_dict`, one dict at a time (a table printed
     from them never holds all 10^6 of them at once)."""
-    # Built from the table's columns: 10^6 blocks would cost 10^6 row objects otherwise.
+    # Built from the table's columns, a chunk of rows at a time: 10^6 blocks would cost
+    # 10^6 row objects, or nine lists of 10^6 Python numbers, otherwise.
     tab = plan.blocks
-    cols_names = ("block", "line", "label", "kind", "length_mm", "time_s", "v_exit",
-                  "cause_code", "hold_s")
-    cols = [tab.column(name) for name in cols_names]
-    cols = [c.tolist() if isinstance(c, np.ndarray) else c for c in cols]
-    for i in (4, 5, 6, 8):                      # plain floats, as the contract says
-        cols[i] = np.asarray(tab.column(cols_names[i]), dtype=np.float64).tolist()
-    cols[7] = [C.CAUSES[k] if k >= 0 else "" for k in cols[7]]
+    names = ("block", "line", "label", "kind", "length_mm", "time_s", "v_exit",
+             "cause_code", "hold_s")
+    floats = {"length_mm", "time_s", "v_exit", "hold_s"}    # plain floats, as the contract says
+    full = {name: (np.asarray(tab.column(name), dtype=np.float64) if name in floats
+                   else tab.column(name)) for name in names}
     hold_cause = plan.holds.causes_by_block()
-    for b, ln, lab, kind, length, t, v, cause, hold in zip(*cols):
-        yield {"block": b, "line": max(1, ln), "label": lab, "kind": kind,
-               "length_mm": max(0.0, length), "t_reference_s": max(0.0, t),
-               "v_exit_reference": max(0.0, v), "limit_reference": cause, "hold_s": hold,
-               "hold_cause": hold_cause.get(b, "")}
+    for lo in range(0, len(tab), _ROW_CHUNK):
+        cols = [full[name][lo:lo + _ROW_CHUNK] for name in names]
+        cols = [c.tolist() if isinstance(c, np.ndarray) else c for c in cols]
+        cols[7] = [C.CAUSES[k] if k >= 0 else "" for k in cols[7]]
+        for b, ln, lab, kind, length, t, v, cause, hold in zip(*cols):
+            yield {"block": b, "line": max(1, ln), "label": lab, "kind": kind,
+                   "length_mm": max(0.0, length), "t_reference_s": max(0.0, t),
+                   "v_exit_reference": max(0.0, v), "limit_reference": cause,
+                   "hold_s": hold, "hold_cause": hold_cause.get(b, "")}
