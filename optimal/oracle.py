@@ -499,20 +499,20 @@ def _block_rows(path: Path, grid: Grid, prof: Profile, labels: tuple[str, ...],
                 t_int: np.ndarray, holds: Holds) -> tuple[BlockRow, ...]:
     """The oracle's rows: the motion measured on its verified profile (holds included),
     the cause the constraint active for most of the block's grid time."""
+    # per block, the label with the largest grid time (ties: the first label in sorted
+    # order), by one sort over (block, label) pairs instead of a pass per block
     blk_of_int = path.block[grid.segment]
-    lab_arr = np.asarray(labels, dtype=object)
-    causes = []
-    for b in path.blocks:
-        if b.n_segments > 0:
-            sel = blk_of_int == b.block
-            if np.any(sel):
-                uniq, inv = np.unique(lab_arr[sel].astype(str), return_inverse=True)
-                w = np.bincount(inv, weights=t_int[sel])
-                causes.append(str(uniq[int(np.argmax(w))]))
-            else:
-                causes.append("none")
-        else:
-            causes.append(b.stop_reason)
+    uniq, code = np.unique(np.asarray(labels, dtype=str), return_inverse=True)
+    key = blk_of_int * max(uniq.size, 1) + code
+    ukey, inv = np.unique(key, return_inverse=True)
+    wsum = np.bincount(inv, weights=t_int, minlength=ukey.size)
+    kblk, kcode = ukey // max(uniq.size, 1), ukey % max(uniq.size, 1)
+    order = np.lexsort((kcode, -wsum, kblk))
+    first = np.ones(order.size, bool)
+    first[1:] = kblk[order][1:] != kblk[order][:-1]
+    best = dict(zip(kblk[order][first].tolist(), uniq[kcode[order][first]].tolist()))
+    causes = [(best.get(b.block, "none") if b.n_segments > 0 else b.stop_reason)
+              for b in path.blocks]
     return block_rows(path, block_motion(path, prof), causes, _hold_per_span(path, holds))
 
 
