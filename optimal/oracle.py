@@ -43,7 +43,7 @@ from .status import SolveStatus
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE)
 
-SUPPORTED_BOUNDS = ("acc",)
+SUPPORTED_BOUNDS = ("acc", "jerk")
 
 ProgressFn = Callable[[str, float], None]
 
@@ -306,6 +306,11 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         raise ValueError(f"max_grid = {max_grid!r}: must be an int >= 2")
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
+    if bounds == "jerk":
+        # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
+        from .jerk import solve_jerk
+        return solve_jerk(path, limits, acc_solve=solve, tol=tol, progress=progress,
+                          holds=holds)
     solve_fn = get_backend(backend)
     if holds is None:
         holds = dwell_holds(path)

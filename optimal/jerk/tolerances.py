@@ -1,0 +1,49 @@
+"""Named tolerances and defaults of the jerk oracle (:mod:`optimal.jerk`), one per quantity.
+
+Each value says what it means, its unit and why it has that size.
+"""
+
+from __future__ import annotations
+
+#: Default requested relative gap ``(upper - lower) / lower`` of ``bounds="jerk"`` (1 %,
+#: the issue's target; the acc oracle's 0.2 % is out of reach while the lower bound on
+#: curved paths is the acc relaxation's).
+DEFAULT_JERK_GAP_TOL = 1e-2
+
+#: Target number of intervals of the NLP grid (spread by length; arcs and short segments
+#: get more, see :func:`optimal.grid.initial_grid`). 400 keeps the first solve of a
+#: corpus program well under a second; refinement doubles it while the gap is open.
+DEFAULT_JERK_INITIAL_INTERVALS = 400
+
+#: Largest number of NLP grid intervals before refinement stops with ``gap_not_met``.
+#: IPOPT's time grows about linearly in the intervals (banded KKT system); 20 000
+#: intervals take some tens of seconds on one core.
+DEFAULT_JERK_MAX_GRID = 20_000
+
+#: Largest number of NLP solves (each on a grid twice as fine as the last).
+DEFAULT_JERK_MAX_ROUNDS = 3
+
+#: Smallest interval duration the NLP may choose, in its time unit ``A/J`` (dimensionless).
+#: Keeps ``j = da/dt`` finite; 1e-9 of ``A/J`` (about 5e-11 s on the default machine) is
+#: far below any interval the optimum uses.
+MIN_INTERVAL_TIME_REL = 1e-9
+
+#: IPOPT's relative convergence tolerance (``tol``) and constraint violation tolerance
+#: (``constr_viol_tol``) in the scaled problem (unit jerk and acceleration): residuals of
+#: 1e-9 become acceleration steps of about 1e-9 A at knots, 1e-6 of the one-cycle jerk
+#: allowance ``J T_ipo``, which the checker's RATIO_TOL absorbs; anything larger is
+#: repaired by time scaling.
+IPOPT_TOL = 1e-9
+
+#: IPOPT's iteration cap: the warm-started solves here take 20-200 iterations; a solve
+#: that needs more is reported as a solver failure (with the valid acc bracket), never
+#: as a result.
+IPOPT_MAX_ITER = 1500
+
+#: Fraction of the acc optimum's speed used as the warm start (a slower start is closer
+#: to jerk feasibility, so IPOPT's restoration phase is rarely needed).
+WARM_START_SPEED_FRACTION = 0.9
+
+#: Relative margin taken off the lower bound for float64 round-off in the closed forms
+#: (their relative error is below 1e-12).
+JERK_LB_ROUNDOFF_REL = 1e-9
