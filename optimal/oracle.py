@@ -310,7 +310,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
         from .jerk import solve_jerk
         return solve_jerk(path, limits, acc_solve=solve, tol=tol, progress=progress,
-                          holds=holds)
+                          holds=holds, initial_intervals=initial_intervals)
     solve_fn = get_backend(backend)
     if holds is None:
         holds = dwell_holds(path)

@@ -29,13 +29,14 @@ from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import BlockRow, block_motion, block_rows
 
-from ..grid import initial_grid
+from ..grid import Grid, grid_from_counts, initial_counts, split
 from ..problem import CAP_NAMES, CAP_ACCELERATION, CAP_VELOCITY
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from .lower import jerk_lower_bound
 from .tolerances import (DEFAULT_JERK_INITIAL_INTERVALS, DEFAULT_JERK_MAX_GRID,
-                         DEFAULT_JERK_MAX_ROUNDS)
+                         DEFAULT_JERK_MAX_ROUNDS, JERK_SHORT_SEGMENT_BUDGET,
+                         MIN_JERK_SEGMENT_INTERVALS)
 from .upper import UpperResult, upper_bound_round
 
 ProgressFn = Callable[[str, float], None]
@@ -101,15 +102,19 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
     best_ub = math.inf
     history: list[IterationRecord] = []
     t_build = t_solve = t_check = 0.0
-    n = initial_intervals
     prev_ub = math.inf
+    prev_step = 0.0
     status = SolveStatus.GAP_NOT_MET
     msg = ""
     rounds = 0
+    grid = jerk_grid(path, initial_intervals)
     for rounds in range(1, max_rounds + 1):
-        grid = initial_grid(path, n)
-        if grid.n_intervals > max_grid and rounds > 1:
-            break
+        if rounds > 1:
+            # halve every interval: short segments need nodes as much as long ones
+            finer = split(grid, path, np.ones(grid.n_intervals, bool))
+            if finer is grid or finer.n_intervals > max_grid:
+                break
+            grid = finer
         r = upper_bound_round(path, limits, grid)
         t_build += r.nlp.build_time_s
         t_solve += r.nlp.solve_time_s
@@ -126,12 +131,17 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         if gap <= tol:
             status = SolveStatus.OPTIMAL
             break
-        # a finer grid only tightens the upper bound: stop when it no longer moves
-        if r.ok and math.isfinite(prev_ub) and (prev_ub - ub) <= 0.25 * tol * lb:
-            break
+        # a finer grid only tightens the upper bound: stop when even its extrapolated
+        # limit (geometric decrease, ratio from the last two rounds, at least 1/2)
+        # cannot bring the gap within tol: then the lower bound is the loose side
+        if r.ok and math.isfinite(prev_ub):
+            step = max(prev_ub - ub, 0.0)
+            ratio = min(max(step / prev_step, 0.5), 0.95) if prev_step > 0 else 0.5
+            if (ub - step * ratio / (1.0 - ratio) - lb) > tol * lb:
+                break
+            prev_step = step
         if r.ok:
             prev_ub = ub
-        n *= 2
     t_check = 0.0
     if best is None:
         return OptimalSolution(
@@ -164,6 +174,18 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
         message=message, holds=holds)
+
+
+def jerk_grid(path: Path, n_intervals: int) -> Grid:
+    """The first NLP grid: :func:`optimal.grid.initial_counts` per segment, but at least
+    :data:`~optimal.jerk.tolerances.MIN_JERK_SEGMENT_INTERVALS` per segment while the
+    total stays within ``JERK_SHORT_SEGMENT_BUDGET`` (a jerk-limited S-curve needs
+    several constant-jerk pieces; with two intervals a short block is planned far too
+    slowly and only refinement would recover it)."""
+    m = path.n_segments
+    k_min = int(np.clip(JERK_SHORT_SEGMENT_BUDGET // max(m, 1), 2, MIN_JERK_SEGMENT_INTERVALS))
+    counts = np.maximum(initial_counts(path, n_intervals), k_min).astype(np.int64)
+    return grid_from_counts(path, counts)
 
 
 def active_labels(r: UpperResult) -> tuple[str, ...]:

@@ -10,10 +10,18 @@ from __future__ import annotations
 #: curved paths is the acc relaxation's).
 DEFAULT_JERK_GAP_TOL = 1e-2
 
-#: Target number of intervals of the NLP grid (spread by length; arcs and short segments
-#: get more, see :func:`optimal.grid.initial_grid`). 400 keeps the first solve of a
-#: corpus program well under a second; refinement doubles it while the gap is open.
-DEFAULT_JERK_INITIAL_INTERVALS = 400
+#: Target number of intervals of the first NLP grid, spread by length (arcs and short
+#: segments get more, see :func:`optimal.jerk.oracle.jerk_grid`). 1000 keeps the first
+#: solve of a corpus program near a second; refinement doubles it while the gap is open.
+DEFAULT_JERK_INITIAL_INTERVALS = 1000
+
+#: Fewest NLP intervals per segment on the first grid (a rest-to-rest S-curve has seven
+#: constant-jerk phases; eight intervals let a short block come close to it) ...
+MIN_JERK_SEGMENT_INTERVALS = 8
+
+#: ... as long as the first grid stays within this many intervals; programs with more
+#: segments start with fewer per segment (at least 2) and rely on refinement.
+JERK_SHORT_SEGMENT_BUDGET = 4000
 
 #: Largest number of NLP grid intervals before refinement stops with ``gap_not_met``.
 #: IPOPT's time grows about linearly in the intervals (banded KKT system); 20 000
@@ -23,16 +31,15 @@ DEFAULT_JERK_MAX_GRID = 20_000
 #: Largest number of NLP solves (each on a grid twice as fine as the last).
 DEFAULT_JERK_MAX_ROUNDS = 3
 
-#: Smallest interval duration the NLP may choose, in its time unit ``A/J`` (dimensionless).
-#: Keeps ``j = da/dt`` finite; 1e-9 of ``A/J`` (about 5e-11 s on the default machine) is
-#: far below any interval the optimum uses.
+#: Smallest interval duration the NLP may choose, in its time unit (a quarter of a typical
+#: segment's rest-to-rest time, :func:`optimal.jerk.transcription.problem_units`). Keeps
+#: ``j = da/dt`` finite; 1e-9 of it is far below any interval the optimum uses.
 MIN_INTERVAL_TIME_REL = 1e-9
 
 #: IPOPT's relative convergence tolerance (``tol``) and constraint violation tolerance
-#: (``constr_viol_tol``) in the scaled problem (unit jerk and acceleration): residuals of
-#: 1e-9 become acceleration steps of about 1e-9 A at knots, 1e-6 of the one-cycle jerk
-#: allowance ``J T_ipo``, which the checker's RATIO_TOL absorbs; anything larger is
-#: repaired by time scaling.
+#: (``constr_viol_tol``) in the scaled problem (speeds and accelerations near 1): residuals
+#: of 1e-9 become acceleration steps at knots far below the one-cycle jerk allowance
+#: ``J T_ipo`` in the checker's RATIO_TOL; anything larger is repaired by time scaling.
 IPOPT_TOL = 1e-9
 
 #: IPOPT's iteration cap: the warm-started solves here take 20-200 iterations; a solve

@@ -18,7 +18,10 @@ Inequalities (formulation note 1.7, with the rulebook's kinematics,
 
 * speed caps ``c_k <= sqrt(cap_k)``: feed, axis velocity, the velocity-jump rule at
   corners and rest at stops, from :func:`optimal.problem.common_node_caps` (the grid
-  problem's feasible flavour);
+  problem's feasible flavour); inside an interval that starts accelerating and ends
+  decelerating the speed peaks between the nodes, at most ``c_k + a_k dt_k / 2``, so
+  ``c_k + a_k dt_k / 2 <= vcap_k`` (feed and axis velocity at both ends of the interval;
+  implied by the node caps in every other case);
 * axis acceleration ``|q'_i a + q''_i c^2| <= A_i`` at every node, with the geometry of
   both neighbouring segments at breaks;
 * axis jerk ``|q'_i j_k + 3 q''_i c a + q'''_i c^3| <= J_i`` at the start of every
@@ -34,8 +37,8 @@ Inequalities (formulation note 1.7, with the rulebook's kinematics,
 The checker (:func:`reference.core.constraints.check_profile`) judges the same rules
 inside every interval; what the nodes miss is repaired by time scaling.
 
-Everything is made dimensionless with the time unit ``A/J`` and the length unit
-``A^3/J^2`` (``A``, ``J`` the largest axis limits), so that IPOPT sees numbers near 1.
+Everything is made dimensionless (:func:`problem_units`), so that IPOPT sees numbers
+near 1.
 
 Units (before scaling): mm, s. Shapes: ``N`` intervals, ``n`` axes, ``R`` rows.
 """
@@ -52,6 +55,7 @@ from reference.core.rules import curvature_jumps, step_jerk_limit
 
 from ..grid import Grid
 from ..problem import common_node_caps
+from .lower import rest_to_rest_time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -61,9 +65,9 @@ class Units:
     Attributes
     ----------
     time_s : float
-        Time unit ``A/J``, s.
+        Time unit, s.
     length_mm : float
-        Length unit ``A^3/J^2``, mm.
+        Length unit, mm.
     """
 
     time_s: float
@@ -178,6 +182,9 @@ class JerkProblem:
         Number of extra accelerations (one per interior break node).
     grid : Grid
         The grid (mm).
+    v_interval : numpy.ndarray, shape (N,)
+        Scaled speed cap inside each interval (feed and axis velocity; ``inf`` where
+        none).
     cap_code, cap_axis : numpy.ndarray of int, shape (N + 1,)
         The constraint behind each speed cap (``optimal.problem.CAP_*``) and its axis.
     axes : tuple[str, ...]
@@ -194,6 +201,7 @@ class JerkProblem:
     end_index: np.ndarray
     n_extra: int
     grid: Grid
+    v_interval: np.ndarray
     cap_code: np.ndarray
     cap_axis: np.ndarray
     axes: tuple[str, ...]
@@ -202,6 +210,20 @@ class JerkProblem:
     def n_intervals(self) -> int:
         """Number of intervals ``N``."""
         return int(self.ds.size)
+
+
+def problem_units(path: Path, lim: AxisArrays) -> Units:
+    """Length unit: the median segment length; time unit: a quarter of the jerk-limited
+    rest-to-rest time over it (:func:`optimal.jerk.lower.rest_to_rest_time` with the
+    largest axis limits). Speeds, accelerations and jerks of the motion are then near 1
+    whether the velocity, the acceleration or the jerk limit shapes it (a time unit of
+    ``A/J`` alone is 1e-9 s for an absurdly large jerk limit and 1000 s for a tiny one)."""
+    L = float(np.median(path.length))
+    feed = path.feed[np.isfinite(path.feed)]
+    V = float(np.max(lim.v_max)) if feed.size == 0 else min(float(np.max(lim.v_max)),
+                                                           float(np.max(feed)))
+    T = rest_to_rest_time(L, V, float(np.max(lim.a_max)), float(np.max(lim.j_max)))
+    return Units(time_s=T / 4.0, length_mm=L)
 
 
 def _rows(node, interval, dq, ddq, dddq, limit, axis) -> Rows:
@@ -237,9 +259,7 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
     -------
     JerkProblem
     """
-    A0 = float(np.max(lim.a_max))
-    J0 = float(np.max(lim.j_max))
-    units = Units(time_s=A0 / J0, length_mm=A0 ** 3 / J0 ** 2)
+    units = problem_units(path, lim)
     L, Au, Ju = units.length_mm, units.accel, units.jerk
     N = grid.n_intervals
     seg = grid.segment
@@ -247,6 +267,10 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
     _, dq1, ddq1, dddq1 = path.evaluate(grid.s[1:], segment=seg)
     caps = common_node_caps(path, lim, grid, dq0, dq1, permissive=False)
     c_max = np.sqrt(caps.cap) / units.speed
+    with np.errstate(divide="ignore"):
+        v_ax = np.minimum(np.min(lim.v_max / np.abs(dq0), axis=1),
+                          np.min(lim.v_max / np.abs(dq1), axis=1))
+    v_interval = np.minimum(path.feed[seg], v_ax) / units.speed
     n = len(path.axes)
     k_all = np.arange(N)
     a_lim = lim.a_max / Au
@@ -264,13 +288,21 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
     seg_end[:-1] = seg[1:] != seg[:-1]
     acc_parts, jerk_parts = [], []
     arc = path.radius[seg] > 0
+    # on lines the rows of all axes are one row, scaled (q' constant, no curvature):
+    # keep the tightest axis only (smallest limit / |q'_i|)
+    with np.errstate(divide="ignore"):
+        inv = np.where(dq0 != 0, 1.0 / np.where(dq0 != 0, np.abs(dq0), 1.0), np.inf)
+    tight_a = np.argmin(lim.a_max[None, :] * inv, axis=1)
+    tight_j = np.argmin(lim.j_max[None, :] * inv, axis=1)
     for i in range(n):
-        for nodes, ia, dq, ddq, sel in ((k_all, k_all, dq0, ddq0, np.ones(N, bool)),
-                                        (k_all + 1, end_index, dq1, ddq1, seg_end)):
+        use_a = arc | (tight_a == i)
+        use_j = arc | (tight_j == i)
+        for nodes, ia, dq, ddq, sel in ((k_all, k_all, dq0, ddq0, use_a),
+                                        (k_all + 1, end_index, dq1, ddq1, seg_end & use_a)):
             cnt = int(sel.sum())
             acc_parts.append((nodes[sel], ia[sel], dq[sel, i], ddq[sel, i] * L,
                               np.zeros(cnt), np.full(cnt, a_lim[i]), np.full(cnt, i)))
-        for nodes, dq, ddq, dddq, sel in ((k_all, dq0, ddq0, dddq0, np.ones(N, bool)),
+        for nodes, dq, ddq, dddq, sel in ((k_all, dq0, ddq0, dddq0, use_j),
                                           (k_all + 1, dq1, ddq1, dddq1, arc)):
             cnt = int(sel.sum())
             jerk_parts.append((nodes[sel], k_all[sel], dq[sel, i], ddq[sel, i] * L,
@@ -282,6 +314,7 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
     return JerkProblem(units=units, ds=np.diff(grid.s) / L, c_max=c_max, acc=acc,
                        acc_index=acc.interval, jerk=jerk, step=step,
                        end_index=end_index, n_extra=n_extra, grid=grid,
+                       v_interval=v_interval,
                        cap_code=caps.code, cap_axis=caps.axis, axes=path.axes)
 
 

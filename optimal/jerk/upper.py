@@ -151,7 +151,7 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperRes
     lim = limits.for_axes(path.axes)
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
     c0, a0, dt0 = warm_start(path, lim, grid, problem)
-    nlp = solve_nlp(problem, c0, a0, dt0)
+    nlp = solve_nlp(problem, c0, a0, dt0, print_level=int(__import__("os").environ.get("JERK_IPOPT_PRINT", "0")))
     empty = np.zeros(grid.n_intervals)
     if not nlp.success:
         return UpperResult(False, None, 1.0, np.inf, None, nlp, problem, empty,

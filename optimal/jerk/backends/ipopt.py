@@ -93,6 +93,13 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     g.append(ds - c[:-1] * dt - (2 * a[:-1] + e) * dt * dt / 6)
     lo += [np.zeros(N), np.zeros(N)]
     hi += [np.zeros(N), np.zeros(N)]
+    # the speed peak inside intervals that accelerate, then decelerate
+    fin = np.flatnonzero(np.isfinite(problem.v_interval))
+    if fin.size:
+        iv = fin.tolist()
+        g.append(c[iv] + a[iv] * dt[iv] / 2)
+        lo.append(np.full(fin.size, -np.inf))
+        hi.append(problem.v_interval[fin])
     ar = problem.acc
     if ar.n:
         cn = c[ar.node.tolist()]
@@ -118,22 +125,16 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
         # the acceleration at the row's place: interval start, or its end value
         at_end = jr.node != jr.interval
         a_here = a_all[np.where(at_end, problem.end_index[jr.interval], jr.interval).tolist()]
-        d = dt[iv]
-        jump = e[iv] - a[iv]
-        val = (ca.DM(jr.dq) * jump
-               + d * (3 * ca.DM(jr.ddq) * cn * a_here + ca.DM(jr.dddq) * cn * cn * cn))
-        lim = ca.DM(jr.limit) * d
-        g.append(val - lim)
-        lo.append(np.full(jr.n, -np.inf))
-        hi.append(np.zeros(jr.n))
-        g.append(val + lim)
-        lo.append(np.zeros(jr.n))
-        hi.append(np.full(jr.n, np.inf))
+        jerk = (e[iv] - a[iv]) / dt[iv]
+        g.append(ca.DM(jr.dq) * jerk
+                 + 3 * ca.DM(jr.ddq) * cn * a_here + ca.DM(jr.dddq) * cn * cn * cn)
+        lo.append(-jr.limit)
+        hi.append(jr.limit)
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
     opts = {"ipopt.print_level": print_level, "print_time": False,
             "ipopt.tol": IPOPT_TOL, "ipopt.constr_viol_tol": IPOPT_TOL,
             "ipopt.max_iter": IPOPT_MAX_ITER, "ipopt.mu_strategy": "adaptive",
-            "ipopt.sb": "yes"}
+            "ipopt.sb": "yes", **({"ipopt.print_timing_statistics": "yes"} if print_level > 4 else {})}
     solver = ca.nlpsol("jerk", "ipopt", nlp, opts)
     lbx = np.concatenate((np.zeros(N + 1), np.full(N + 1, -np.inf),
                           np.full(N, MIN_INTERVAL_TIME_REL), np.full(ne, -np.inf)))
