@@ -40,6 +40,7 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
                       DiscreteResult, build_grid_problem, check_feed, interval_times)
 from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
+from .jerk.tolerances import DEFAULT_JERK_GAP_TOL
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE)
 
@@ -232,7 +233,7 @@ def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str,
 
 # --------------------------------------------------------------------------- solve
 def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
-          tol: float = DEFAULT_GAP_TOL, backend: str = DEFAULT_BACKEND,
+          tol: float | None = None, backend: str = DEFAULT_BACKEND,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
           initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
@@ -258,9 +259,11 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     limits : MachineLimits
         Machine limits; must define every axis of the path.
     bounds : str
-        Bound set; only ``"acc"`` (velocity and acceleration) is supported.
-    tol : float
-        Requested relative gap ``(upper - lower) / lower`` (default 0.2 %).
+        Bound set: ``"acc"`` (velocity and acceleration) or ``"jerk"`` (also axis jerk;
+        solved by :func:`optimal.jerk.solve_jerk`, see there).
+    tol : float, optional
+        Requested relative gap ``(upper - lower) / lower`` (default 0.2 % for ``acc``,
+        1 % for ``jerk``).
     backend : str
         Backend of the grid problem (``"fast"`` default, ``"highs"``, ``"clarabel"``).
     backend_options : Mapping, optional
@@ -300,6 +303,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if bounds not in SUPPORTED_BOUNDS:
         raise ValueError(f"bound set {bounds!r} is not supported by the oracle yet "
                          f"(supported: {', '.join(SUPPORTED_BOUNDS)})")
+    if tol is None:
+        tol = DEFAULT_JERK_GAP_TOL if bounds == "jerk" else DEFAULT_GAP_TOL
     if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
         raise ValueError(f"tol = {tol!r}: must be a finite number > 0")
     if not (isinstance(max_grid, int) and max_grid >= 2):

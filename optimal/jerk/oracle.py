@@ -152,7 +152,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             iterations=rounds, backend="ipopt", build_time_s=t_build,
             solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
             total_time_s=time.perf_counter() - t_start, dwell_s=_dwell_part(holds),
-            history=tuple(history), message=f"jerk NLP failed: {msg}", holds=holds)
+            history=tuple(history), message=f"jerk NLP failed: {msg}", holds=holds,
+            bounds="jerk")
     prof_h = with_holds(best.profile, path, holds)
     labels = active_labels(best)
     g = best.problem.grid
@@ -173,7 +174,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         backend="ipopt", build_time_s=t_build, solve_time_s=t_solve, check_time_s=t_check,
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
-        message=message, holds=holds)
+        message=message, holds=holds, bounds="jerk")
 
 
 def jerk_grid(path: Path, n_intervals: int) -> Grid:

@@ -24,9 +24,9 @@ MIN_JERK_SEGMENT_INTERVALS = 8
 JERK_SHORT_SEGMENT_BUDGET = 4000
 
 #: Largest number of NLP grid intervals before refinement stops with ``gap_not_met``.
-#: IPOPT's time grows about linearly in the intervals (banded KKT system); 20 000
-#: intervals take some tens of seconds on one core.
-DEFAULT_JERK_MAX_GRID = 20_000
+#: IPOPT's time grows a little faster than linearly in the intervals (banded KKT system,
+#: more iterations); 10 000 intervals take some seconds to tens of seconds on one core.
+DEFAULT_JERK_MAX_GRID = 10_000
 
 #: Largest number of NLP solves (each on a grid twice as fine as the last).
 DEFAULT_JERK_MAX_ROUNDS = 3
