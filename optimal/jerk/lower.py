@@ -59,7 +59,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from reference.core.geometry import Path
+from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays
 from reference.core.rules import RELAXED, curvature_jumps, is_tangential, step_jerk_limit
 from reference.core.tolerances import VEL_TOL_MM_S
@@ -127,7 +127,7 @@ def _max_fixed(f: np.ndarray, g: np.ndarray, gamma: np.ndarray, z_max: float,
     Parameters
     ----------
     f, g : numpy.ndarray, shape (k, n)
-    gamma : numpy.ndarray, shape (n,)
+    gamma : numpy.ndarray, shape (n,) or (k, n)
     z_max : float
     w_nonneg : numpy.ndarray of bool, shape (k,)
 
@@ -159,19 +159,21 @@ def _max_fixed(f: np.ndarray, g: np.ndarray, gamma: np.ndarray, z_max: float,
     return np.where(top, z_max, hi)
 
 
-def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float
-                        ) -> tuple[np.ndarray, np.ndarray]:
+def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float,
+                        b_break: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Largest path acceleration (in size) on arriving at and on leaving every break
-    that the acceleration-step rule allows, where the axis accelerations there are
-    ``q'_i a`` (lines on both sides, or at rest); ``a_cap`` elsewhere (no claim).
+    that the acceleration-step rule allows.
 
-    The step ``|t_out_i a_r - t_in_i a_l|`` is held to ``J_i T_ipo``
-    (:func:`reference.core.rules.step_jerk_limit` between two lines, where the
-    curvature does not jump, and at rest). At a stop the path decelerates into the
-    rest (``a_l <= 0``) and accelerates out of it (``a_r >= 0``); elsewhere both signs
-    are possible and the set is symmetric, so the largest ``|a|`` is the largest ``a``.
-    Outside the path the motion rests (tangent 0). Each side's bound is taken over all
-    values of the other side: a relaxation.
+    Crossing a break at ``v`` steps axis ``i``'s acceleration by
+    ``t_out_i a_r - t_in_i a_l + dk_i v^2`` (``dk`` the jump of ``q''``), held to
+    ``Jstep_i T_ipo``: ``J_i`` without a curvature jump and at rest, PATH_TRANS_JERK_LIM
+    with one while moving (:func:`reference.core.rules.step_jerk_limit`), so the larger
+    of the two is a relaxation. With ``v^2 <= b_break`` the centripetal part is at most
+    ``|dk_i| b_break``, which is added to the allowance. At a stop the path decelerates
+    into the rest (``a_l <= 0``) and accelerates out of it (``a_r >= 0``); elsewhere both
+    signs are possible and the set is symmetric, so the largest ``|a|`` is the largest
+    ``a``. Outside the path the motion rests (tangent and curvature 0). Each side's
+    bound is taken over all values of the other side: a relaxation.
 
     Parameters
     ----------
@@ -180,8 +182,9 @@ def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float
     t_ipo : float
         IPO cycle, s.
     a_cap : float
-        Upper end of the search, mm/s^2 (at least every segment's path acceleration
-        limit).
+        Upper end of the search, mm/s^2.
+    b_break : numpy.ndarray, shape (m + 1,)
+        Valid upper bounds of ``v^2`` at the breaks, mm^2/s^2.
 
     Returns
     -------
@@ -192,18 +195,29 @@ def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float
     n = len(path.axes)
     t_in = np.zeros((m + 1, n))
     t_out = np.zeros((m + 1, n))
-    _, d0, _, _ = path.evaluate(path.s_breaks[:-1], segment=np.arange(m))
-    _, d1, _, _ = path.evaluate(path.s_breaks[1:], segment=np.arange(m))
-    t_out[:m] = d0
-    t_in[1:] = d1
-    line = path.radius == 0
-    known = np.asarray(path.stop, bool) | (np.concatenate(([True], line))
-                                           & np.concatenate((line, [True])))
-    gamma = lim.j_max * t_ipo
+    k_in = np.zeros((m + 1, n))
+    k_out = np.zeros((m + 1, n))
+    _, d0, c0, _ = path.evaluate(path.s_breaks[:-1], segment=np.arange(m))
+    _, d1, c1, _ = path.evaluate(path.s_breaks[1:], segment=np.arange(m))
+    t_out[:m], k_out[:m] = d0, c0
+    t_in[1:], k_in[1:] = d1, c1
+    dk = np.abs(k_out - k_in)
+    jstep = np.maximum(step_jerk_limit(curvature_jumps(k_in, k_out), lim.j_max,
+                                       lim.path_trans_jerk), lim.j_max[None, :])
+    gamma = jstep * t_ipo + dk * np.maximum(np.asarray(b_break), 0.0)[:, None]
     # step = t_out a_r + t_in x with x = -a_l (>= 0 and a_r >= 0 at a stop)
-    a_in = _max_fixed(t_in, t_out, gamma, a_cap, path.stop)
-    a_out = _max_fixed(t_out, t_in, gamma, a_cap, path.stop)
-    return np.where(known, a_in, a_cap), np.where(known, a_out, a_cap)
+    a_in = _max_fixed_rows(t_in, t_out, gamma, a_cap, path.stop)
+    a_out = _max_fixed_rows(t_out, t_in, gamma, a_cap, path.stop)
+    return a_in, a_out
+
+
+def _max_fixed_rows(f, g, gamma, z_max, w_nonneg):
+    """:func:`_max_fixed` with one allowance vector per row (``gamma`` shape (k, n))."""
+    out = np.empty(f.shape[0])
+    for key in np.unique(gamma, axis=0, return_inverse=True)[1].reshape(-1)[:0]:
+        pass
+    # rows share the allowance only by chance: solve them in one vectorised bisection
+    return _max_fixed(f, g, gamma, z_max, w_nonneg) if out.size else out
 
 
 def envelope_times(L: np.ndarray, vb: np.ndarray, a_s: np.ndarray, V: np.ndarray,
@@ -254,7 +268,8 @@ def envelope_times(L: np.ndarray, vb: np.ndarray, a_s: np.ndarray, V: np.ndarray
 
 
 def _line_limits(path: Path, lim: AxisArrays, seg: np.ndarray):
-    """Path speed, acceleration and jerk limits ``V, A, J`` of line segments ``seg``."""
+    """Path speed, acceleration and jerk limits ``V, A, J`` of line segments ``seg``
+    (exact: every axis value is ``|q'_i|`` times the path value)."""
     u = np.abs(path.d[seg])
     with np.errstate(divide="ignore"):
         inv = np.where(u > 0, 1.0 / np.where(u > 0, u, 1.0), np.inf)
@@ -264,9 +279,35 @@ def _line_limits(path: Path, lim: AxisArrays, seg: np.ndarray):
     return V, A, J
 
 
-def line_segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray]:
-    """Steps 3 and 4 of the module docstring: per-line-segment jerk bounds.
+def _curve_limits(path: Path, lim: AxisArrays, seg: np.ndarray, B: np.ndarray):
+    """Path acceleration and jerk bounds ``A, J`` valid everywhere on curved segments
+    ``seg`` where ``v^2 <= B``.
+
+    At every point ``sum_i q'_i^2 >= 1`` over the axes that move on the segment (``s`` is
+    the arc length of a subset of them). If ``|q'_i| |x| <= X_i`` for every axis, then
+    ``|x| <= ||X||_2`` (otherwise every ``|q'_i| < X_i / |x|`` and the squares sum to
+    less than 1). With ``|q'_i s''| <= A_i + |q''_i| B`` and
+    ``|q'_i s'''| <= J_i + 3 |q''_i| v |s''| + |d3q_i| v^3`` (the rulebook's axis
+    kinematics, ``d3q = q'''``) and the segment's suprema of ``|q''_i|`` and ``|d3q_i|``
+    (:func:`reference.core.geometry.plane_amplitudes`) this gives ``A`` and ``J``.
+    """
+    amp = plane_amplitudes(path)
+    rho = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)
+    k2 = rho * amp.curvature[seg][:, None]
+    k3 = rho * np.hypot(amp.jerk_t[seg], amp.jerk_n[seg])[:, None]
+    reach = np.abs(path.d[seg]) + rho * amp.speed[seg][:, None]
+    moving = reach > 0
+    Bc = B[:, None]
+    A_ax = np.where(moving, lim.a_max[None, :] + k2 * Bc, 0.0)
+    A = np.sqrt(np.sum(A_ax ** 2, axis=1))
+    v = np.sqrt(Bc)
+    J_ax = np.where(moving, lim.j_max[None, :] + 3 * k2 * v * A[:, None] + k3 * v ** 3, 0.0)
+    return A, np.sqrt(np.sum(J_ax ** 2, axis=1))
+
+
+def segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray,
+                  b_seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Steps 3 and 4 of the module docstring: per-segment jerk bounds.
 
     Parameters
     ----------
@@ -276,11 +317,13 @@ def line_segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.nd
         IPO cycle, s.
     b_break : numpy.ndarray, shape (m + 1,)
         Upper bounds of ``v^2`` at the breaks valid for every feasible motion, mm^2/s^2.
+    b_seg : numpy.ndarray, shape (m,)
+        Upper bounds of ``v^2`` on every segment, valid likewise, mm^2/s^2.
 
     Returns
     -------
     envelope : numpy.ndarray, shape (m,)
-        Step 4 on every line segment (0 on arcs), s.
+        Step 4 on every segment, s.
     runs : numpy.ndarray, shape (R,)
         Step 3 on every run that is one line segment (0 on other runs), s.
     """
@@ -288,21 +331,33 @@ def line_segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.nd
     env = np.zeros(m)
     stops = np.flatnonzero(path.stop)
     runs = np.zeros(max(stops.size - 1, 0))
-    seg = np.flatnonzero((path.radius == 0) & np.any(path.d != 0, axis=1))
+    moving = np.any(path.d != 0, axis=1) | (path.radius > 0)
+    line = (path.radius == 0) & moving
+    curve = path.radius > 0
+    V = np.sqrt(np.maximum(b_seg, 0.0))
+    A = np.full(m, np.inf)
+    J = np.full(m, np.inf)
+    seg_l = np.flatnonzero(line)
+    if seg_l.size:
+        V_l, A[seg_l], J[seg_l] = _line_limits(path, lim, seg_l)
+        V[seg_l] = np.minimum(V[seg_l], V_l)
+    seg_c = np.flatnonzero(curve)
+    if seg_c.size:
+        A[seg_c], J[seg_c] = _curve_limits(path, lim, seg_c, np.maximum(b_seg[seg_c], 0.0))
+    seg = np.flatnonzero(moving & (V > 0))
     if seg.size == 0:
         return env, runs
-    V, A, J = _line_limits(path, lim, seg)
-    a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A)))
+    a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A[seg])), b_break)
     a_s = np.maximum(a_out[seg], a_in[seg + 1])
     vb = np.sqrt(np.maximum(np.maximum(b_break[seg], b_break[seg + 1]), 0.0))
-    env[seg] = envelope_times(path.length[seg], vb, a_s, V, A, J)
-    where = {int(k): i for i, k in enumerate(seg)}
+    env[seg] = envelope_times(path.length[seg], vb, a_s, V[seg], A[seg], J[seg])
     for r in np.flatnonzero(np.diff(stops) == 1):
-        i = where.get(int(stops[r]))
-        if i is not None:
+        k = int(stops[r])
+        if line[k] and V[k] > 0:
             # the 1-D bound is symmetric in its ends: the larger allowance is a relaxation
-            runs[r] = rest_to_rest_time(float(path.length[seg[i]]), float(V[i]), float(A[i]),
-                                        float(J[i]), float(a_s[i]))
+            a_k = max(float(a_out[k]), float(a_in[k + 1]))
+            runs[r] = rest_to_rest_time(float(path.length[k]), float(V[k]), float(A[k]),
+                                        float(J[k]), a_k)
     return env, runs
 
 
@@ -385,14 +440,18 @@ def jerk_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.n
         ``jerk_seg``.
     """
     grid = grid_on(path, np.asarray(acc_grid_s, dtype=np.float64))
-    _, t_lb, _, b_hat = lower_bound(path, lim, grid)
+    _, t_lb, rel, b_hat = lower_bound(path, lim, grid)
     caps = curvature_break_caps(path, lim, t_ipo, b_hat[grid.break_node])
     if np.any(caps < b_hat[grid.break_node]):
         b_node = b_hat.copy()
         b_node[grid.break_node] = np.minimum(b_node[grid.break_node], caps)
-        _, t_lb, _, b_hat = lower_bound(path, lim, grid, b_node=b_node)
+        _, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
     acc_seg = np.bincount(grid.segment, weights=t_lb, minlength=path.n_segments)
-    env, runs = line_segment_times(path, lim, t_ipo, b_hat[grid.break_node])
+    # v^2 on each segment: at most its intervals' a-priori bounds and its node bounds
+    b_seg = np.zeros(path.n_segments)
+    np.maximum.at(b_seg, grid.segment, np.maximum(rel.b_bar, np.maximum(b_hat[:-1],
+                                                                         b_hat[1:])))
+    env, runs = segment_times(path, lim, t_ipo, b_hat[grid.break_node], b_seg)
     jerk_seg = env.copy()
     stops = np.flatnonzero(path.stop)
     one = np.flatnonzero(runs > 0)
