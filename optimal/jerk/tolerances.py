@@ -42,10 +42,12 @@ MIN_INTERVAL_TIME_REL = 1e-9
 #: ``J T_ipo`` in the checker's RATIO_TOL; anything larger is repaired by time scaling.
 IPOPT_TOL = 1e-9
 
-#: IPOPT's iteration cap: the warm-started solves here take 20-200 iterations; a solve
-#: that needs more is reported as a solver failure (with the valid acc bracket), never
-#: as a result.
-IPOPT_MAX_ITER = 1500
+#: IPOPT's barrier-parameter strategies, tried in turn, each with its iteration cap: the
+#: warm-started solves here take 20-130 iterations; adaptive is usually the faster, but
+#: on a program with long arcs at the feed it needed 900 iterations where monotone took
+#: 30 (sin_cead_arc.mpf), so it gets a short leash. A solve that fails both is reported
+#: as a solver failure (with the valid lower bound), never as a result.
+MU_STRATEGIES = (("adaptive", 200), ("monotone", 1500))
 
 #: Fraction of the acc optimum's speed used as the warm start (a slower start is closer
 #: to jerk feasibility, so IPOPT's restoration phase is rarely needed).

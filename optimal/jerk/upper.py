@@ -92,7 +92,41 @@ def warm_start(path: Path, lim, grid: Grid, problem: JerkProblem
     a[1:-1] = 0.5 * (a_int[:-1] + a_int[1:])
     vs = c[:-1] + c[1:]
     dt = np.where(vs > 0, 2.0 * ds / np.where(vs > 0, vs, 1.0), 1.0)
-    return c, a, dt
+    # slow it down until the node rows hold: IPOPT then starts (nearly) feasible, which
+    # it needs (from the acc optimum itself it wandered for 900 iterations on a
+    # program with long arcs); stretching time by lam divides c by lam, a by lam^2 and
+    # every jerk row by lam^3
+    lam = max(1.0, _row_excess(problem, c, a, dt))
+    return c / lam, a / lam ** 2, dt * lam
+
+
+def _row_excess(problem: JerkProblem, c: np.ndarray, a: np.ndarray, dt: np.ndarray
+                ) -> float:
+    """Smallest time stretch after which the acceleration, step and jerk rows hold at
+    ``(c, a, dt)`` (accelerations continuous at breaks)."""
+    inner = problem.grid.break_node[1:-1]
+    a_all = np.concatenate((a, a[inner]))
+    lam = 1.0
+    for rows, idx, power in ((problem.acc, problem.acc_index, 2),):
+        if rows.n:
+            val = rows.dq * a_all[idx] + rows.ddq * c[rows.node] ** 2
+            lam = max(lam, float(np.max(np.abs(val) / rows.limit)) ** (1.0 / power))
+    st = problem.step
+    if st.n:
+        z = np.concatenate((a_all, [0.0]))
+        ai = z[np.where(st.ia_in < 0, z.size - 1, st.ia_in)]
+        ao = z[np.where(st.ia_out < 0, z.size - 1, st.ia_out)]
+        c2 = c[st.node] ** 2
+        val = st.dq_out * ao + st.ddq_out * c2 - st.dq_in * ai - st.ddq_in * c2
+        lam = max(lam, float(np.max(np.abs(val) / st.limit)) ** 0.5)
+    jr = problem.jerk
+    if jr.n:
+        k = jr.interval
+        cn = c[jr.node]
+        an = a[jr.node]
+        val = (jr.dq * (a[k + 1] - a[k]) / dt[k] + 3 * jr.ddq * cn * an + jr.dddq * cn ** 3)
+        lam = max(lam, float(np.max(np.abs(val) / jr.limit)) ** (1.0 / 3.0))
+    return lam
 
 
 def exact_profile(problem: JerkProblem, c: np.ndarray, dt: np.ndarray,
@@ -151,7 +185,7 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperRes
     lim = limits.for_axes(path.axes)
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
     c0, a0, dt0 = warm_start(path, lim, grid, problem)
-    nlp = solve_nlp(problem, c0, a0, dt0, print_level=int(__import__("os").environ.get("JERK_IPOPT_PRINT", "0")))
+    nlp = solve_nlp(problem, c0, a0, dt0)
     empty = np.zeros(grid.n_intervals)
     if not nlp.success:
         return UpperResult(False, None, 1.0, np.inf, None, nlp, problem, empty,

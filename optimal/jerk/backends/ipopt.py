@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..tolerances import IPOPT_MAX_ITER, IPOPT_TOL, MIN_INTERVAL_TIME_REL
+from ..tolerances import IPOPT_TOL, MIN_INTERVAL_TIME_REL, MU_STRATEGIES
 from ..transcription import JerkProblem
 
 NAME = "ipopt"
@@ -131,11 +131,6 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
         lo.append(-jr.limit)
         hi.append(jr.limit)
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
-    opts = {"ipopt.print_level": print_level, "print_time": False,
-            "ipopt.tol": IPOPT_TOL, "ipopt.constr_viol_tol": IPOPT_TOL,
-            "ipopt.max_iter": IPOPT_MAX_ITER, "ipopt.mu_strategy": "adaptive",
-            "ipopt.sb": "yes", **({"ipopt.print_timing_statistics": "yes"} if print_level > 4 else {})}
-    solver = ca.nlpsol("jerk", "ipopt", nlp, opts)
     lbx = np.concatenate((np.zeros(N + 1), np.full(N + 1, -np.inf),
                           np.full(N, MIN_INTERVAL_TIME_REL), np.full(ne, -np.inf)))
     ubx = np.concatenate((problem.c_max, np.full(N + 1, np.inf), np.full(N, np.inf),
@@ -143,17 +138,33 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     x0 = np.concatenate((np.clip(c0, 0.0, problem.c_max), a0,
                          np.maximum(dt0, MIN_INTERVAL_TIME_REL),
                          a0[problem.grid.break_node[1:-1]]))
-    ts = time.perf_counter()
-    sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lo), ubg=np.concatenate(hi))
-    te = time.perf_counter()
-    stats = solver.stats()
-    xs = np.asarray(sol["x"]).ravel()
-    status = str(stats.get("return_status", "unknown"))
-    ok = bool(stats.get("success", False)) or status == "Solved_To_Acceptable_Level"
-    a_all = xs[N + 1:2 * (N + 1)]
-    a_all = np.concatenate((a_all, xs[3 * N + 2:]))
-    return NlpResult(success=ok and bool(np.all(np.isfinite(xs))), c=xs[:N + 1],
-                     a=xs[N + 1:2 * (N + 1)], a_end=a_all[problem.end_index],
-                     dt=xs[2 * (N + 1):3 * N + 2],
-                     iterations=int(stats.get("iter_count", 0)), message=status,
-                     build_time_s=ts - tb, solve_time_s=te - ts)
+    build = time.perf_counter() - tb
+    solve = 0.0
+    iters = 0
+    # IPOPT's adaptive barrier update is the faster one on most paths here, but on some
+    # (long arcs at the feed) it wandered for 900 iterations where the monotone update
+    # took 30: try adaptive with a short leash, then monotone
+    for k, (strategy, max_iter) in enumerate(MU_STRATEGIES):
+        tk = time.perf_counter()
+        opts = {"ipopt.print_level": print_level, "print_time": False,
+                "ipopt.tol": IPOPT_TOL, "ipopt.constr_viol_tol": IPOPT_TOL,
+                "ipopt.max_iter": max_iter, "ipopt.mu_strategy": strategy, "ipopt.sb": "yes"}
+        solver = ca.nlpsol("jerk", "ipopt", nlp, opts)
+        ts = time.perf_counter()
+        build += ts - tk
+        sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lo),
+                     ubg=np.concatenate(hi))
+        solve += time.perf_counter() - ts
+        stats = solver.stats()
+        xs = np.asarray(sol["x"]).ravel()
+        iters += int(stats.get("iter_count", 0))
+        status = str(stats.get("return_status", "unknown"))
+        ok = ((bool(stats.get("success", False)) or status == "Solved_To_Acceptable_Level")
+              and bool(np.all(np.isfinite(xs))))
+        if ok:
+            break
+    a_all = np.concatenate((xs[N + 1:2 * (N + 1)], xs[3 * N + 2:]))
+    return NlpResult(success=ok, c=xs[:N + 1], a=xs[N + 1:2 * (N + 1)],
+                     a_end=a_all[problem.end_index], dt=xs[2 * (N + 1):3 * N + 2],
+                     iterations=iters, message=f"{status} ({strategy} barrier update)",
+                     build_time_s=build, solve_time_s=solve)
