@@ -15,39 +15,52 @@ acceleration in steps; such motions are not jerk-limited and not in this set.)
 
 Why the bound holds
 ===================
-1. *Runs.* The breaks where ``path.stop`` is set cut the path into runs
-   ``r = 1..R``; every feasible motion rests at their ends, so its time is the sum of
-   the times ``T_r`` it spends on each run, and each ``T_r`` is at least the minimum
-   time ``T*_r`` of run ``r`` on its own (the only coupling across a stop is the
-   acceleration-step rule there, and dropping it only enlarges each run's feasible
-   set). So ``T >= sum_r LB_r`` for any ``LB_r <= T*_r``.
-2. *Acc relaxation per run.* Every jerk-feasible motion is ``acc``-feasible. The
-   ``acc`` relaxation of :func:`optimal.bounds.lower_bound` has only interval-local
-   rows and node caps, with cap 0 at stops, and ``b = 0`` satisfies all of them; so the
-   node values of a motion that is feasible on run ``r`` alone, extended by ``b = 0``
-   elsewhere, are feasible for the relaxed discrete problem and dominated by its
-   greatest element, and the tent times of the intervals of run ``r`` (steps 3-4 of
-   that docstring) sum to a lower bound of ``T*_r`` (the acc bound's own proof, applied
-   to one run).
-3. *Straight runs.* A run that is one line segment with direction ``u = q'`` has
-   ``q'' = q''' = 0``: the axis constraints are exactly ``|v| <= V``,
+1. *Segments.* Every motion's time is the sum of the times ``T_g`` it spends on the
+   segments ``g``; any valid lower bound of each ``T_g`` may be used, and the largest of
+   several is one too: ``T >= sum_g max_i LB_g,i``.
+2. *Acc relaxation.* Every jerk-feasible motion is ``acc``-feasible. In the ``acc``
+   relaxation of :func:`optimal.bounds.lower_bound` every feasible motion has
+   ``b(s_k) <= bhat_k`` at the nodes and ``b <= tent`` inside every interval (steps 3-4
+   of that module's docstring), so the tent time of each interval bounds the time
+   *every* feasible motion spends there, and their sum over a segment's intervals
+   bounds ``T_g``. Node bounds that hold for every jerk-feasible motion (step 5) may be
+   given to that relaxation as extra node caps; its proof is unchanged.
+3. *Straight runs between stops.* A run that is one line segment with direction
+   ``u = q'`` has ``q'' = q''' = 0``: the axis constraints are exactly ``|v| <= V``,
    ``|s''| <= A``, ``|s'''| <= J`` with ``V = min(F, min_i V_i / |u_i|)``,
    ``A = min_i A_i / |u_i|``, ``J = min_i J_i / |u_i|``, and the path acceleration at
-   its ends is at most ``a_s`` in size, the largest value the acceleration-step rule
-   at rest allows (:func:`stop_accelerations`: ``J T_ipo`` at the path start and end,
-   unbounded at a 180 degree reversal). The minimum time
-   of this 1-D problem, rest to rest with boundary acceleration up to ``a_s``, is that
-   of the classical double-S profile that starts at ``s'' = a_s`` (Biagiotti &
-   Melchiorri 2008, section 3.4; ruckig with ``current_acceleration = a_s``,
-   ``target_acceleration = -a_s`` computes the same): accelerate as fast as the jerk
-   and acceleration limits allow to the peak speed, cruise, decelerate symmetrically.
+   its ends is at most ``a_s`` in size, the largest value the acceleration-step rule at
+   rest allows (:func:`break_accelerations`: ``J T_ipo`` at the path start and end,
+   unbounded at a 180 degree reversal). The minimum time of this 1-D problem, rest to
+   rest with boundary acceleration up to ``a_s``, is that of the classical double-S
+   profile that starts at ``s'' = a_s`` (Biagiotti & Melchiorri 2008, section 3.4;
+   ruckig with ``current_acceleration = a_s``, ``target_acceleration = -a_s``
+   computes the same, tests/optimal/test_jerk.py): accelerate as fast as the jerk and
+   acceleration limits allow to the peak speed, cruise, decelerate symmetrically.
    :func:`rest_to_rest_time` gives it in closed form by extending the first jerk ramp
    back to zero acceleration (a virtual start at speed ``-a_s^2 / (2J)``). When the
-   move is too short for that ramp (peak speed below ``a_s^2 / (2J)``, a few um on
-   real machines) only step 2 is used.
-4. ``LB = sum_r max(step 2, step 3) (1 - JERK_LB_ROUNDOFF_REL) + holds``, and the
-   result is never below the ``acc`` oracle's own certified lower bound, which is valid
-   too (jerk limits only remove motions).
+   move is too short for that ramp (peak speed below ``a_s^2 / (2J)``, a few um on real
+   machines) it returns the jerk-free time, a weaker bound.
+4. *Envelope on every segment* (:func:`envelope_times`): with ``v^2`` at most ``bhat``
+   at both breaks, ``|s''|`` at most the step rule's allowance there
+   (:func:`break_accelerations`), and path bounds ``V, A, J`` valid on the whole
+   segment (exact on lines; on curves from :func:`_curve_limits`), the speed cannot
+   grow faster than the fastest jerk-limited ramp from either end, which bounds the
+   distance covered in a given time from above and so the time from below.
+5. *Curvature-jump caps* (:func:`curvature_break_caps`): at a tangential break where the
+   curvature vector jumps, the centripetal step ``dk v^2`` must fit the one-cycle
+   allowance up to what a path-acceleration step can cancel; that bounds ``v^2`` there
+   for every jerk-feasible motion (the ``acc`` problem has no such rule).
+6. ``LB = sum_g max(step 2, step 3 or 0, step 4) (1 - JERK_LB_ROUNDOFF_REL) + holds``,
+   never below the ``acc`` oracle's own certified lower bound, which is valid too (jerk
+   limits only remove motions). Rest at stops is ``v = 0`` exactly, as in the ``acc``
+   relaxation.
+
+Where it is loose: on arcs the path acceleration and jerk bounds of step 4 are norms
+over the axes (up to ``sqrt(n)`` above the pointwise values), and across corners crossed
+at speed and tangential joints nothing couples neighbouring segments beyond the node
+bounds; a convex relaxation of the jerk constraint itself (Consolini et al.) is not
+implemented, so the bracket on curved programs is often wider than 1 %.
 
 Units: mm, s.
 """
