@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import partial
 from typing import Callable, Mapping
 
 import numpy as np
@@ -260,7 +261,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         Machine limits; must define every axis of the path.
     bounds : str
         Bound set: ``"acc"`` (velocity and acceleration) or ``"jerk"`` (also axis jerk;
-        solved by :func:`optimal.jerk.solve_jerk`, see there).
+        solved by :func:`optimal.jerk.solve_jerk`, see there; ``backend``,
+        ``backend_options``, ``max_grid`` and ``max_iterations`` then apply to the
+        ``acc`` solve inside it, ``initial_intervals`` to its NLP grid).
     tol : float, optional
         Requested relative gap ``(upper - lower) / lower`` (default 0.2 % for ``acc``,
         1 % for ``jerk``).
@@ -314,7 +317,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if bounds == "jerk":
         # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
         from .jerk import solve_jerk
-        return solve_jerk(path, limits, acc_solve=solve, tol=tol, progress=progress,
+        # (backend, its options and the grid limits apply to that inner acc solve)
+        acc_solve = partial(solve, backend=backend, backend_options=backend_options,
+                            max_grid=max_grid, max_iterations=max_iterations)
+        return solve_jerk(path, limits, acc_solve=acc_solve, tol=tol, progress=progress,
                           holds=holds, initial_intervals=initial_intervals)
     solve_fn = get_backend(backend)
     if holds is None:

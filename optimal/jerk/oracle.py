@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -88,7 +89,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
     if holds is None:
         holds = dwell_holds(path)
     if path.n_segments == 0:
-        return acc_solve(path, limits, "acc", holds=holds, progress=progress)
+        return replace(acc_solve(path, limits, "acc", holds=holds, progress=progress),
+                       bounds="jerk")
     lim = limits.for_axes(path.axes)
     hold_t = holds.total_s
     sub = (lambda msg, f: progress(f"acc: {msg}", 0.3 * f)) if progress else None
@@ -115,9 +117,12 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             if finer is grid or finer.n_intervals > max_grid:
                 break
             grid = finer
+        tr = time.perf_counter()
         r = upper_bound_round(path, limits, grid)
         t_build += r.nlp.build_time_s
         t_solve += r.nlp.solve_time_s
+        # the rest of the round: transcription, warm start, the checker
+        t_check += time.perf_counter() - tr - r.nlp.build_time_s - r.nlp.solve_time_s
         ub = r.profile.duration + hold_t if r.ok else math.inf
         history.append(IterationRecord(grid.n_points, lb, ub, r.objective_s + hold_t,
                                        r.time_scale))
@@ -142,7 +147,6 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             prev_step = step
         if r.ok:
             prev_ub = ub
-    t_check = 0.0
     if best is None:
         return OptimalSolution(
             status=SolveStatus.SOLVER_ERROR, profile=None, lower_bound_s=lb,
