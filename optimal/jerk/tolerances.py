@@ -47,7 +47,7 @@ IPOPT_TOL = 1e-9
 #: on a program with long arcs at the feed it needed 900 iterations where monotone took
 #: 30 (sin_cead_arc.mpf), so it gets a short leash. A solve that fails both is reported
 #: as a solver failure (with the valid lower bound), never as a result.
-MU_STRATEGIES = (("adaptive", 200), ("monotone", 1500))
+MU_STRATEGIES = (("adaptive", 200), ("monotone", 500))
 
 #: Fraction of the acc optimum's speed used as the warm start (a slower start is closer
 #: to jerk feasibility, so IPOPT's restoration phase is rarely needed).

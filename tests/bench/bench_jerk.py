@@ -3,7 +3,7 @@
 Path: a stadium (G-code through the normal pipeline, default machine: tangent lines and
 half circles, curvature jumps at every line/arc joint, SOFT jerk limits), 2 laps.
 
-At 1,000 and 5,000 grid intervals:
+At 1,000, 2,000 and 5,000 grid intervals (and the scaling exponent of ours):
 
 * ``ours``: :func:`optimal.jerk.upper.upper_bound_round`: the scaled transcription,
   warm started from the acc grid optimum, IPOPT, exact profile, ``check_profile`` and
@@ -44,7 +44,7 @@ from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
 
-SIZES = (1000, 5000)
+SIZES = (1000, 2000, 5000)
 
 
 def stadium_gcode(R: float = 20.0, L: float = 80.0, laps: int = 2, F: float = 15000.0):
@@ -103,6 +103,7 @@ def main() -> int:
     print(f"stadium: {path.n_segments} segments, {path.total_length:.1f} mm, default machine")
     print(f"{'N':>6} {'ours s':>8} {'plain s':>8} {'ratio':>6} {'T ours (UB)':>12} "
           f"{'T plain (grid)':>15}  ours: build s, IPOPT s, iterations; plain status")
+    sizes, ours_s = [], []
     for n in SIZES:
         grid = initial_grid(path, n)
         t0 = time.perf_counter()
@@ -110,9 +111,13 @@ def main() -> int:
         ours = time.perf_counter() - t0
         plain_s, plain_T, status = plain_nlp(path, limits, grid)
         t_ours = r.profile.duration if r.ok else float("inf")
+        sizes.append(grid.n_intervals)
+        ours_s.append(ours)
         print(f"{grid.n_intervals:>6} {ours:8.2f} {plain_s:8.2f} {ours / plain_s:6.2f} "
               f"{t_ours:12.5f} {plain_T:15.5f}  {r.nlp.build_time_s:.2f}, "
               f"{r.nlp.solve_time_s:.2f}, {r.nlp.iterations}; {status}", flush=True)
+    slope = np.polyfit(np.log(sizes), np.log(ours_s), 1)[0]
+    print(f"ours: time ~ N^{slope:.2f} over N = {sizes[0]}..{sizes[-1]}")
     t0 = time.perf_counter()
     sol = optimal.solve(path, limits, bounds="jerk", tol=1e-2)
     secs = time.perf_counter() - t0
