@@ -3,14 +3,15 @@
 Pipeline:
 
 1. the ``acc`` oracle on the same path (its lower bound is valid here too, and its final
-   grid carries the per-run ``acc`` relaxation of :mod:`optimal.jerk.lower`);
+   grid carries the per-segment ``acc`` relaxation of :mod:`optimal.jerk.lower`);
 2. the certified lower bound (:func:`optimal.jerk.lower.jerk_lower_bound`);
 3. the jerk NLP on a piece-aware grid (:mod:`optimal.jerk.upper`): solve, verify with
    ``check_profile``, time-scale; while the gap is above ``tol`` and a finer grid still
-   improves the upper bound by a meaningful amount, solve again on a grid twice as fine;
+   can close the gap (extrapolated from the last rounds), solve again on a grid with
+   every interval halved;
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met``
    with both (valid) bounds; ``solver_error`` when IPOPT never produced a verified
-   profile (the bracket then is the acc lower bound and no upper bound).
+   profile (then only the lower bound is reported, the upper bound is ``inf``).
 
 Units: mm, s.
 """
