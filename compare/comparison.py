@@ -329,5 +329,6 @@ def compare(plan: ReferencePlan, solution: OptimalSolution, *,
                          "pass holds=plan.holds to optimal.solve")
     lines = tuple(program.lines) if program is not None else ()
     name = program.file if program is not None else ""
-    return compare_profiles(plan.path, limits, reference_side(plan), oracle_result(solution),
+    return compare_profiles(plan.path, limits, reference_side(plan),
+                            oracle_result(solution, solution.bounds),
                             program=name, machine=machine, program_lines=lines)

@@ -1,6 +1,7 @@
 """The oracle: time-optimal path-velocity profiles with certified bounds.
 
-``solve(path, limits, bounds="acc")`` returns an :class:`OptimalSolution` with the
+``solve(path, limits, bounds="acc")`` (or ``bounds="jerk"``, :mod:`optimal.jerk`)
+returns an :class:`OptimalSolution` with the
 verified profile, ``lower_bound_s`` (a relaxation, :mod:`optimal.bounds`) and
 ``upper_bound_s`` (a profile ``check_profile`` accepts), times per segment and per NC
 block, and the active constraint along the path. ``to_json_dict`` gives the JSON part.
@@ -8,7 +9,7 @@ block, and the active constraint along the path. ``to_json_dict`` gives the JSON
 Layers (G2): grid (:mod:`optimal.grid`) -> discrete problem (:mod:`optimal.problem`,
 numpy only) -> backend (:mod:`optimal.backends`, one file per solver).
 Import rule: this package imports ``reference.core`` only; solver packages only inside
-``optimal/backends/``.
+``optimal/backends/`` and ``optimal/jerk/backends/``.
 """
 
 from .backends import available_backends, known_backends, solve_discrete

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import partial
 from typing import Callable, Mapping
 
 import numpy as np
@@ -40,11 +41,12 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
                       DiscreteResult, build_grid_problem, check_feed, interval_times)
 from .solution import IterationRecord, OptimalSolution
 from .status import SolveStatus
+from .jerk.tolerances import DEFAULT_JERK_GAP_TOL
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE,
                          LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET)
 
-SUPPORTED_BOUNDS = ("acc",)
+SUPPORTED_BOUNDS = ("acc", "jerk")
 
 ProgressFn = Callable[[str, float], None]
 
@@ -251,7 +253,7 @@ def _empty_solution(path: Path, limits: MachineLimits, t0: float, backend: str,
 
 # --------------------------------------------------------------------------- solve
 def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
-          tol: float = DEFAULT_GAP_TOL, backend: str = DEFAULT_BACKEND,
+          tol: float | None = None, backend: str = DEFAULT_BACKEND,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
           initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
@@ -277,9 +279,13 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     limits : MachineLimits
         Machine limits; must define every axis of the path.
     bounds : str
-        Bound set; only ``"acc"`` (velocity and acceleration) is supported.
-    tol : float
-        Requested relative gap ``(upper - lower) / lower`` (default 0.2 %).
+        Bound set: ``"acc"`` (velocity and acceleration) or ``"jerk"`` (also axis jerk;
+        solved by :func:`optimal.jerk.solve_jerk`, see there; ``backend``,
+        ``backend_options``, ``max_grid`` and ``max_iterations`` then apply to the
+        ``acc`` solve inside it, ``initial_intervals`` to its NLP grid).
+    tol : float, optional
+        Requested relative gap ``(upper - lower) / lower`` (default 0.2 % for ``acc``,
+        1 % for ``jerk``).
     backend : str
         Backend of the grid problem (``"fast"`` default, ``"highs"``, ``"clarabel"``).
     backend_options : Mapping, optional
@@ -319,12 +325,22 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if bounds not in SUPPORTED_BOUNDS:
         raise ValueError(f"bound set {bounds!r} is not supported by the oracle yet "
                          f"(supported: {', '.join(SUPPORTED_BOUNDS)})")
+    if tol is None:
+        tol = DEFAULT_JERK_GAP_TOL if bounds == "jerk" else DEFAULT_GAP_TOL
     if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
         raise ValueError(f"tol = {tol!r}: must be a finite number > 0")
     if not (isinstance(max_grid, int) and max_grid >= 2):
         raise ValueError(f"max_grid = {max_grid!r}: must be an int >= 2")
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
+    if bounds == "jerk":
+        # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
+        from .jerk import solve_jerk
+        # (backend, its options and the grid limits apply to that inner acc solve)
+        acc_solve = partial(solve, backend=backend, backend_options=backend_options,
+                            max_grid=max_grid, max_iterations=max_iterations)
+        return solve_jerk(path, limits, acc_solve=acc_solve, tol=tol, progress=progress,
+                          holds=holds, initial_intervals=initial_intervals)
     solve_fn = get_backend(backend)
     if holds is None:
         holds = dwell_holds(path)

@@ -87,6 +87,8 @@ class OptimalSolution:
         Human-readable summary.
     holds : Holds
         The imposed holds in ``profile`` and in both bounds (as given to :func:`solve`).
+    bounds : str
+        The bound set solved (``"acc"`` or ``"jerk"``, :data:`BOUND_SETS` keys).
     """
 
     status: SolveStatus
@@ -114,6 +116,7 @@ class OptimalSolution:
     history: tuple[IterationRecord, ...] = field(default=())
     message: str = ""
     holds: Holds = NO_HOLDS
+    bounds: str = "acc"
 
     @property
     def hold_s(self) -> float:

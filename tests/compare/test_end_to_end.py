@@ -142,3 +142,27 @@ def test_gate_thresholds_hold_today():
                            cwd=ROOT, timeout=600)
         assert r.returncode == 0, f"{prog}: {r.stdout}{r.stderr}"
         assert parse_max_gap(gap) > 0
+
+
+def test_compare_with_jerk_bounds(tmp_path, capsys):
+    """``--bounds jerk``: the jerk oracle end to end; ``auto`` still solves ``acc`` for a
+    SOFT program and says why."""
+    prog = tmp_path / "soft.mpf"
+    prog.write_text("N10 G90 G64 SOFT F3000\nN20 G1 X20\nN30 G1 Y10\nN40 G1 X30\nM30\n")
+    js = tmp_path / "j.json"
+    assert cli.main(["compare", str(prog), "--bounds", "jerk", "--no-report", "--json",
+                     str(js)]) == 0
+    doc = json.loads(js.read_text())
+    jsonschema.validate(doc, schema())
+    assert doc["bounds"] == "jerk"
+    orc, ref = doc["oracle"], doc["reference"]
+    assert orc["status"] in ("optimal", "gap_not_met")
+    # the heuristic keeps jerk limits too, so it can be no faster than the jerk LB
+    assert 0 < orc["lower_bound_s"] <= orc["upper_bound_s"]
+    assert orc["lower_bound_s"] <= ref["time_s"]
+    js2 = tmp_path / "a.json"
+    assert cli.main(["compare", str(prog), "--no-report", "--json", str(js2)]) == 0
+    doc2 = json.loads(js2.read_text())
+    assert doc2["bounds"] == "acc"
+    assert any("--bounds jerk" in n for n in doc2["notes"])
+    capsys.readouterr()

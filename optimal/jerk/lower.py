@@ -1,0 +1,473 @@
+"""Certified lower bound of the minimum time under the ``jerk`` bound set.
+
+The problem
+===========
+A *jerk-feasible motion* is a motion ``s(t)`` with ``b = v^2`` as in the ``acc`` problem
+(axis velocity, axis acceleration, feed, rest at ``path.stop`` breaks, the velocity-jump
+rule at corners) whose path acceleration is absolutely continuous between segment
+breaks with ``|q'_i s''' + 3 q''_i v s'' + q'''_i v^3| <= J_i`` almost everywhere, and
+whose axis acceleration steps only at segment breaks and at the path ends, by at most
+``Jstep_i T_ipo`` (:func:`reference.core.rules.step_jerk_limit`; the surroundings of the
+path ends rest with zero acceleration). This is the issue's definition and what the
+upper bound's profiles satisfy. (``check_profile`` also accepts a step of up to
+``J_i T_ipo`` at *every* knot of a profile, so a profile with many knots could build up
+acceleration in steps; such motions are not jerk-limited and not in this set.)
+
+Why the bound holds
+===================
+1. *Segments.* Every motion's time is the sum of the times ``T_g`` it spends on the
+   segments ``g``; any valid lower bound of each ``T_g`` may be used, and the largest of
+   several is one too: ``T >= sum_g max_i LB_g,i``.
+2. *Acc relaxation.* Every jerk-feasible motion is ``acc``-feasible. In the ``acc``
+   relaxation of :func:`optimal.bounds.lower_bound` every feasible motion has
+   ``b(s_k) <= bhat_k`` at the nodes and ``b <= tent`` inside every interval (steps 3-4
+   of that module's docstring), so the tent time of each interval bounds the time
+   *every* feasible motion spends there, and their sum over a segment's intervals
+   bounds ``T_g``. Node bounds that hold for every jerk-feasible motion (step 5) may be
+   given to that relaxation as extra node caps; its proof is unchanged.
+3. *Straight runs between stops.* A run that is one line segment with direction
+   ``u = q'`` has ``q'' = q''' = 0``: the axis constraints are exactly ``|v| <= V``,
+   ``|s''| <= A``, ``|s'''| <= J`` with ``V = min(F, min_i V_i / |u_i|)``,
+   ``A = min_i A_i / |u_i|``, ``J = min_i J_i / |u_i|``, and the path acceleration at
+   its ends is at most ``a_s`` in size, the largest value the acceleration-step rule at
+   rest allows (:func:`break_accelerations`: ``J T_ipo`` at the path start and end,
+   unbounded at a 180 degree reversal). The minimum time of this 1-D problem, rest to
+   rest with boundary acceleration up to ``a_s``, is that of the classical double-S
+   profile that starts at ``s'' = a_s`` (Biagiotti & Melchiorri 2008, section 3.4;
+   ruckig with ``current_acceleration = a_s``, ``target_acceleration = -a_s``
+   computes the same, tests/optimal/test_jerk.py): accelerate as fast as the jerk and
+   acceleration limits allow to the peak speed, cruise, decelerate symmetrically.
+   :func:`rest_to_rest_time` gives it in closed form by extending the first jerk ramp
+   back to zero acceleration (a virtual start at speed ``-a_s^2 / (2J)``). When the
+   move is too short for that ramp (peak speed below ``a_s^2 / (2J)``, a few um on real
+   machines) it returns the jerk-free time, a weaker bound.
+4. *Envelope on every segment* (:func:`envelope_times`): with ``v^2`` at most ``bhat``
+   at both breaks, ``|s''|`` at most the step rule's allowance there
+   (:func:`break_accelerations`), and path bounds ``V, A, J`` valid on the whole
+   segment (exact on lines; on curves from :func:`_curve_limits`), the speed cannot
+   grow faster than the fastest jerk-limited ramp from either end, which bounds the
+   distance covered in a given time from above and so the time from below.
+5. *Curvature-jump caps* (:func:`curvature_break_caps`): at a tangential break where the
+   curvature vector jumps, the centripetal step ``dk v^2`` must fit the one-cycle
+   allowance up to what a path-acceleration step can cancel; that bounds ``v^2`` there
+   for every jerk-feasible motion (the ``acc`` problem has no such rule).
+6. ``LB = sum_g max(step 2, step 3 or 0, step 4) (1 - JERK_LB_ROUNDOFF_REL) + holds``,
+   never below the ``acc`` oracle's own certified lower bound, which is valid too (jerk
+   limits only remove motions). Rest at stops is ``v = 0`` exactly, as in the ``acc``
+   relaxation.
+
+Where it is loose: on arcs the path acceleration and jerk bounds of step 4 are norms
+over the axes (up to ``sqrt(n)`` above the pointwise values), and across corners crossed
+at speed and tangential joints nothing couples neighbouring segments beyond the node
+bounds; a convex relaxation of the jerk constraint itself (Consolini et al.) is not
+implemented, so the bracket on curved programs is often wider than 1 %.
+
+Units: mm, s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+from reference.core.geometry import Path, plane_amplitudes
+from reference.core.limits import AxisArrays
+from reference.core.rules import RELAXED, curvature_jumps, is_tangential, step_jerk_limit
+from reference.core.tolerances import VEL_TOL_MM_S
+
+from ..bounds import lower_bound
+from ..grid import Grid
+from .tolerances import JERK_LB_ROUNDOFF_REL
+
+
+def rest_to_rest_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) -> float:
+    """Minimum time of a straight move of length ``L`` from rest to rest.
+
+    Parameters
+    ----------
+    L : float
+        Distance, mm (> 0).
+    V, A, J : float
+        Path speed, acceleration and jerk limits, mm/s, mm/s^2, mm/s^3 (> 0).
+    a_s : float
+        Largest path acceleration allowed at the start and at the end (in size),
+        mm/s^2 (clipped to ``[0, A]``).
+
+    Returns
+    -------
+    float
+        Seconds; the jerk-free bound ``L/V + V/A`` or ``2 sqrt(L/A)`` when the move is
+        too short for the jerk ramp (see the module docstring, step 3).
+    """
+    a_s = min(max(a_s, 0.0), A)
+    delta = a_s * a_s / (2.0 * J)
+    a2j = A * A / J
+
+    def half(vp: float) -> tuple[float, float]:
+        # virtual S-ramp from -delta (a = 0) to vp; the real one starts a_s / J later
+        dv = vp + delta
+        tv = dv / A + A / J if dv >= a2j else 2.0 * math.sqrt(dv / J)
+        return tv - a_s / J, 0.5 * (vp - delta) * tv + a_s ** 3 / (3.0 * J * J)
+
+    t_v, d_v = half(V)
+    if 2.0 * d_v <= L:
+        return 2.0 * t_v + (L - 2.0 * d_v) / V
+    if 2.0 * half(delta)[1] < L:
+        vp = brentq(lambda x: 2.0 * half(x)[1] - L, delta, V, xtol=1e-15 * V, rtol=1e-15)
+        return 2.0 * half(vp)[0]
+    return L / V + V / A if V * V / A <= L else 2.0 * math.sqrt(L / A)
+
+
+def grid_on(path: Path, s: np.ndarray) -> Grid:
+    """The :class:`Grid` with nodes ``s`` (which contain every segment break)."""
+    seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
+    return Grid(s=s, segment=seg, break_node=np.searchsorted(s, path.s_breaks))
+
+
+def _max_fixed(f: np.ndarray, g: np.ndarray, gamma: np.ndarray, z_max: float,
+               w_nonneg: np.ndarray) -> np.ndarray:
+    """Largest ``z`` in ``[0, z_max]`` with some ``w`` (``w >= 0`` on rows where
+    ``w_nonneg``) meeting ``|g_i w + f_i z| <= gamma_i`` for every axis, per row.
+
+    The set of such ``z`` is an interval containing 0 (the projection of a convex set
+    that contains the origin); for fixed ``z`` the ``w`` allowed by each axis form an
+    interval, and the constraint holds iff their intersection (with ``[0, inf)``
+    where ``w_nonneg``) is not empty. Bisection; the upper end of the final bracket is
+    returned, so the result is never below the true maximum.
+
+    Parameters
+    ----------
+    f, g : numpy.ndarray, shape (k, n)
+    gamma : numpy.ndarray, shape (n,) or (k, n)
+    z_max : float
+    w_nonneg : numpy.ndarray of bool, shape (k,)
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+    """
+    def feasible(z: np.ndarray) -> np.ndarray:
+        c = f * z[:, None]
+        gz = g != 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            e1 = np.where(gz, (-gamma - c) / np.where(gz, g, 1.0), -np.inf)
+            e2 = np.where(gz, (gamma - c) / np.where(gz, g, 1.0), np.inf)
+        lo = np.max(np.minimum(e1, e2), axis=1)
+        lo = np.where(w_nonneg, np.maximum(lo, 0.0), lo)
+        hi = np.min(np.maximum(e1, e2), axis=1)
+        ok_zero = np.all(gz | (np.abs(c) <= gamma), axis=1)
+        return ok_zero & (lo <= hi)
+
+    k = f.shape[0]
+    lo = np.zeros(k)
+    hi = np.full(k, z_max)
+    top = feasible(hi)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        ok = feasible(mid)
+        lo = np.where(ok, mid, lo)
+        hi = np.where(ok, hi, mid)
+    return np.where(top, z_max, hi)
+
+
+def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float,
+                        b_break: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Largest path acceleration (in size) on arriving at and on leaving every break
+    that the acceleration-step rule allows.
+
+    Crossing a break at ``v`` steps axis ``i``'s acceleration by
+    ``t_out_i a_r - t_in_i a_l + dk_i v^2`` (``dk`` the jump of ``q''``), held to
+    ``Jstep_i T_ipo``: ``J_i`` without a curvature jump and at rest, PATH_TRANS_JERK_LIM
+    with one while moving (:func:`reference.core.rules.step_jerk_limit`), so the larger
+    of the two is a relaxation. With ``v^2 <= b_break`` the centripetal part is at most
+    ``|dk_i| b_break``, which is added to the allowance. At a stop the path decelerates
+    into the rest (``a_l <= 0``) and accelerates out of it (``a_r >= 0``); elsewhere both
+    signs are possible and the set is symmetric, so the largest ``|a|`` is the largest
+    ``a``. Outside the path the motion rests (tangent and curvature 0). Each side's
+    bound is taken over all values of the other side: a relaxation.
+
+    Parameters
+    ----------
+    path : Path
+    lim : AxisArrays
+    t_ipo : float
+        IPO cycle, s.
+    a_cap : float
+        Upper end of the search, mm/s^2.
+    b_break : numpy.ndarray, shape (m + 1,)
+        Valid upper bounds of ``v^2`` at the breaks, mm^2/s^2.
+
+    Returns
+    -------
+    a_in, a_out : numpy.ndarray, shape (m + 1,)
+        Bounds of ``|a_l|`` and ``|a_r|`` at every break, mm/s^2.
+    """
+    m = path.n_segments
+    n = len(path.axes)
+    t_in = np.zeros((m + 1, n))
+    t_out = np.zeros((m + 1, n))
+    k_in = np.zeros((m + 1, n))
+    k_out = np.zeros((m + 1, n))
+    _, d0, c0, _ = path.evaluate(path.s_breaks[:-1], segment=np.arange(m))
+    _, d1, c1, _ = path.evaluate(path.s_breaks[1:], segment=np.arange(m))
+    t_out[:m], k_out[:m] = d0, c0
+    t_in[1:], k_in[1:] = d1, c1
+    dk = np.abs(k_out - k_in)
+    jstep = np.maximum(step_jerk_limit(curvature_jumps(k_in, k_out), lim.j_max,
+                                       lim.path_trans_jerk), lim.j_max[None, :])
+    gamma = jstep * t_ipo + dk * np.maximum(np.asarray(b_break), 0.0)[:, None]
+    # step = t_out a_r + t_in x with x = -a_l (>= 0 and a_r >= 0 at a stop)
+    a_in = _max_fixed_rows(t_in, t_out, gamma, a_cap, path.stop)
+    a_out = _max_fixed_rows(t_out, t_in, gamma, a_cap, path.stop)
+    return a_in, a_out
+
+
+def _max_fixed_rows(f, g, gamma, z_max, w_nonneg):
+    """:func:`_max_fixed` with one allowance vector per row (``gamma`` shape (k, n))."""
+    out = np.empty(f.shape[0])
+    for key in np.unique(gamma, axis=0, return_inverse=True)[1].reshape(-1)[:0]:
+        pass
+    # rows share the allowance only by chance: solve them in one vectorised bisection
+    return _max_fixed(f, g, gamma, z_max, w_nonneg) if out.size else out
+
+
+def envelope_times(L: np.ndarray, vb: np.ndarray, a_s: np.ndarray, V: np.ndarray,
+                   A: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """Lower bound of the time to travel ``L`` on a line between two breaks (step 4 of
+    the module docstring), vectorised over segments.
+
+    Every motion with ``v <= vb`` and ``|s''| <= a_s`` at both ends, ``v <= V``,
+    ``|s''| <= A`` and ``|s'''| <= J`` has ``v(t) <= min(V, F(t), F(T - t))`` with
+    ``F(t) = vb + int_0^t min(A, a_s + J tau) dtau`` (the speed can grow no faster from
+    either end), hence ``L <= I(T) = 2 int_0^{T/2} min(V, F)``. ``I`` is increasing in
+    ``T``; bisection returns the lower end of its final bracket, where ``I < L``.
+
+    Parameters
+    ----------
+    L, vb, a_s, V, A, J : numpy.ndarray, shape (k,)
+        Length (mm), boundary speed bound and speed limit (mm/s), boundary and path
+        acceleration limits (mm/s^2), jerk limit (mm/s^3).
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+        Seconds.
+    """
+    vb = np.minimum(vb, V)
+    a_s = np.clip(a_s, 0.0, A)
+    t1 = (A - a_s) / J
+    F1 = vb + a_s * t1 + J * t1 * t1 / 2
+    t_quad = (-a_s + np.sqrt(a_s * a_s + 2 * J * np.maximum(V - vb, 0.0))) / J
+    t_V = np.where(V <= F1, t_quad, t1 + (V - F1) / A)
+    Q1 = vb * t1 + a_s * t1 * t1 / 2 + J * t1 ** 3 / 6
+
+    def integral(T: np.ndarray) -> np.ndarray:
+        tau = np.minimum(T / 2, t_V)
+        d = tau - t1
+        q = np.where(tau <= t1, vb * tau + a_s * tau * tau / 2 + J * tau ** 3 / 6,
+                     Q1 + F1 * d + A * d * d / 2)
+        return 2.0 * (q + V * np.maximum(T / 2 - t_V, 0.0))
+
+    lo = np.zeros(L.size)
+    hi = 2.0 * t_V + L / V
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        short = integral(mid) < L
+        lo = np.where(short, mid, lo)
+        hi = np.where(short, hi, mid)
+    return lo
+
+
+def _line_limits(path: Path, lim: AxisArrays, seg: np.ndarray):
+    """Path speed, acceleration and jerk limits ``V, A, J`` of line segments ``seg``
+    (exact: every axis value is ``|q'_i|`` times the path value)."""
+    u = np.abs(path.d[seg])
+    with np.errstate(divide="ignore"):
+        inv = np.where(u > 0, 1.0 / np.where(u > 0, u, 1.0), np.inf)
+    V = np.minimum(path.feed[seg], np.min(lim.v_max[None, :] * inv, axis=1))
+    A = np.min(lim.a_max[None, :] * inv, axis=1)
+    J = np.min(lim.j_max[None, :] * inv, axis=1)
+    return V, A, J
+
+
+def _curve_limits(path: Path, lim: AxisArrays, seg: np.ndarray, B: np.ndarray):
+    """Path acceleration and jerk bounds ``A, J`` valid everywhere on curved segments
+    ``seg`` where ``v^2 <= B``.
+
+    At every point ``sum_i q'_i^2 >= 1`` over the axes that move on the segment (``s`` is
+    the arc length of a subset of them). If ``|q'_i| |x| <= X_i`` for every axis, then
+    ``|x| <= ||X||_2`` (otherwise every ``|q'_i| < X_i / |x|`` and the squares sum to
+    less than 1). With ``|q'_i s''| <= A_i + |q''_i| B`` and
+    ``|q'_i s'''| <= J_i + 3 |q''_i| v |s''| + |d3q_i| v^3`` (the rulebook's axis
+    kinematics, ``d3q = q'''``) and the segment's suprema of ``|q''_i|`` and ``|d3q_i|``
+    (:func:`reference.core.geometry.plane_amplitudes`) this gives ``A`` and ``J``.
+    """
+    amp = plane_amplitudes(path)
+    rho = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)
+    k2 = rho * amp.curvature[seg][:, None]
+    k3 = rho * np.hypot(amp.jerk_t[seg], amp.jerk_n[seg])[:, None]
+    reach = np.abs(path.d[seg]) + rho * amp.speed[seg][:, None]
+    moving = reach > 0
+    Bc = B[:, None]
+    A_ax = np.where(moving, lim.a_max[None, :] + k2 * Bc, 0.0)
+    A = np.sqrt(np.sum(A_ax ** 2, axis=1))
+    v = np.sqrt(Bc)
+    J_ax = np.where(moving, lim.j_max[None, :] + 3 * k2 * v * A[:, None] + k3 * v ** 3, 0.0)
+    return A, np.sqrt(np.sum(J_ax ** 2, axis=1))
+
+
+def segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray,
+                  b_seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Steps 3 and 4 of the module docstring: per-segment jerk bounds.
+
+    Parameters
+    ----------
+    path : Path
+    lim : AxisArrays
+    t_ipo : float
+        IPO cycle, s.
+    b_break : numpy.ndarray, shape (m + 1,)
+        Upper bounds of ``v^2`` at the breaks valid for every feasible motion, mm^2/s^2.
+    b_seg : numpy.ndarray, shape (m,)
+        Upper bounds of ``v^2`` on every segment, valid likewise, mm^2/s^2.
+
+    Returns
+    -------
+    envelope : numpy.ndarray, shape (m,)
+        Step 4 on every segment, s.
+    runs : numpy.ndarray, shape (R,)
+        Step 3 on every run that is one line segment (0 on other runs), s.
+    """
+    m = path.n_segments
+    env = np.zeros(m)
+    stops = np.flatnonzero(path.stop)
+    runs = np.zeros(max(stops.size - 1, 0))
+    moving = np.any(path.d != 0, axis=1) | (path.radius > 0)
+    line = (path.radius == 0) & moving
+    curve = path.radius > 0
+    V = np.sqrt(np.maximum(b_seg, 0.0))
+    A = np.full(m, np.inf)
+    J = np.full(m, np.inf)
+    seg_l = np.flatnonzero(line)
+    if seg_l.size:
+        V_l, A[seg_l], J[seg_l] = _line_limits(path, lim, seg_l)
+        V[seg_l] = np.minimum(V[seg_l], V_l)
+    seg_c = np.flatnonzero(curve)
+    if seg_c.size:
+        A[seg_c], J[seg_c] = _curve_limits(path, lim, seg_c, np.maximum(b_seg[seg_c], 0.0))
+    seg = np.flatnonzero(moving & (V > 0))
+    if seg.size == 0:
+        return env, runs
+    a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A[seg])), b_break)
+    a_s = np.maximum(a_out[seg], a_in[seg + 1])
+    vb = np.sqrt(np.maximum(np.maximum(b_break[seg], b_break[seg + 1]), 0.0))
+    env[seg] = envelope_times(path.length[seg], vb, a_s, V[seg], A[seg], J[seg])
+    for r in np.flatnonzero(np.diff(stops) == 1):
+        k = int(stops[r])
+        if line[k] and V[k] > 0:
+            # the 1-D bound is symmetric in its ends: the larger allowance is a relaxation
+            a_k = max(float(a_out[k]), float(a_in[k + 1]))
+            runs[r] = rest_to_rest_time(float(path.length[k]), float(V[k]), float(A[k]),
+                                        float(J[k]), a_k)
+    return env, runs
+
+
+def curvature_break_caps(path: Path, lim: AxisArrays, t_ipo: float, b_max: np.ndarray
+                         ) -> np.ndarray:
+    """Upper bounds of ``v^2`` at tangential breaks where the curvature jumps (step 5).
+
+    Crossing such a break at ``v`` steps axis ``i``'s acceleration by
+    ``t_out_i a_r - t_in_i a_l + (q''_out_i - q''_in_i) v^2``; the rulebook holds the step
+    to ``Jstep_i T_ipo`` (PATH_TRANS_JERK_LIM, :func:`reference.core.rules.step_jerk_limit`
+    with :func:`reference.core.rules.curvature_jumps`). Writing ``t_out a_r - t_in a_l =
+    t_out delta + (t_out - t_in) a_l`` with ``|a_l| <= a_bnd`` (some geometry axis has
+    ``|t_i| >= 1/sqrt(n)``, so ``|a| <= sqrt(n) (max A + max|q''| b_max)``), a crossing at
+    ``v^2 = z`` needs some ``delta`` with ``|t_out_i delta + dk_i z| <= Jstep_i T_ipo +
+    |t_out_i - t_in_i| a_bnd`` for all ``i``; the largest such ``z`` (from above) bounds
+    ``v^2`` there, or the speed is at standstill level (``VEL_TOL_MM_S``, where the
+    checker applies MAX_AX_JERK instead: the cap is raised to that level).
+
+    Parameters
+    ----------
+    path : Path
+    lim : AxisArrays
+    t_ipo : float
+        IPO cycle, s.
+    b_max : numpy.ndarray, shape (m + 1,)
+        Valid upper bounds of ``v^2`` at the breaks (the search range), mm^2/s^2.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m + 1,)
+        mm^2/s^2, ``b_max`` where nothing is claimed.
+    """
+    m = path.n_segments
+    out = np.asarray(b_max, dtype=np.float64).copy()
+    if m < 2:
+        return out
+    t_in, t_out = path.junction_tangents()
+    k_in, k_out = path.junction_curvatures()
+    sel = np.flatnonzero(is_tangential(t_in, t_out, RELAXED) & curvature_jumps(k_in, k_out))
+    if sel.size == 0:
+        return out
+    n = len(path.axes)
+    zmax = np.maximum(out[sel + 1], 0.0)
+    kap = np.max(np.abs(k_in[sel]), axis=1)
+    a_bnd = math.sqrt(n) * (float(np.max(lim.a_max)) + kap * zmax)
+    jstep = step_jerk_limit(np.ones(sel.size, bool), lim.j_max, lim.path_trans_jerk)
+    gamma = jstep * t_ipo + np.abs(t_out[sel] - t_in[sel]) * a_bnd[:, None]
+    dk = k_out[sel] - k_in[sel]
+    z = np.empty(sel.size)
+    for r in range(sel.size):     # one bisection per break (vectorised over its axes)
+        z[r] = _max_fixed(dk[r:r + 1], t_out[sel[r]:sel[r] + 1], gamma[r],
+                          float(zmax[r]), np.zeros(1, bool))[0]
+    out[sel + 1] = np.minimum(out[sel + 1], np.maximum(z, VEL_TOL_MM_S ** 2))
+    return out
+
+
+def jerk_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
+                     ) -> tuple[float, np.ndarray, np.ndarray]:
+    """Certified lower bound of the motion time (holds excluded), module docstring.
+
+    Parameters
+    ----------
+    path : Path
+        The path (at least one segment).
+    lim : AxisArrays
+        Limits in the path's axis order.
+    t_ipo : float
+        IPO cycle, s.
+    acc_grid_s : numpy.ndarray, shape (N + 1,)
+        Nodes of the grid on which the ``acc`` relaxation is evaluated (every segment
+        break a node; the ``acc`` oracle's final grid is a good one).
+
+    Returns
+    -------
+    lb_s : float
+        Lower bound, s.
+    acc_seg, jerk_seg : numpy.ndarray, shape (m,)
+        Per segment: the ``acc`` relaxation's bound and the larger of the straight-line
+        bounds (0 on arcs), s; on runs that are one line the run bound (step 3) is in
+        ``jerk_seg``.
+    """
+    grid = grid_on(path, np.asarray(acc_grid_s, dtype=np.float64))
+    _, t_lb, rel, b_hat = lower_bound(path, lim, grid)
+    caps = curvature_break_caps(path, lim, t_ipo, b_hat[grid.break_node])
+    if np.any(caps < b_hat[grid.break_node]):
+        b_node = b_hat.copy()
+        b_node[grid.break_node] = np.minimum(b_node[grid.break_node], caps)
+        _, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
+    acc_seg = np.bincount(grid.segment, weights=t_lb, minlength=path.n_segments)
+    # v^2 on each segment: at most its intervals' a-priori bounds and its node bounds
+    b_seg = np.zeros(path.n_segments)
+    np.maximum.at(b_seg, grid.segment, np.maximum(rel.b_bar, np.maximum(b_hat[:-1],
+                                                                         b_hat[1:])))
+    env, runs = segment_times(path, lim, t_ipo, b_hat[grid.break_node], b_seg)
+    jerk_seg = env.copy()
+    stops = np.flatnonzero(path.stop)
+    one = np.flatnonzero(runs > 0)
+    jerk_seg[stops[one]] = np.maximum(jerk_seg[stops[one]], runs[one])
+    lb = float(np.maximum(acc_seg, jerk_seg).sum()) * (1.0 - JERK_LB_ROUNDOFF_REL)
+    return lb, acc_seg, jerk_seg

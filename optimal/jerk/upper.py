@@ -1,0 +1,205 @@
+"""Upper bound of the jerk oracle: warm start, NLP solve, exact profile, checker, scaling.
+
+1. *Warm start*: the exact optimum of the ``acc`` grid problem on the same grid
+   (:func:`optimal.problem.build_grid_problem`, solved by the fast sweep), slowed to
+   :data:`~optimal.jerk.tolerances.WARM_START_SPEED_FRACTION` of its speed.
+2. *NLP*: :func:`optimal.jerk.backends.solve_nlp` (CasADi + IPOPT).
+3. *Exact profile*: node speeds and interval durations are kept; on every interval the
+   start acceleration and the constant jerk are re-solved from the two integration
+   equalities, so positions and speeds meet the knots exactly
+   (:class:`~reference.core.profile.Profile` checks both). The acceleration then steps
+   at knots by the solver's residual only (1e-9 of the acceleration unit).
+4. *Verification*: ``check_profile`` judges the profile under ``BOUND_SETS["jerk"]``;
+   what the nodes missed (jerk and acceleration between nodes on arcs, the speed peak
+   inside an interval) is repaired by stretching time
+   (:func:`reference.core.constraints.time_scale_factor`, the same rule the ``acc``
+   oracle applies). The accepted profile's duration is the upper bound.
+
+Units: mm, s. Shapes: ``N`` intervals.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
+                                        scale_time, time_scale_factor)
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.core.profile import Profile
+
+from ..backends import get_backend
+from ..grid import Grid
+from ..problem import build_grid_problem
+from ..status import SolveStatus
+from .backends import NlpResult, solve_nlp
+from .tolerances import WARM_START_SPEED_FRACTION
+from .transcription import JerkProblem, build_jerk_problem
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class UpperResult:
+    """One verified round of the jerk NLP.
+
+    Attributes
+    ----------
+    ok : bool
+        IPOPT converged and the checker accepted the (time-scaled) profile.
+    profile : Profile or None
+        The accepted profile (holds not inserted), ``None`` when not ``ok``.
+    time_scale : float
+        Stretch factor applied (>= 1).
+    objective_s : float
+        Duration of the NLP's profile before scaling, s.
+    report : ConstraintReport or None
+        The checker's report on the unscaled profile.
+    nlp : NlpResult
+        IPOPT's answer.
+    problem : JerkProblem
+        The transcription.
+    interval_times_s : numpy.ndarray, shape (N,)
+        Time on every grid interval of the accepted profile, s.
+    message : str
+        Why not ``ok``.
+    """
+
+    ok: bool
+    profile: Profile | None
+    time_scale: float
+    objective_s: float
+    report: ConstraintReport | None
+    nlp: NlpResult
+    problem: JerkProblem
+    interval_times_s: np.ndarray
+    message: str = ""
+
+
+def warm_start(path: Path, lim, grid: Grid, problem: JerkProblem
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Dimensionless ``(c, a, dt)`` from the ``acc`` grid optimum on ``grid``."""
+    acc = get_backend("fast")(build_grid_problem(path, lim, grid), None)
+    if acc.b is None or acc.status not in (SolveStatus.OPTIMAL,
+                                           SolveStatus.OPTIMAL_INACCURATE):
+        raise RuntimeError(f"acc warm start failed: {acc.status} ({acc.message})")
+    u = problem.units
+    f = WARM_START_SPEED_FRACTION
+    c = f * np.sqrt(np.maximum(acc.b, 0.0)) / u.speed
+    ds = problem.ds
+    a_int = (c[1:] ** 2 - c[:-1] ** 2) / (2.0 * ds)
+    a = np.zeros(c.size)
+    a[1:-1] = 0.5 * (a_int[:-1] + a_int[1:])
+    vs = c[:-1] + c[1:]
+    dt = np.where(vs > 0, 2.0 * ds / np.where(vs > 0, vs, 1.0), 1.0)
+    # slow it down until the node rows hold: IPOPT then starts (nearly) feasible, which
+    # it needs (from the acc optimum itself it wandered for 900 iterations on a
+    # program with long arcs); stretching time by lam divides c by lam, a by lam^2 and
+    # every jerk row by lam^3
+    lam = max(1.0, _row_excess(problem, c, a, dt))
+    return c / lam, a / lam ** 2, dt * lam
+
+
+def _row_excess(problem: JerkProblem, c: np.ndarray, a: np.ndarray, dt: np.ndarray
+                ) -> float:
+    """Smallest time stretch after which the acceleration, step and jerk rows hold at
+    ``(c, a, dt)`` (accelerations continuous at breaks)."""
+    inner = problem.grid.break_node[1:-1]
+    a_all = np.concatenate((a, a[inner]))
+    lam = 1.0
+    for rows, idx, power in ((problem.acc, problem.acc_index, 2),):
+        if rows.n:
+            val = rows.dq * a_all[idx] + rows.ddq * c[rows.node] ** 2
+            lam = max(lam, float(np.max(np.abs(val) / rows.limit)) ** (1.0 / power))
+    st = problem.step
+    if st.n:
+        z = np.concatenate((a_all, [0.0]))
+        ai = z[np.where(st.ia_in < 0, z.size - 1, st.ia_in)]
+        ao = z[np.where(st.ia_out < 0, z.size - 1, st.ia_out)]
+        c2 = c[st.node] ** 2
+        val = st.dq_out * ao + st.ddq_out * c2 - st.dq_in * ai - st.ddq_in * c2
+        lam = max(lam, float(np.max(np.abs(val) / st.limit)) ** 0.5)
+    jr = problem.jerk
+    if jr.n:
+        k = jr.interval
+        cn = c[jr.node]
+        an = a[jr.node]
+        val = (jr.dq * (a[k + 1] - a[k]) / dt[k] + 3 * jr.ddq * cn * an + jr.dddq * cn ** 3)
+        lam = max(lam, float(np.max(np.abs(val) / jr.limit)) ** (1.0 / 3.0))
+    return lam
+
+
+def exact_profile(problem: JerkProblem, c: np.ndarray, dt: np.ndarray,
+                  block: np.ndarray) -> Profile:
+    """The piecewise-constant-jerk profile through node speeds ``c`` and durations ``dt``.
+
+    On interval ``k`` (length ``D``, duration ``h``) the start acceleration ``a`` and
+    jerk ``j`` solve ``a h + j h^2 / 2 = c_{k+1} - c_k`` and
+    ``a h^2 / 2 + j h^3 / 6 = D - c_k h`` exactly.
+
+    Parameters
+    ----------
+    problem : JerkProblem
+        For the grid and the units.
+    c : numpy.ndarray, shape (N + 1,)
+        Dimensionless node speeds (clipped to ``[0, c_max]``).
+    dt : numpy.ndarray, shape (N,)
+        Dimensionless durations (> 0).
+    block : numpy.ndarray of int, shape (N,)
+        NC block of each interval.
+
+    Returns
+    -------
+    Profile
+        In mm and s.
+    """
+    u = problem.units
+    c = np.clip(c, 0.0, problem.c_max)
+    h = dt * u.time_s
+    v = c * u.speed
+    D = np.diff(problem.grid.s)
+    X = v[1:] - v[:-1]
+    Y = D - v[:-1] * h
+    a = (6.0 * Y - 2.0 * X * h) / (h * h)
+    j = 2.0 * (X - a * h) / (h * h)
+    t = np.concatenate(([0.0], np.cumsum(h)))
+    return Profile(t=t, s=problem.grid.s, v=v, a=a, j=j, block=block)
+
+
+def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperResult:
+    """Solve the jerk NLP on ``grid`` and verify its profile (see the module docstring).
+
+    Parameters
+    ----------
+    path : Path
+        The path.
+    limits : MachineLimits
+        Machine limits.
+    grid : Grid
+        NLP grid.
+
+    Returns
+    -------
+    UpperResult
+    """
+    lim = limits.for_axes(path.axes)
+    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
+    c0, a0, dt0 = warm_start(path, lim, grid, problem)
+    nlp = solve_nlp(problem, c0, a0, dt0)
+    empty = np.zeros(grid.n_intervals)
+    if not nlp.success:
+        return UpperResult(False, None, 1.0, np.inf, None, nlp, problem, empty,
+                           f"IPOPT: {nlp.message} after {nlp.iterations} iterations")
+    block = path.block[grid.segment]
+    prof = exact_profile(problem, nlp.c, nlp.dt, block)
+    report = check_profile(path, limits, prof)
+    lam = time_scale_factor(report, BOUND_SETS["jerk"])
+    if not np.isfinite(lam):
+        bad = [r for r in report.results if not np.isfinite(r.ratio)]
+        where = f"{bad[0].constraint} at s = {bad[0].s:.6g} mm" if bad else "a constraint"
+        return UpperResult(False, None, lam, prof.duration, report, nlp, problem, empty,
+                           f"the NLP profile breaks {where} beyond repair by time scaling")
+    accepted = scale_time(prof, lam) if lam > 1.0 else prof
+    return UpperResult(True, accepted, lam, prof.duration, report, nlp, problem,
+                       np.diff(accepted.t), f"IPOPT: {nlp.message}, {nlp.iterations} "
+                       f"iterations, time scale {lam:.6f}")
