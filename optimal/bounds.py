@@ -98,9 +98,9 @@ from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, lower
                          slope_peak, tangential_slope_bound)
 from .backends.fast import sweep
 from .grid import Grid
-from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
+from .problem import (CAP_BOUND, DiscreteProblem, RowWriter, _assemble, common_node_caps,
                       interval_geometry, interval_times, moving_axes, pair_mvc)
-from .tolerances import LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
+from .tolerances import ENVELOPE_CHUNK, LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -215,9 +215,11 @@ def derivative_ranges(path: Path, grid: Grid, dq0: np.ndarray, ddq0: np.ndarray,
     t_lo, t_hi = np.minimum(dq0, dq1), np.maximum(dq0, dq1)
     k_lo, k_hi = np.minimum(ddq0, ddq1), np.maximum(ddq0, ddq1)
     exact = path.dradius[seg] == 0
-    circ = np.flatnonzero(exact & (path.radius[seg] > 0))
+    circ_all = np.flatnonzero(exact & (path.radius[seg] > 0))
     amp = np.zeros_like(dq0)
-    if circ.size:
+    # in chunks of intervals: a dozen (chunk, n) temporaries each
+    for lo in range(0, circ_all.size, ENVELOPE_CHUNK):
+        circ = circ_all[lo:lo + ENVELOPE_CHUNK]
         sc = seg[circ]
         e1, e2 = path.e1[sc], path.e2[sc]
         r, w = path.radius[sc], path.omega[sc]
@@ -457,7 +459,7 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
     margin = np.where(good, slope, 0.0) * ds * ds / REMAINDER_DIVISOR
     E = np.where(good[:, None], geo.k2 * margin[:, None]
                  + geo.ierr * np.where(good, B, 0.0)[:, None], np.inf)
-    cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
+    rows = RowWriter(N, 4 * len(geo.axes_used))
     if guide is not None:       # second-order rows (optimal.arc_bounds.envelope_rows)
         slope_g = np.where(good, slope, np.inf)
         env = lower_envelopes(ds, guide[:-1], guide[1:], lim.a_max, geo.dq_mid,
@@ -475,10 +477,8 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
                 # relax: drop one term at a time (b >= 0)
                 caps.add(left[both], hrow[both] / c1[both], CAP_BOUND)
                 caps.add(left[both] + 1, hrow[both] / c2[both], CAP_BOUND)
-            cols_c1.append(np.where(both, 0.0, c1))
-            cols_c2.append(np.where(both, 0.0, c2))
-            cols_h.append(np.where(fin, hrow, 1.0))
-            row_axis.append(j)
+            rows.append(np.where(both, 0.0, c1), np.where(both, 0.0, c2),
+                        np.where(fin, hrow, 1.0), j)
             if guide is None:
                 continue
             # the same row in second-order form (optimal.arc_bounds.envelope_rows)
@@ -496,19 +496,17 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
                 caps.add(left[both] + 1, h2[both] / n2[both], CAP_BOUND)
             # where formed it replaces the first-order row in the same column (dropping
             # a valid row only relaxes; this keeps the sweep's column count)
-            cols_c1[-1] = np.where(ok, np.where(both, 0.0, n1), cols_c1[-1])
-            cols_c2[-1] = np.where(ok, np.where(both, 0.0, n2), cols_c2[-1])
-            cols_h[-1] = np.where(ok, h2, cols_h[-1])
+            l1, l2, lh = rows.last()
+            l1[ok] = np.where(both, 0.0, n1)[ok]
+            l2[ok] = np.where(both, 0.0, n2)[ok]
+            lh[ok] = h2[ok]
         # energy rows (step 2b of the module docstring): exact, no remainder
         e0 = geo.dq0[:, j] ** 2
         e1 = geo.dq1[:, j] ** 2
         he = 2.0 * lim.a_max[j] * geo.travel[:, j]
         for c1, c2 in ((-e0, e1), (e0, -e1)):
-            cols_c1.append(c1)
-            cols_c2.append(c2)
-            cols_h.append(he)
-            row_axis.append(j)
-    prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
+            rows.append(c1, c2, he, j)
+    prob = _assemble(path, lim, grid, caps, rows, "relaxed")
     return Relaxation(prob, B, slope)
 
 

@@ -513,6 +513,7 @@ def _solve_grid(work: Path, lim, grid: Grid, solve_fn, options, geometry=None) -
         geometry = interval_geometry(work, grid)
     for attempt in range(SLOPE_SOLVES + 2):
         ta = time.perf_counter()
+        problem = None              # the previous problem goes before the next is built
         problem = build_grid_problem(work, lim, grid, g, guess, geometry)
         tb = time.perf_counter()
         res = solve_fn(problem, options)

@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.core.arrays import readonly
-from reference.core.errors import InfeasibleError
+from reference.core.errors import InfeasibleError, InternalError
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays
 from reference.core.rules import FEASIBLE, RELAXED, junction_speed_cap
@@ -140,7 +140,8 @@ class DiscreteProblem:
             raise ValueError(f"nodes must increase strictly (interval {int(np.argmin(ds))})")
         if not np.all(np.isfinite(self.cap)) or np.any(self.cap < 0):
             raise ValueError("caps must be finite and >= 0")
-        if np.any(self.c1 * self.c2 > 0) or np.any(self.h < 0):
+        if np.any((self.c1 > 0) & (self.c2 > 0)) or np.any((self.c1 < 0) & (self.c2 < 0)) \
+                or np.any(self.h < 0):
             raise ValueError("rows are not in lattice form (c1 * c2 <= 0, h >= 0)")
         object.__setattr__(self, "ds", readonly(ds, np.float64))
         gamma = np.zeros(N) if self.gamma is None else np.asarray(self.gamma, np.float64)
@@ -470,7 +471,6 @@ def build_grid_problem(path: Path, lim: AxisArrays, grid: Grid,
     inv2ds = 1.0 / (2.0 * D)
     g = clip_slopes(path, lim, grid, dq0, dq1,
                     np.zeros(N) if gamma is None or b_guess is None else gamma)
-    cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
     left = np.arange(N)
     # a concave b (gamma < 0) rises above the larger end value by up to |gamma| D^2 / 4
     # inside the interval: keep that much below the speed caps at both ends
@@ -483,7 +483,9 @@ def build_grid_problem(path: Path, lim: AxisArrays, grid: Grid,
         caps.cap = lowered
     m0, mc = interior_margins(path, lim, grid, dq0, ddq0, dq1, ddq1, caps.cap, g, b_guess)
     tilted = mc > 0
-    for j in moving_axes(dq0, ddq0, dq1, ddq1):
+    axes_used = moving_axes(dq0, ddq0, dq1, ddq1)
+    rows = RowWriter(N, sum(8 if np.any(tilted[:, j]) else 4 for j in axes_used))
+    for j in axes_used:
         A = lim.a_max[j]
         h_j = A - m0[:, j]
         # the margin's part mc |abar| as two rows, +abar and -abar (abar = (b1 - b0) / 2D)
@@ -511,11 +513,8 @@ def build_grid_problem(path: Path, lim: AxisArrays, grid: Grid,
                         capv = hh[both] / (e1[both] + e2[both])
                         caps.add(left[both], capv, CAP_ACCELERATION, j)
                         caps.add(left[both] + 1, capv, CAP_ACCELERATION, j)
-                    cols_c1.append(np.where(both, 0.0, e1))
-                    cols_c2.append(np.where(both, 0.0, e2))
-                    cols_h.append(hh)
-                    row_axis.append(j)
-    return _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "grid", g)
+                    rows.append(np.where(both, 0.0, e1), np.where(both, 0.0, e2), hh, j)
+    return _assemble(path, lim, grid, caps, rows, "grid", g)
 
 
 #: Largest share of an axis' acceleration limit that the slope terms of one row may take
@@ -687,10 +686,24 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
     seg = grid.segment
     out = np.zeros((N, n))
     coef = np.zeros((N, n))
-    curved = np.flatnonzero(path.radius[seg] > 0)
-    if curved.size == 0:
-        return out, coef
+    curved_all = np.flatnonzero(path.radius[seg] > 0)
     g = np.zeros(N) if gamma is None else np.asarray(gamma, dtype=np.float64)
+    bg = None if b_guess is None else np.maximum(np.asarray(b_guess, dtype=np.float64), 0.0)
+    # in chunks of intervals (a dozen (chunk, n) temporaries each)
+    for lo in range(0, curved_all.size, _MARGIN_CHUNK):
+        curved = curved_all[lo:lo + _MARGIN_CHUNK]
+        out[curved], coef[curved] = _curved_margins(path, lim, grid, curved, dq0, ddq0, dq1,
+                                                    ddq1, cap, g, bg)
+    return out, coef
+
+
+#: Intervals per chunk of :func:`interior_margins` (bounds its temporaries).
+_MARGIN_CHUNK = 1 << 16
+
+
+def _curved_margins(path, lim, grid, curved, dq0, ddq0, dq1, ddq1, cap, g, bg):
+    """:func:`interior_margins` on the curved intervals ``curved``: ``(m0, mc)`` rows."""
+    seg = grid.segment
     sa = seg[curved]
     r, w = path.radius[sa], np.abs(path.omega[sa])
     plane = np.sqrt(path.e1[sa] ** 2 + path.e2[sa] ** 2)             # (K, n)
@@ -709,8 +722,7 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
     gd = np.abs(g[curved]) * D
     m = (rho[:, None] * (A + C * (gd / 2.0)[:, None]) + (D * gd / 2.0)[:, None] * k2)
     mc = rho[:, None] * C
-    if b_guess is not None and np.any(g[curved]):
-        bg = np.maximum(np.asarray(b_guess, dtype=np.float64), 0.0)
+    if bg is not None and np.any(g[curved]):
         blo = np.minimum(bg[curved], bg[curved + 1])
         with np.errstate(divide="ignore", invalid="ignore"):
             fit = np.where(g[curved] != 0, np.abs(g[curved]) * abar * D * D
@@ -728,28 +740,50 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
                                                        + k4[spiral] * bbar[:, None])
         mc[spiral] = 0.0
     big = ~np.isfinite(m) | (rho >= 0.5)[:, None]
-    out[curved] = np.where(big, 0.5 * A, np.minimum(m, 0.5 * A))
-    coef[curved] = np.where(big, 0.0, mc)
-    return out, coef
+    return np.where(big, 0.5 * A, np.minimum(m, 0.5 * A)), np.where(big, 0.0, mc)
 
 
-def _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, kind,
-              gamma=None):
+class RowWriter:
+    """The row columns of a discrete problem, written into arrays sized up front.
+
+    The rows are the largest arrays of a round (a few hundred bytes per interval), so
+    they are written in place instead of being collected as columns and copied.
+
+    Parameters
+    ----------
+    n_intervals : int
+        ``N``.
+    n_rows : int
+        ``R``, the number of columns that will be written (exactly).
+    """
+
+    def __init__(self, n_intervals: int, n_rows: int) -> None:
+        self.c1 = np.zeros((n_intervals, n_rows))
+        self.c2 = np.zeros((n_intervals, n_rows))
+        self.h = np.zeros((n_intervals, n_rows))
+        self.axis = np.zeros(n_rows, dtype=np.int64)
+        self.n = 0
+
+    def append(self, c1: np.ndarray, c2: np.ndarray, h: np.ndarray, axis: int) -> None:
+        """Write the next column."""
+        r = self.n
+        self.c1[:, r] = c1
+        self.c2[:, r] = c2
+        self.h[:, r] = h
+        self.axis[r] = axis
+        self.n = r + 1
+
+    def last(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Views of the last column written (to be replaced in place)."""
+        r = self.n - 1
+        return self.c1[:, r], self.c2[:, r], self.h[:, r]
+
+
+def _assemble(path, lim, grid, caps, rows: RowWriter, kind, gamma=None):
     N = grid.n_intervals
-    if cols_c1:
-        # column by column into one array each, releasing every column as it is copied
-        # (the rows are the largest arrays of a round)
-        out = []
-        for cols in (cols_c1, cols_c2, cols_h):
-            arr = np.empty((N, len(cols)))
-            for r in range(len(cols)):
-                arr[:, r] = cols[r]
-                cols[r] = None
-            cols.clear()
-            out.append(arr)
-        c1, c2, h = out
-    else:
-        c1 = c2 = h = np.zeros((N, 0))
+    if rows.n != rows.c1.shape[1]:
+        raise InternalError(f"{rows.n} row columns written, {rows.c1.shape[1]} sized")
+    c1, c2, h, row_axis = rows.c1, rows.c2, rows.h, rows.axis
     # rows with both coefficients <= 0 can never bind (b >= 0, h >= 0): blank them
     vac = (c1 <= 0) & (c2 <= 0)
     c1[vac] = 0.0
@@ -761,6 +795,6 @@ def _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, kind,
                               "(no axis moves there)", int(path.block[grid.segment[
                                   min(k, N - 1)]]))
     return DiscreteProblem(s=grid.s, cap=caps.cap, c1=c1, c2=c2, h=h, segment=grid.segment,
-                           row_axis=np.asarray(row_axis, dtype=np.int64),
+                           row_axis=row_axis,
                            cap_code=caps.code, cap_axis=caps.axis, axes=path.axes,
                            accel_scale=float(np.max(lim.a_max)), kind=kind, gamma=gamma)

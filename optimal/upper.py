@@ -152,63 +152,69 @@ def grid_profile(s: np.ndarray, b: np.ndarray, block: np.ndarray,
     Y = D - v[:-1] * h
     a = np.where(g == 0, X / h, (6.0 * Y - 2.0 * X * h) / (h * h))
     j = np.where(g == 0, 0.0, 2.0 * (X - a * h) / (h * h))
-    on = tents.on if tents is not None else np.zeros(N, bool)
-    if not np.any(on):
+    del X, Y
+    line = np.flatnonzero(tents.on) if tents is not None else np.zeros(0, np.int64)
+    if line.size == 0:
         t = np.concatenate(([0.0], np.cumsum(h)))
         return Profile(t=t, s=s, v=v, a=a, j=j, block=block)
-    # ---- lines: three pieces (accelerate, cruise, brake) of lengths l1, l2, l3
-    M = np.where(on, tents.slope, 1.0)
-    cap = np.where(on, np.maximum(tents.cap, np.maximum(b[:-1], b[1:])), 1.0)
-    b0, b1 = b[:-1], b[1:]
-    l1 = np.clip((cap - b0) / M, 0.0, D)
-    l3 = np.clip((cap - b1) / M, 0.0, D)
-    meet = l1 + l3 > D                       # no cruise: the two ramps meet at a peak
-    lp = np.clip((b1 - b0 + M * D) / (2.0 * M), 0.0, D)
+    # ---- line intervals: three pieces (accelerate, cruise, brake) of lengths l1, l2, l3
+    Dl, b0, b1 = D[line], b[line], b[line + 1]
+    M = tents.slope[line]
+    cap = np.maximum(tents.cap[line], np.maximum(b0, b1))
+    l1 = np.clip((cap - b0) / M, 0.0, Dl)
+    l3 = np.clip((cap - b1) / M, 0.0, Dl)
+    meet = l1 + l3 > Dl                      # no cruise: the two ramps meet at a peak
+    lp = np.clip((b1 - b0 + M * Dl) / (2.0 * M), 0.0, Dl)
     l1 = np.where(meet, lp, l1)
-    l3 = np.where(meet, D - lp, l3)
+    l3 = np.where(meet, Dl - lp, l3)
     # pieces shorter than round-off of the interval are none (a ramp of 1e-17 mm would
-    # carry an acceleration made of round-off): give their length to the cruise/peak
-    tiny = 1e-9 * D
+    # carry an acceleration made of round-off): their length goes to the neighbour
+    tiny = 1e-9 * Dl
     l1 = np.where(l1 < tiny, 0.0, l1)
     l3 = np.where(l3 < tiny, 0.0, l3)
-    l3 = np.where(meet & (l3 == 0.0), 0.0, l3)
-    l1 = np.where(meet & (D - l1 - l3 < tiny), D - l3, l1)
-    l2 = np.maximum(D - l1 - l3, 0.0)
+    l2 = Dl - l1 - l3
     l2 = np.where(l2 < tiny, 0.0, l2)
-    l1 = np.where(on & (l2 == 0.0) & (l1 > 0), D - l3, l1)
-    bp = np.minimum(cap, b0 + M * l1)        # speed^2 at the peak or while cruising
-    vp = np.sqrt(bp)
-    # pieces (K = 3 N before dropping empty ones): lengths, start/end speeds, accel
-    P = np.stack([np.where(on, l1, D), np.where(on, l2, 0.0), np.where(on, l3, 0.0)], 1)
-    V0 = np.stack([v[:-1], vp, vp], 1)
-    V1 = np.stack([np.where(on, vp, v[1:]), vp, v[1:]], 1)
-    acc = np.stack([np.where(on, M / 2.0, a), np.zeros(N), np.where(on, -M / 2.0, 0.0)], 1)
-    jer = np.stack([np.where(on, 0.0, j), np.zeros(N), np.zeros(N)], 1)
+    l1 = np.where((l2 == 0.0) & (l1 > 0), Dl - l3, l1)
+    l3 = np.where((l2 == 0.0) & (l1 == 0), Dl, l3)
+    vp = np.sqrt(np.minimum(cap, b0 + M * l1))     # speed at the peak or while cruising
+    P = np.stack([l1, l2, l3], 1)                  # (L, 3) piece lengths
+    V0 = np.stack([v[line], vp, vp], 1)
+    V1 = np.stack([vp, vp, v[line + 1]], 1)
     keep = P > 0
-    keep[:, 0] |= ~on                        # the one piece of a non-line interval
     with np.errstate(divide="ignore", invalid="ignore"):
-        dur = np.where(on[:, None], np.where(V0 + V1 > 0, 2.0 * P / (V0 + V1), np.inf),
-                       np.stack([h, np.zeros(N), np.zeros(N)], 1))
-    if not np.all(np.isfinite(dur[keep])):
-        k = int(np.flatnonzero(~np.all(np.isfinite(np.where(keep, dur, 0.0)), axis=1))[0])
+        dur = np.where(keep, 2.0 * P / (V0 + V1), 0.0)
+    if not np.all(np.isfinite(dur)):
+        k = int(line[np.flatnonzero(~np.all(np.isfinite(dur), axis=1))[0]])
         raise InternalError(f"grid profile: interval {k} is never traversed "
                             f"(b = {b[k]:.6g}, {b[k + 1]:.6g} mm^2/s^2)")
     # a ramp's acceleration from its end speeds (consistent with the knots), never above
-    # the tent's own M / 2 in size (round-off)
-    ramp = on[:, None] & (np.arange(3)[None, :] != 1) & keep
-    a_ramp = np.clip((V1 - V0) / np.where(dur > 0, dur, 1.0), -M[:, None] / 2.0,
-                     M[:, None] / 2.0)
-    acc = np.where(ramp, a_ramp, acc)
-    kk = keep.ravel()
-    L = P.ravel()[kk]
-    knots_s = np.concatenate(([s[0]], s[0] + np.cumsum(L)))
-    # snap every interval's end to its node (round-off of the running sum)
-    last = np.cumsum(keep.sum(axis=1))
-    knots_s[last] = s[1:]
-    t = np.concatenate(([0.0], np.cumsum(dur.ravel()[kk])))
-    vk = np.concatenate(([v[0]], V1.ravel()[kk]))
-    return Profile(t=t, s=knots_s, v=vk, a=acc.ravel()[kk], j=jer.ravel()[kk],
-                   block=np.repeat(np.asarray(block), 3)[kk])
+    # the tent's own M / 2 in size (round-off); cruising: 0
+    half = (M / 2.0)[:, None]
+    acc = np.where(keep, np.clip((V1 - V0) / np.where(dur > 0, dur, 1.0), -half, half), 0.0)
+    acc[:, 1] = 0.0
+    del V0, half
+    # ---- assemble: every interval's pieces in order (1 off lines, 1 to 3 on lines)
+    count = np.ones(N, dtype=np.int64)
+    count[line] = keep.sum(axis=1)
+    first = np.concatenate(([0], np.cumsum(count)[:-1]))
+    K = int(count.sum())
+    pl = np.empty(K)                  # piece lengths
+    pd = np.empty(K)                  # durations
+    pa = np.empty(K)
+    pj = np.zeros(K)
+    pv = np.empty(K)                  # speed at each piece's end
+    other = np.ones(N, bool)
+    other[line] = False
+    io = first[other]
+    pl[io], pd[io], pa[io], pj[io], pv[io] = D[other], h[other], a[other], j[other], v[1:][other]
+    rank = np.cumsum(keep, axis=1) - 1             # position of a kept piece in its interval
+    idx = (first[line][:, None] + rank)[keep]
+    pl[idx], pd[idx], pa[idx], pv[idx] = P[keep], dur[keep], acc[keep], V1[keep]
+    knots_s = np.concatenate(([s[0]], s[0] + np.cumsum(pl)))
+    knots_s[first + count] = s[1:]                 # each interval ends at its node exactly
+    t = np.concatenate(([0.0], np.cumsum(pd)))
+    return Profile(t=t, s=knots_s, v=np.concatenate(([v[0]], pv)), a=pa, j=pj,
+                   block=np.repeat(np.asarray(block), count))
 
 
 def verified_profile(path: Path, limits: MachineLimits, s: np.ndarray, b: np.ndarray,
