@@ -54,7 +54,8 @@ _MACHINE_KEYS: dict[str, _Key] = {
 _CHANNEL_KEYS: dict[str, _Key] = {
     "SMOOTHING_MODE": _Key(int, "", -1, 99999, "MD20480 decimal digit map"),
     "IGNORE_OVL_FACTOR_FOR_ADIS": _Key(bool, "", doc="MD20490"),
-    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0, "MD20460"),
+    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0,
+                                  "MD20460 (0 selects the internal 100 %)"),
     "ADAPT_PATH_DYNAMIC": _Key(list, "", doc="MD20465 [BRISK, SOFT], each >= 1"),
     "lookahead_blocks": _Key(int, "blocks", 0, 100000, "LookAhead horizon"),
     "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465", 1e-6),
@@ -140,7 +141,11 @@ class ChannelSettings:
     ignore_ovl_factor_for_adis : bool
         MD20490.
     lookahead_smooth_factor_pct : float
-        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss (0 = smoothing off here).
+        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss, as given. 0 (also the value
+        when the key is missing) selects the control's internal 100 %: "a smoothing
+        factor other than 0% prevents the default value of 100% from being used" (B1
+        excerpt; :func:`reference.planner.smoothing.effective_factor`). A small value
+        such as 1 % switches the smoothing practically off.
     adapt_path_dynamic : tuple[float, float]
         MD20465 ADAPT_PATH_DYNAMIC for [BRISK, SOFT]; 1.0 = off.
     lookahead_blocks : int

@@ -43,7 +43,7 @@ from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
                        unit_profiles)
 from .result import (BlockTable, CornerRow, CornerTable, ReferencePlan,
                      TraceEntry)
-from .smoothing import smooth_velocity
+from .smoothing import effective_factor, smooth_velocity
 from .stops import ACCEL_MODES, SegmentModes, segment_modes
 
 Progress = Callable[[str, float], None]
@@ -165,15 +165,16 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     trace.append(("profiles", _case_counts(prof, units)))
 
     report_progress("smoothing", 0.6)
-    if ch.lookahead_smooth_factor_pct > 0:
-        sm = smooth_velocity(units, speeds, prof, ch.lookahead_smooth_factor_pct,
-                             params.smoothing_rounds, _replan)
-        units, speeds, prof = sm.units, sm.speeds, sm.profiles
-        trace.append(("smoothing", f"LOOKAH_SMOOTH_FACTOR {ch.lookahead_smooth_factor_pct:g} "
-                                   f"%: {sm.n_bumps} bumps removed, moving time "
-                                   f"{sm.time_before:.6g} s -> {sm.time_after:.6g} s"))
-    else:
-        trace.append(("smoothing", "off (LOOKAH_SMOOTH_FACTOR = 0)"))
+    factor = effective_factor(ch.lookahead_smooth_factor_pct)
+    sm = smooth_velocity(units, speeds, prof, factor, params.smoothing_rounds, _replan)
+    units, speeds, prof = sm.units, sm.speeds, sm.profiles
+    md = ch.lookahead_smooth_factor_pct
+    trace.append(("smoothing", f"LOOKAH_SMOOTH_FACTOR {md:g} %"
+                               + (f" (0 selects the internal {factor:g} %)" if md <= 0 else "")
+                               + (": smoothing_rounds = 0, none removed (bare LookAhead)"
+                                  if params.smoothing_rounds == 0 else
+                                  f": {sm.n_bumps} bumps removed, moving time "
+                                  f"{sm.time_before:.6g} s -> {sm.time_after:.6g} s")))
 
     report_progress("adaptation", 0.7)
     adapt = tuple(ch.adapt_path_dynamic)

@@ -20,9 +20,13 @@ Model [I]:
 Each capped bump costs at most ``factor`` % of its own time, so the whole program slows
 down by at most ``factor`` %: 1 % is "practically off", as the manual's example says.
 
-The value 0: the manual's excerpt suggests that 0 makes the control use an internal
-100 %; this project's machine data (DESIGN section 3) defines 0 as "smoothing off", and
-the model follows the project. Set 100 for full smoothing.
+The value 0 (:func:`effective_factor`): the B1 excerpt on dynamic response adaptation
+(Function Manual 11/2006, example 1, note) says "A smoothing factor other than 0%
+prevents the default value of 100% from being used to smooth the path velocity", and
+sets 1.0 % to "practically deactivate" the smoothing. So 0 selects the control's internal
+100 % (model note 7.3: "treat 0 as 'use 100 %'"), and there is no exact "off": a small
+factor is the manual's way to switch smoothing practically off, and by the bound above
+it slows the program by at most that many percent.
 """
 
 from __future__ import annotations
@@ -36,6 +40,30 @@ from . import causes as C
 from .lookahead import NodeSpeeds, Units
 from .parameters import CAUSE_REL_TOL
 from .profiles import UnitProfiles
+
+
+#: The smoothing factor, %, the control uses when MD20460 LOOKAH_SMOOTH_FACTOR is 0 (the
+#: B1 note: "a smoothing factor other than 0% prevents the default value of 100% from
+#: being used").
+INTERNAL_DEFAULT_FACTOR_PCT = 100.0
+
+
+def effective_factor(md_value_pct: float) -> float:
+    """The smoothing factor in effect for a value of MD20460 LOOKAH_SMOOTH_FACTOR.
+
+    Parameters
+    ----------
+    md_value_pct : float
+        The machine-data value, % (>= 0).
+
+    Returns
+    -------
+    float
+        ``md_value_pct``, or :data:`INTERNAL_DEFAULT_FACTOR_PCT` (100 %) for 0: "a
+        smoothing factor other than 0% prevents the default value of 100% from being
+        used to smooth the path velocity" (B1 excerpt, note to example 1).
+    """
+    return INTERNAL_DEFAULT_FACTOR_PCT if md_value_pct <= 0.0 else float(md_value_pct)
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,9 +139,10 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     speeds : NodeSpeeds
     prof : UnitProfiles
     factor_pct : float
-        LOOKAH_SMOOTH_FACTOR, % (0 = off).
+        The factor in effect, % (:func:`effective_factor` of LOOKAH_SMOOTH_FACTOR;
+        a value <= 0 plans no smoothing, for callers that want the bare LookAhead).
     rounds : int
-        Rounds of bump removal.
+        Rounds of bump removal (0: none).
     replan : callable
         ``replan(units_subset_index -> ...)``: given ``(units, idx, v_nodes)`` returns the
         unit profiles of units ``idx`` with entry ``v_nodes[idx]`` and exit
@@ -125,10 +154,10 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     """
     t0 = float(prof.time.sum())
     n_bumps = 0
-    if factor_pct <= 0.0 or units.n_units == 0:
+    if factor_pct <= 0.0 or rounds <= 0 or units.n_units == 0:
         return SmoothingResult(units, speeds, prof, 0, t0, t0)
     v = speeds.v.copy()
-    for _ in range(max(rounds, 1)):
+    for _ in range(rounds):
         valleys = find_valleys(prof)
         if valleys.size < 2:
             break
