@@ -8,8 +8,14 @@ as AX2 moves). No contour error results: only the speed changes.
 
 Model [I]:
 
-* A bump is the stretch between two consecutive *valleys* of the planned speed (nodes
-  where the speed stops falling and starts rising; program start and end count).
+* A bump is the stretch between two consecutive *valleys* of the planned speed: nodes
+  where the descent from a peak ends or the ascent to one starts. A constant-speed
+  stretch (a cruise) ends a descent and starts an ascent like a dip does, so a node
+  counts when the speed just before it falls or stays level and just after it rises, or
+  just before it falls and just after it stays level or rises (program start and end
+  count). A short rise and fall between two stretches at constant speed is a bump of
+  its own (``G1 X50 F3000 / X51 F6000 / X101 F3000``); a plateau at the top of a bump
+  (level on both sides of a node) is no valley, so the bump keeps its plateau.
 * Candidate: cap the bump at ``v_flat = max(v_left_valley, v_right_valley)``; this keeps
   every pair of node speeds joinable (lower speeds never lengthen a ramp).
 * Accept the candidate when the bump is shorter than ``1/f`` and the time it costs is at
@@ -38,7 +44,7 @@ import numpy as np
 
 from . import causes as C
 from .lookahead import NodeSpeeds, Units
-from .parameters import CAUSE_REL_TOL
+from .parameters import CAUSE_REL_TOL, DISTANCE_REL_TOL
 from .profiles import UnitProfiles
 
 
@@ -99,8 +105,19 @@ def _moves(prof: UnitProfiles):
     return rise, fall
 
 
+#: Direction of the speed: falling, level, rising.
+_FALL, _LEVEL, _RISE = -1, 0, 1
+
+
 def find_valleys(prof: UnitProfiles) -> np.ndarray:
-    """Node indices where the speed stops falling and starts rising (ends included).
+    """Nodes where a descent ends or an ascent starts (the bump boundaries).
+
+    A unit's profile is rise, cruise, fall, so the speed just after its entry node
+    rises (a rise), stays level (a cruise) or falls, and just before its exit node falls,
+    stays level or rises. Node ``k`` is a valley when the speed just before it falls or
+    stays level and just after it rises or stays level, except level on both sides (a
+    plateau, e.g. the top of a bump spread over several units, is not cut). Program
+    start and end count as level outside.
 
     Parameters
     ----------
@@ -112,19 +129,18 @@ def find_valleys(prof: UnitProfiles) -> np.ndarray:
     numpy.ndarray of int
         Sorted node indices in ``[0, u]``.
     """
-    u = prof.v_peak.size
     rise, fall = _moves(prof)
-    last = np.where(fall, -1, np.where(rise, 1, 0))     # last move inside unit
-    first = np.where(rise, 1, np.where(fall, -1, 0))    # first move inside unit
-    # last move before node k (units < k), forward-filled over flat units
-    idx = np.where(last != 0, np.arange(u), -1)
-    ff = np.maximum.accumulate(idx) if u else idx
-    before = np.concatenate(([0], np.where(ff >= 0, last[np.maximum(ff, 0)], 0)))
-    # first move after node k (units >= k), backward-filled
-    idx2 = np.where(first != 0, np.arange(u), u)
-    bf = np.minimum.accumulate(idx2[::-1])[::-1] if u else idx2
-    after = np.concatenate((np.where(bf < u, first[np.minimum(bf, max(u - 1, 0))], 0), [0]))
-    return np.flatnonzero((before <= 0) & (after >= 0))
+    length = prof.dist_rise + prof.dist_cruise + prof.dist_fall
+    # a cruise shorter than the profiles' round-off is no constant-speed stretch
+    cruise = prof.dist_cruise > DISTANCE_REL_TOL * np.maximum(length, 1.0)
+    last = np.where(fall, _FALL, np.where(cruise | ~rise, _LEVEL, _RISE))   # into exit node
+    first = np.where(rise, _RISE, np.where(cruise | ~fall, _LEVEL, _FALL))  # out of entry
+    before = np.concatenate(([_LEVEL], last))
+    after = np.concatenate((first, [_LEVEL]))
+    valley = (before <= _LEVEL) & (after >= _LEVEL) & ~((before == _LEVEL)
+                                                        & (after == _LEVEL))
+    valley[[0, -1]] = True          # the program starts and ends at rest
+    return np.flatnonzero(valley)
 
 
 def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,

@@ -84,6 +84,28 @@ TWO_BUMPS = ("G90 G64 BRISK\nG1 X50 F3000\nX50.4 F6000\nX100.4 F3000\nX100.8 F60
              "X150.8 F3000\nM30\n")
 
 
+@pytest.mark.parametrize("name", MACHINES)
+def test_factor_zero_plans_like_100_and_one_percent_keeps_the_bumps(name):
+    """The same note: 0 smooths like 100 %, while the example's 1.0 % leaves the
+    smoothing "practically deactivated". Closed forms (BRISK, A = MAX_AX_ACCEL of X,
+    bumps at v = 50 mm/s, L = 0.4 mm): peak ``sqrt(v^2 + A L)``, bump time
+    ``2 (vp - v)/A``; smoothed, the program is one trapezoid ``150.8/v + v/A``."""
+    zero = run(TWO_BUMPS, bundled(name, {"LOOKAH_SMOOTH_FACTOR": 0.0}))
+    full = run(TWO_BUMPS, bundled(name, {"LOOKAH_SMOOTH_FACTOR": 100.0}))
+    one = run(TWO_BUMPS, bundled(name, {"LOOKAH_SMOOTH_FACTOR": 1.0}))
+    A, _ = x_limits(bundled(name))
+    v, L = 50.0, 0.4
+    vp = math.sqrt(v * v + A * L)
+    t_bump = 2 * (vp - v) / A
+    smoothed = 150.8 / v + v / A
+    assert zero.time_s == pytest.approx(smoothed, rel=1e-12)
+    assert full.time_s == zero.time_s
+    assert one.time_s == pytest.approx(smoothed - 2 * (L / v - t_bump), rel=1e-12)
+    assert "0 selects the internal 100 %" in dict(zero.trace)["smoothing"]
+    for p in (zero, one):
+        assert_ok(p)
+
+
 def test_bundled_machines_state_their_smoothing_factor():
     """The bundled machines say what they mean: the SINUMERIK-like mill keeps the
     control's default (100 %, which 0 would select too), the LinuxCNC machine, whose
@@ -111,3 +133,118 @@ def test_bare_lookahead_knob_removes_no_bump():
     t_bump = 2 * (math.sqrt(v * v + A * L) - v) / A
     assert bare.time_s == pytest.approx(150.8 / v + v / A - 2 * (L / v - t_bump), rel=1e-12)
     assert "none removed" in dict(bare.trace)["smoothing"]
+
+
+# ======================================================================= 2. plateaus
+def _brisk_cases(A: float, v: float = 50.0) -> dict[str, tuple[str, float, float, float]]:
+    """Program, time without and with the bump removed, and the bump's (time, flat time)
+    for each case, BRISK with acceleration ``A`` (mm/s^2), plateau speed ``v`` = F3000.
+
+    Returns ``{name: (program, t_kept, t_removed, t_bump, t_flat)}``; ``t_bump = nan``
+    when the LookAhead leaves no bump at all (the speed cannot reach the plateau speed
+    and come back within the block).
+    """
+    out = {}
+    # the issue's program: a 1 mm block at F6000 between stretches at F3000
+    vp = math.sqrt(v * v + A * 1.0)
+    tb, tf = 2 * (vp - v) / A, 1.0 / v
+    removed = 101 / v + v / A
+    out["issue"] = ("G1 X50 F3000\nX51 F6000\nX101 F3000", removed - tf + tb, removed, tb, tf)
+    # two 0.4 mm bumps
+    vp = math.sqrt(v * v + A * 0.4)
+    tb, tf = 2 * (vp - v) / A, 0.4 / v
+    removed = 150.8 / v + v / A
+    out["two bumps"] = ("G1 X50 F3000\nX50.4 F6000\nX100.4 F3000\nX100.8 F6000\nX150.8 F3000",
+                        removed - 2 * (tf - tb), removed, tb, tf)
+    # a bump at the program start (from rest) and at the end (to rest): 1 mm at F6000;
+    # the bump exists when the plateau speed is reachable within the block
+    removed = 51 / v + v / A
+    if 2 * A * 1.0 > v * v:
+        vp = math.sqrt((2 * A * 1.0 + v * v) / 2)
+        tb = vp / A + (vp - v) / A
+        tf = v / A + (1.0 - v * v / (2 * A)) / v      # capped: ramp to v, then cruise
+    else:
+        tb = tf = math.nan
+    kept = removed - tf + tb if tb == tb else removed
+    out["at start"] = ("G1 X1 F6000\nX51 F3000", kept, removed, tb, tf)
+    out["at end"] = ("G1 X50 F3000\nX51 F6000", kept, removed, tb, tf)
+    # beside a dwell: the bump falls to rest at the dwell, then a rest-to-rest 50 mm
+    after = 0.5 + 50 / v + v / A
+    out["beside a dwell"] = ("G1 X50 F3000\nX51 F6000\nG4 F0.5\nX101 F3000",
+                             kept + after, removed + after, tb, tf)
+    # a bump whose top is a plateau over two blocks (F3660 over 2 x 0.25 mm between
+    # stretches at F3600): one bump, not two halves cut at the plateau
+    v2, vt = 60.0, 61.0
+    d_ramp = (vt * vt - v2 * v2) / (2 * A)
+    tb = 2 * (vt - v2) / A + (0.5 - 2 * d_ramp) / vt
+    tf = 0.5 / v2
+    removed = 100.5 / v2 + v2 / A
+    out["plateau top"] = ("G1 X50 F3600\nX50.25 F3660\nX50.5 F3660\nX100.5 F3600",
+                          removed - tf + tb, removed, tb, tf)
+    return out
+
+
+CASES = ("issue", "two bumps", "at start", "at end", "beside a dwell", "plateau top")
+
+
+@pytest.mark.parametrize("name", MACHINES)
+@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("factor", [1.0, 100.0])
+def test_bump_beside_a_constant_speed_stretch(name, case, factor):
+    """Model note 7.3: "Acceleration processes that contribute less than this factor to
+    a shorter run time are not executed. Only accelerations whose frequency lies above
+    the limit frequencies MD32440 LOOKAH_FREQUENCY of the axes involved are considered";
+    the bump "(rise from v_a, peak v_p, fall to v_b)" is capped at ``max(v_a, v_b)``. A
+    stretch at constant speed bounds a bump like a dip does: ``G1 X50 F3000 / X51 F6000
+    / X101 F3000`` rises and falls for 17 ms on the default machine (BRISK), below its
+    1/f = 50 ms, and costs 17 % to flatten, so 100 % removes it and 1 % keeps it. On the
+    LinuxCNC machine (100 Hz) the same bump lasts 18.7 ms > 10 ms and stays.
+
+    Expected times are closed-form trapezoids (:func:`_brisk_cases`); the decision is
+    ``t_bump < 1/f`` and ``t_flat - t_bump <= factor % * t_bump``.
+    """
+    m = bundled(name, {"LOOKAH_SMOOTH_FACTOR": factor})
+    A, t_f = x_limits(m)
+    text, kept, removed, tb, tf = _brisk_cases(A)[case]
+    p = run(f"G90 G64 BRISK\n{text}\nM30\n", m)
+    if tb != tb:                  # no bump at all: the speed never exceeds the plateau
+        assert p.time_s == pytest.approx(removed, rel=1e-12)
+        return
+    remove = tb < t_f and tf - tb <= factor / 100.0 * tb
+    assert p.time_s == pytest.approx(removed if remove else kept, rel=1e-12)
+    assert_ok(p)
+
+
+def test_the_issue_bump_is_decided_as_the_numbers_say():
+    """The numbers quoted in the issue, hand-computed: on the default machine the bump of
+    ``G1 X50 F3000 / X51 F6000 / X101 F3000`` (BRISK) peaks at sqrt(50^2 + 2000) =
+    67.08 mm/s and lasts 17.08 ms; flat it takes 20 ms."""
+    m = bundled("default", {"LOOKAH_SMOOTH_FACTOR": 100.0})
+    p = run("G90 G64 BRISK\nG1 X50 F3000\nX51 F6000\nX101 F3000\nM30\n", m)
+    bump = p.blocks[2]
+    assert bump.time_s == pytest.approx(0.020, rel=1e-12)
+    assert bump.v_peak == pytest.approx(50.0, rel=1e-12)
+    assert bump.cause == "frequency"
+    keep = run("G90 G64 BRISK\nG1 X50 F3000\nX51 F6000\nX101 F3000\nM30\n",
+               bundled("default", {"LOOKAH_SMOOTH_FACTOR": 1.0}))
+    assert keep.blocks[2].v_peak == pytest.approx(math.sqrt(4500.0), rel=1e-12)
+    assert keep.blocks[2].time_s == pytest.approx(2 * (math.sqrt(4500) - 50) / 2000,
+                                                  rel=1e-12)
+
+
+def test_soft_bump_beside_a_constant_speed_stretch():
+    """The same under SOFT (default machine, J = 40 m/s^3): a 2 mm block at F6000
+    between stretches at F3000 is planned as its own unit (its reachable peak 53.7 mm/s
+    is more than 5 % above 50) and lasts 38.5 ms < 50 ms. Removed, the program is one
+    rest-to-rest S-curve at 50 mm/s < A^2/J = 100 mm/s (jerk-limited ramps):
+    ``T = L/v + 2 sqrt(v/J)``."""
+    text = "G90 G64 SOFT\nG1 X50 F3000\nX52 F6000\nX102 F3000\nM30\n"
+    full = run(text, bundled("default", {"LOOKAH_SMOOTH_FACTOR": 100.0}))
+    one = run(text, bundled("default", {"LOOKAH_SMOOTH_FACTOR": 1.0}))
+    J = 40000.0
+    assert full.time_s == pytest.approx(102 / 50 + 2 * math.sqrt(50 / J), rel=1e-12)
+    assert full.blocks[2].v_peak == pytest.approx(50.0, rel=1e-12)
+    assert one.blocks[2].v_peak > 53.0                 # 1 %: the bump stays
+    assert one.time_s < full.time_s
+    assert_ok(full)
+    assert_ok(one)
