@@ -248,3 +248,100 @@ def test_soft_bump_beside_a_constant_speed_stretch():
     assert one.time_s < full.time_s
     assert_ok(full)
     assert_ok(one)
+
+
+# ======================================================================= 3. geometry stop
+#: A rotary axis for the LinuxCNC machine, which has none (values as the default mill's
+#: A axis: 30 rev/min, 1 rev/s^2, 20 rev/s^3).
+ROTARY_A = {"type": "rotary", "MAX_AX_VELO": 30.0, "MAX_AX_ACCEL": 1.0, "MAX_AX_JERK": 20.0,
+            "LOOKAH_FREQUENCY": 10.0}
+
+
+def with_rotary(name: str):
+    d = tomllib.loads(resources.files("reference.machines").joinpath(f"{name}.toml")
+                      .read_text())
+    d["axis"].setdefault("A", dict(ROTARY_A))
+    return machine_from_dict(d, f"<{name} + A>")
+
+
+def _rest_to_rest(L: float, v: float, A: float, J: float) -> float:
+    """Rest-to-rest time over ``L`` at cruise speed ``v`` (reached): trapezoid ``L/v +
+    v/A`` (J = inf), S-curve ``L/v + v/A + A/J`` if ``v >= A^2/J``, else ``L/v + 2
+    sqrt(v/J)``."""
+    if math.isinf(J):
+        return L / v + v / A
+    return L / v + (v / A + A / J if v >= A * A / J else 2 * math.sqrt(v / J))
+
+
+XAX = "G90 G64 F3000\nG1 X50\nA30\nX100\nM30\n"
+
+
+@pytest.mark.parametrize("name", MACHINES)
+def test_rotary_block_between_path_blocks_stops(name):
+    """Model note 5.2, group 1, "The axes stop between the blocks anyway: ... geometry
+    axes move in one block but not in the other": ``A30`` alone between two X blocks
+    rests at both transitions (a path stop, reason named, cause "forced stop"). Hand
+    numbers: three rest-to-rest moves at F3000 (50 mm/s, and 50 deg/s for A alone)."""
+    m = with_rotary(name)
+    p = run(XAX, m)
+    assert [c.v for c in p.corners] == [0.0, 0.0]
+    assert [c.cause for c in p.corners] == ["forced stop", "forced stop"]
+    assert p.path.stop_reason[1:3] == ("geometry axes move in one block only",) * 2
+    assert [b.stop_reason for b in p.path.blocks[1:3]] == [
+        "geometry axes move in one block only"] * 2
+    x, a = m.limits.axis("X"), m.limits.axis("A")
+    soft = p.bound_set == "jerk"
+    jx, ja = (x.j_max, a.j_max) if soft else (math.inf, math.inf)
+    expected = 2 * _rest_to_rest(50, 50, x.a_max, jx) + _rest_to_rest(30, 50, a.a_max, ja)
+    assert p.time_s == pytest.approx(expected, rel=1e-12)
+    assert_ok(p)
+
+
+@pytest.mark.parametrize("name", MACHINES)
+def test_the_oracle_obeys_the_geometry_stop(name):
+    """A path stop binds every planner (:mod:`reference.prepare`): the oracle rests there
+    too, so its time is at least the three rest-to-rest trapezoids (acc bounds:
+    ``L/v + v/A`` each) and it passes both transitions at zero speed."""
+    import numpy as np
+
+    from optimal import solve
+    from reference.prepare import build_path
+    m = with_rotary(name)
+    prog = parse_text(XAX, "t.mpf")
+    path = build_path(prog, m)
+    sol = solve(path, m.limits, "acc")
+    x, a = m.limits.axis("X"), m.limits.axis("A")
+    t_min = 2 * (50 / 50 + 50 / x.a_max) + 30 / 50 + 50 / a.a_max
+    assert sol.upper_bound_s >= t_min * (1 - 1e-9)
+    assert sol.lower_bound_s <= t_min * (1 + 1e-9)
+    t = sol.profile.time_at(path.s_breaks[1:3])
+    assert np.all(sol.profile.state(t)[1] == 0.0)
+
+
+@pytest.mark.parametrize("text, stops", [
+    ("G1 X10 A10\nA20\nX20\n", [True, True]),       # X+A, then A alone: geometry stops
+    ("G1 X10 A10\nX20\n", [False]),                 # geometry in both blocks: no stop
+    ("G1 A10\nB10\n", [False]),                     # geometry in neither block: no stop
+    ("G1 X10\nM8\nA10\n", [True]),                  # an idle block between names its stop
+])
+def test_geometry_stop_needs_geometry_in_exactly_one_block(text, stops):
+    """Model note 5.2: "geometry axes move in one block but not in the other"; the
+    reason a block states itself (an aux output block between) takes precedence."""
+    from reference.prepare import build_path
+    m = load_machine("default")
+    prog = parse_text("G90 G64 F3000\n" + text + "M30\n", "t.mpf")
+    path = build_path(prog, m)
+    assert [bool(s) for s in path.stop[1:-1]] == stops
+    if text.startswith("G1 X10\nM8"):
+        assert path.stop_reason[1].startswith("block without path motion")
+
+
+def test_ngc_programs_pass_the_rotary_transition():
+    """LinuxCNC blends into and out of a rotary-only move (its planner skips only the
+    blend arc and the tangency test there), so the rule is SINUMERIK's alone: the same
+    moves in NGC are passed without a path stop."""
+    from reference.prepare import build_path
+    m = with_rotary("linuxcnc_xyz")
+    prog = parse_text("G90 G64 F3000\nG1 X50\nG1 A30\nG1 X100\nM2\n", "t.ngc", "ngc")
+    path = build_path(prog, m)
+    assert not path.stop[1:3].any()
