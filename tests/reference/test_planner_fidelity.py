@@ -345,3 +345,184 @@ def test_ngc_programs_pass_the_rotary_transition():
     prog = parse_text("G90 G64 F3000\nG1 X50\nG1 A30\nG1 X100\nM2\n", "t.ngc", "ngc")
     path = build_path(prog, m)
     assert not path.stop[1:3].any()
+
+
+# ======================================================================= 4. DRIVE
+def drive_machine(name: str, sp: float, factor: float, kind: int = 0, axes=("X",),
+                  channel: dict | None = None):
+    """A bundled machine whose ``axes`` reduce their acceleration in DRIVE."""
+    red = {"ACCEL_REDUCTION_SPEED_POINT": sp, "ACCEL_REDUCTION_FACTOR": factor,
+           "ACCEL_TYPE_DRIVE": kind}
+    return bundled(name, channel, {ax: dict(red) for ax in axes})
+
+
+def knee_ramp(v: float, A: float, v_k: float, r: float) -> tuple[float, float]:
+    """(time, distance) of a DRIVE ramp from rest to ``v``: ``A`` up to ``v_k``, ``r A``
+    above (hand formulas: ``t = v_k/A + (v - v_k)/(r A)``, ``d = v_k^2/(2A) + (v^2 -
+    v_k^2)/(2 r A)``)."""
+    if v <= v_k:
+        return v / A, v * v / (2 * A)
+    return v_k / A + (v - v_k) / (r * A), v_k ** 2 / (2 * A) + (v * v - v_k ** 2) / (2 * r * A)
+
+
+# v = F/60 mm/s above the knee: default (v_max 500 mm/s), LinuxCNC (203.2 mm/s)
+DRIVE_CASES = {"default": (12000.0, 0.25), "linuxcnc_xyz": (6000.0, 0.25)}
+
+
+@pytest.mark.parametrize("name", MACHINES)
+def test_drive_constant_characteristic_rest_to_rest(name):
+    """Model note 6.1: "DRIVE / DRIVEA(axis): knee-shaped acceleration characteristic
+    above a velocity threshold ... v_red = ACCEL_REDUCTION_SPEED_POINT · MAX_AX_VELO,
+    a_red = (1 − ACCEL_REDUCTION_FACTOR) · MAX_AX_ACCEL ... constant: a(v) = a_red".
+    A rest-to-rest line in X at a feed above v_red: two ramps of ``v_red/A + (v -
+    v_red)/a_red`` and a cruise over the rest; BRISK (no knee) for comparison."""
+    F, sp = DRIVE_CASES[name]
+    m = drive_machine(name, sp, 0.5)
+    ax = m.limits.axis("X")
+    v, A, v_k = F / 60, ax.a_max, sp * ax.v_max
+    assert v > v_k
+    t_r, d_r = knee_ramp(v, A, v_k, 0.5)
+    L = 200.0
+    drive = run(f"G90 G64 DRIVE F{F:g}\nG1 X{L:g}\nM30\n", m)
+    brisk = run(f"G90 G64 BRISK F{F:g}\nG1 X{L:g}\nM30\n", m)
+    assert drive.time_s == pytest.approx(2 * t_r + (L - 2 * d_r) / v, rel=1e-12)
+    assert brisk.time_s == pytest.approx(L / v + v / A, rel=1e-12)
+    assert drive.blocks[1].mode == "DRIVE"
+    assert_ok(drive)
+    note = dict(drive.trace)["limit curves"]
+    assert "DRIVE: 1 of 1 segments above a knee" in note and "gap includes it" in note
+
+
+@pytest.mark.parametrize("name", MACHINES)
+@pytest.mark.parametrize("sp, factor", [(1.0, 0.5), (0.25, 0.0)])
+def test_drive_without_reduction_is_brisk(name, sp, factor):
+    """Model note 6.1: "No reduction is applied if SPEED_POINT = 1 or FACTOR = 0"."""
+    F, _ = DRIVE_CASES[name]
+    m = drive_machine(name, sp, factor)
+    drive = run(f"G90 G64 DRIVE F{F:g}\nG1 X200\nM30\n", m)
+    brisk = run(f"G90 G64 BRISK F{F:g}\nG1 X200\nM30\n", m)
+    assert drive.time_s == brisk.time_s
+    assert "none above a knee" in dict(drive.trace)["limit curves"]
+
+
+@pytest.mark.parametrize("name", MACHINES)
+def test_drive_ramp_limited_block_names_axis_acceleration(name):
+    """A block the speed rises through, across the knee, is limited by the (reduced)
+    acceleration: cause "axis acceleration" in the shared vocabulary. Hand numbers: the
+    block is 1 mm longer than the ramp to the knee, so it ends at ``sqrt(v_red^2 + 2
+    a_red 1 mm)`` after ``v_red/A + (v - v_red)/a_red``."""
+    F, sp = DRIVE_CASES[name]
+    m = drive_machine(name, sp, 0.5)
+    ax = m.limits.axis("X")
+    A, v_k = ax.a_max, sp * ax.v_max
+    _, d_k = knee_ramp(v_k, A, v_k, 0.5)
+    L1 = d_k + 1.0
+    v1 = math.sqrt(v_k ** 2 + 2 * 0.5 * A * 1.0)
+    assert v1 < F / 60
+    p = run(f"G90 G64 DRIVE F{F:g}\nG1 X{L1!r}\nX{L1 + 200!r}\nM30\n", m)
+    b = p.blocks[1]
+    assert b.v_exit == pytest.approx(v1, rel=1e-9)
+    assert b.time_s == pytest.approx(knee_ramp(v1, A, v_k, 0.5)[0], rel=1e-9)
+    assert b.cause == "axis acceleration"
+    assert_ok(p)
+
+
+@pytest.mark.parametrize("kind", [0, 1, 2])
+def test_characteristic_shapes(kind):
+    """Model note 6.1 (B2 2.18): the curves run from ``a_max`` at ``v_red`` to ``a_red``
+    at ``v_max``; constant ``a_red`` above ``v_red``; linear ``a_max − (a_max −
+    a_red)·(v − v_red)/(v_max − v_red)``; hyperbolic through the same two points (``c0 +
+    c1/v``), so that FACTOR = 0 reduces nothing as the note requires. Hand values at
+    ``v_max = 100``, ``v_red = 20``, FACTOR 0.5, ``v = 60``."""
+    from reference.planner.drive import acceleration_share
+    f = 0.5
+    share = lambda v: float(acceleration_share(v, 100.0, 0.2, f, kind))   # noqa: E731
+    assert share(20.0) == 1.0 and share(10.0) == 1.0
+    assert share(100.0) == pytest.approx(1 - f, rel=1e-12)
+    expected_60 = {0: 0.5, 2: 1 - f * 40 / 80,
+                   1: 1 - f * (100 / 80) * (1 - 20 / 60)}[kind]      # c0 + c1/v, normalised
+    assert share(60.0) == pytest.approx(expected_60, rel=1e-12)
+    assert float(acceleration_share(60.0, 100.0, 0.2, 0.0, kind)) == 1.0
+    assert float(acceleration_share(60.0, 100.0, 1.0, 0.5, kind)) == 1.0
+
+
+def test_most_restrictive_type_wins():
+    """B2 2.18.1.2 via note 6.1: "For the path, the most restrictive type among the path
+    axes wins (priority: constant, hyperbolic, linear, none)": X linear and Y constant
+    moving together both reduce as constant; X alone keeps its linear curve."""
+    import numpy as np
+
+    from reference.planner.drive import drive_reduction
+    moving = np.array([[True, True], [True, False]])
+    tangent = np.array([[0.7071, 0.7071], [1.0, 0.0]])
+    cap = np.array([100.0, 100.0])
+    v_max, sp, f = np.array([100.0, 100.0]), np.array([0.2, 0.2]), np.array([0.5, 0.5])
+    knee, share = drive_reduction(np.array([True, True]), moving, tangent, cap, v_max, sp,
+                                  f, np.array([2, 0]))
+    assert knee[0] == pytest.approx(20 / 0.7071) and knee[1] == pytest.approx(20.0)
+    assert share[0].tolist() == [0.5, 0.5]                      # both constant
+    assert share[1, 0] == pytest.approx(1 - 0.5 * (100 - 20) / 80)   # linear at 100 mm/s
+
+
+def test_drive_arc_centripetal_cap_uses_the_reduced_acceleration():
+    """Note 6.1 with 6.4 (centripetal ``v^2 |q''_i| <= share * A_i``): on a circle of
+    R = 10 mm in DRIVE the speed cap is ``sqrt(0.75 a_red R)`` once that is above the
+    knee (the axis speed at the cap is above ``v_red``): 86.6 mm/s instead of the BRISK
+    122.5 mm/s (default machine, A = 2 m/s^2, a_red = 1 m/s^2, v_red = 50 mm/s)."""
+    m = drive_machine("default", 0.1, 0.5, axes=("X", "Y"))
+    text = "G90 G64 {} F30000\nG1 X10\nG2 X10 Y0 I-10 J0\nG1 X0\nM30\n"
+    drive = run(text.format("DRIVE"), m)
+    brisk = run(text.format("BRISK"), m)
+    assert brisk.blocks[2].v_peak == pytest.approx(math.sqrt(0.75 * 2000 * 10), rel=1e-9)
+    assert drive.blocks[2].v_peak == pytest.approx(math.sqrt(0.75 * 1000 * 10), rel=1e-9)
+    assert drive.blocks[2].cause == "axis acceleration"
+    assert_ok(drive)
+
+
+@pytest.mark.parametrize("name, sp, F", [("default", 0.1, 4800.0),
+                                         ("linuxcnc_xyz", 0.02, 360.0)])
+def test_drive_adaptation_stretches_the_knee_ramp(name, sp, F):
+    """Note 7.4 (B1 excerpt: "The acceleration rates are reduced by a factor greater than
+    1 and less than the value written in machine data MD20465 ADAPT_PATH_DYNAMIC ... the
+    process lasts for t_adapt"): a DRIVE ramp across the knee shorter than 1/f is
+    stretched to 1/f by lowering both accelerations by ``lambda = t_adapt / T``; the
+    rest-to-rest time is ``2 t_adapt + (L - 2 lambda d)/v`` (ramp distance ``d`` grows
+    by ``lambda`` too)."""
+    excerpt_says("b1-840dsl-dynamic-adaptation.txt", "The acceleration rates are reduced "
+                 "by a factor greater than 1 and less than the value written in machine data")
+    m = drive_machine(name, sp, 0.2, channel={"ADAPT_PATH_DYNAMIC": [1.5, 1.0]})
+    ax = m.limits.axis("X")
+    v, A, v_k, t_adapt = F / 60, ax.a_max, sp * ax.v_max, 1 / ax.frequency_hz
+    t_r, d_r = knee_ramp(v, A, v_k, 0.8)
+    lam = t_adapt / t_r
+    assert v > v_k and 1.0 < lam < 1.5
+    L = 100.0
+    p = run(f"G90 G64 DRIVE F{F:g}\nG1 X{L:g}\nM30\n", m)
+    assert p.time_s == pytest.approx(2 * t_adapt + (L - 2 * lam * d_r) / v, rel=1e-9)
+    assert_ok(p)
+
+
+def test_drive_warning_names_the_line():
+    """The comparison stays honest: the oracle does not know DRIVE, so a program using it
+    is warned about (the gap includes the reduction)."""
+    from reference.prepare import unmodelled_features
+    w = unmodelled_features(parse_text("G90 G1 X1 F1000\nDRIVE\nX2\n", "t.mpf"))
+    (d,) = [x for x in w if "DRIVE" in x.message]
+    assert d.line == 2 and "the gap includes that reduction" in d.message
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("ACCEL_REDUCTION_SPEED_POINT", 0.0, r"ACCEL_REDUCTION_SPEED_POINT = 0\.0: must be > 0"),
+    ("ACCEL_REDUCTION_SPEED_POINT", 1.5, r"ACCEL_REDUCTION_SPEED_POINT = 1\.5: must be <= 1"),
+    ("ACCEL_REDUCTION_FACTOR", 1.0, r"ACCEL_REDUCTION_FACTOR = 1\.0: must be <= 0\.99"),
+    ("ACCEL_REDUCTION_FACTOR", -0.1, r"ACCEL_REDUCTION_FACTOR = -0\.1: must be >= 0"),
+    ("ACCEL_TYPE_DRIVE", 3, r"ACCEL_TYPE_DRIVE = 3: must be 0 \(constant\), 1 \(hyperbolic\)"),
+    ("ACCEL_TYPE_DRIVE", 1.0, r"ACCEL_TYPE_DRIVE = 1\.0: must be an integer"),
+    ("ACCEL_REDUCTION_SPEEDPOINT", 0.5, r"ACCEL_REDUCTION_SPEEDPOINT = 0\.5: unknown key "
+                                        r"\(did you mean ACCEL_REDUCTION_SPEED_POINT\?\)"),
+])
+def test_drive_machine_data_are_validated(key, value, message):
+    """Bad machine data name the key (DESIGN section 3)."""
+    from reference.core.errors import MachineDataError
+    with pytest.raises(MachineDataError, match=rf"axis\.X\.{message}"):
+        bundled("default", axes={"X": {key: value}})
