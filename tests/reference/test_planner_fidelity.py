@@ -107,11 +107,11 @@ def test_factor_zero_plans_like_100_and_one_percent_keeps_the_bumps(name):
 
 
 def test_bundled_machines_state_their_smoothing_factor():
-    """The bundled machines say what they mean: the SINUMERIK-like mill keeps the
-    control's default (100 %, which 0 would select too), the LinuxCNC machine, whose
-    planner does not smooth, uses the manual's "practically deactivated" 1.0 %; a file
-    without the key gets the control's default 0, i.e. 100 %."""
-    assert load_machine("default").channel.lookahead_smooth_factor_pct == 100.0
+    """The bundled machines say what they mean: both meant "no smoothing" (the mill's
+    0 was documented as "off"; LinuxCNC's planner does not smooth), which the machine
+    data can only say as the manual's "practically deactivated" 1.0 %; a file without the
+    key gets the control's 0, i.e. the internal 100 %."""
+    assert load_machine("default").channel.lookahead_smooth_factor_pct == 1.0
     assert load_machine("linuxcnc_xyz").channel.lookahead_smooth_factor_pct == 1.0
     d = tomllib.loads(resources.files("reference.machines").joinpath("default.toml")
                       .read_text())
