@@ -35,7 +35,6 @@ Stops that only the heuristic makes (a BRISK/SOFT change) belong to the referenc
 planner (:mod:`reference.planner.stops`), not to the path.
 """
 
-
 from __future__ import annotations
 
 from dataclasses import replace

@@ -13,8 +13,9 @@ Three steps, all O(n) in the number of segments:
    backward pass per block the stage computes one cap per break:
 
    - BRISK: ``z_k^2 = 2 sum_{i=k}^{k+N-1} A_i L_i`` (exact, a cumulative sum); a DRIVE
-     segment with a knee counts with its reduced acceleration (a lower cap: safe, exact
-     where the braking from the horizon starts above the knee);
+     segment with a knee counts with its acceleration above the knee all the way down
+     (a cumulative sum still; the cap is lower than the knee-shaped braking would give:
+     safe, never faster than the characteristic allows);
    - SOFT: one jerk-limited braking ramp from ``z_k`` to rest over the horizon distance
      with the weakest ``A``, ``J`` of the horizon (a sliding-window minimum).
 
