@@ -188,13 +188,20 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
             short = t_bump < 1.0 / f_bump
         # a bump between two standstills cannot be flattened (v_flat = 0)
         v_flat_all = np.maximum(v[a], v[b])
-        cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0))
+        # capped, no speed in the bump exceeds v_flat: it takes at least L / v_flat, so a
+        # bump whose bound already costs more than the factor is rejected unplanned
+        s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_low = (s_node[b] - s_node[a]) / v_flat_all
+        affordable = t_low - t_bump <= factor_pct / 100.0 * t_bump * (1.0 + 1e-9)
+        cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0) & affordable)
         if cand.size == 0:
             break
         v_flat = np.maximum(v[a[cand]], v[b[cand]])
         # units of the candidate bumps and their flat speed
         counts = b[cand] - a[cand]
-        uidx = np.concatenate([np.arange(x, y) for x, y in zip(a[cand], b[cand])])
+        first = np.cumsum(counts) - counts
+        uidx = np.arange(int(counts.sum())) + np.repeat(a[cand] - first, counts)
         vf_u = np.repeat(v_flat, counts)
         new_cap = np.minimum(units.cap[uidx], vf_u)
         v_new = v.copy()
