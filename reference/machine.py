@@ -54,7 +54,8 @@ _MACHINE_KEYS: dict[str, _Key] = {
 _CHANNEL_KEYS: dict[str, _Key] = {
     "SMOOTHING_MODE": _Key(int, "", -1, 99999, "MD20480 decimal digit map"),
     "IGNORE_OVL_FACTOR_FOR_ADIS": _Key(bool, "", doc="MD20490"),
-    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0, "MD20460"),
+    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0,
+                                  "MD20460 (0 selects the internal 100 %)"),
     "ADAPT_PATH_DYNAMIC": _Key(list, "", doc="MD20465 [BRISK, SOFT], each >= 1"),
     "lookahead_blocks": _Key(int, "blocks", 0, 100000, "LookAhead horizon"),
     "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465", 1e-6),
@@ -65,6 +66,11 @@ _CHANNEL_KEYS: dict[str, _Key] = {
     "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560", 1e-3),
     "rounding_length_clamp": _Key((int, float), "", 0.0, 0.5, "block-length clamp c", 1e-3),
 }
+
+#: Largest MD35230 ACCEL_REDUCTION_FACTOR: a_red = (1 - factor) MAX_AX_ACCEL must stay a
+#: real acceleration (1 would stop the axis from accelerating above the knee at all);
+#: a reduction to less than 1 % is a typing error, not a drive.
+_DRIVE_FACTOR_MAX = 0.99
 
 _AXIS_KEYS: dict[str, _Key] = {
     "type": _Key(str, "", doc="linear | rotary"),
@@ -85,6 +91,11 @@ _AXIS_KEYS: dict[str, _Key] = {
     "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433", 1e-3),
     "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434", 1e-3),
     "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435", 1e-3),
+    "ACCEL_REDUCTION_SPEED_POINT": _Key((int, float), "", 0.0, 1.0,
+                                        "MD35220: share of MAX_AX_VELO, 0..1", 1e-3),
+    "ACCEL_REDUCTION_FACTOR": _Key((int, float), "", -1e-12, _DRIVE_FACTOR_MAX,
+                                   "MD35230: a_red = (1 - factor) MAX_AX_ACCEL, 0..0.99"),
+    "ACCEL_TYPE_DRIVE": _Key(int, "", None, None, "MD35240: 0 constant, 1 hyperbolic, 2 linear"),
 }
 
 
@@ -116,6 +127,15 @@ class AxisSettings:
         exact-stop settle model (:mod:`reference.holds`). Default 0.
     soft_accel_factor, g00_accel_factor, g00_jerk_factor : float
         MD32433 / MD32434 / MD32435.
+    accel_reduction_speed_point : float
+        MD35220 ACCEL_REDUCTION_SPEED_POINT: DRIVE reduces the acceleration above this
+        share of MAX_AX_VELO (1 = never). Default 1.
+    accel_reduction_factor : float
+        MD35230 ACCEL_REDUCTION_FACTOR: ``a_red = (1 - factor) MAX_AX_ACCEL``
+        (0 = no reduction). Default 0.
+    accel_type_drive : int
+        MD35240 ACCEL_TYPE_DRIVE, the characteristic above the knee: 0 constant,
+        1 hyperbolic, 2 linear (:mod:`reference.planner.drive`). Default 0.
     """
 
     compress_pos_tol_mm: float = 0.01
@@ -127,6 +147,9 @@ class AxisSettings:
     soft_accel_factor: float = 1.0
     g00_accel_factor: float = 1.0
     g00_jerk_factor: float = 1.0
+    accel_reduction_speed_point: float = 1.0
+    accel_reduction_factor: float = 0.0
+    accel_type_drive: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,7 +163,11 @@ class ChannelSettings:
     ignore_ovl_factor_for_adis : bool
         MD20490.
     lookahead_smooth_factor_pct : float
-        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss (0 = smoothing off here).
+        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss, as given. 0 (also the value
+        when the key is missing) selects the control's internal 100 %: "a smoothing
+        factor other than 0% prevents the default value of 100% from being used" (B1
+        excerpt; :func:`reference.planner.smoothing.effective_factor`). A small value
+        such as 1 % switches the smoothing practically off.
     adapt_path_dynamic : tuple[float, float]
         MD20465 ADAPT_PATH_DYNAMIC for [BRISK, SOFT]; 1.0 = off.
     lookahead_blocks : int
@@ -217,19 +244,28 @@ def _check(section: str, key: str, value: Any, spec: _Key, source: str) -> None:
         ok = isinstance(value, kinds)
     if not ok:
         want = " or ".join(k.__name__ for k in kinds).replace("int or float", "number")
-        raise MachineDataError(dotted, value, f"must be a {want}"
+        want = {"int": "n integer", "str": " string", "bool": " boolean"}.get(want, f" {want}")
+        raise MachineDataError(dotted, value, f"must be a{want}"
                                + (f" in {spec.unit}" if spec.unit else ""), source)
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         if value != value or value in (float("inf"), float("-inf")):
             raise MachineDataError(dotted, value, "must be finite", source)
         if spec.lo is not None and not value > spec.lo:
-            raise MachineDataError(dotted, value, f"must be > {spec.lo:g} {spec.unit}".rstrip(),
-                                   source)
+            # lo just below 0 stands for ">= 0" (0 itself allowed)
+            rule = ("must be >= 0" if -1e-9 < spec.lo < 0 else f"must be > {spec.lo:g}")
+            raise MachineDataError(dotted, value, f"{rule} {spec.unit}".rstrip(), source)
+        if spec.low is not None and value < spec.low and not spec.unit:
+            raise MachineDataError(dotted, value, f"is below the plausible minimum "
+                                   f"{spec.low:g} ({spec.doc})", source)
         if spec.low is not None and value < spec.low:
             raise MachineDataError(
                 dotted, value, f"is below the plausible minimum {spec.low:g} {spec.unit}; "
                 f"check the unit ({spec.doc} is given in {spec.unit})".replace(" ;", ";")
                 .replace("( is given in )", "(a factor)"), source)
+        if spec.hi is not None and value > spec.hi and not spec.unit:
+            # a share, a factor or a code: no unit to mix up
+            raise MachineDataError(dotted, value, f"must be <= {spec.hi:g} ({spec.doc})",
+                                   source)
         if spec.hi is not None and value > spec.hi:
             raise MachineDataError(
                 dotted, value, f"is above the plausible maximum {spec.hi:g} {spec.unit}; "
@@ -330,6 +366,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             if k not in _AXIS_KEYS:
                 _unknown(sec, k, v, _AXIS_KEYS, source)
             _check(sec, k, v, _AXIS_KEYS[k], source)
+        if tbl.get("ACCEL_TYPE_DRIVE", 0) not in (0, 1, 2):
+            raise MachineDataError(f"{sec}.ACCEL_TYPE_DRIVE", tbl["ACCEL_TYPE_DRIVE"],
+                                   "must be 0 (constant), 1 (hyperbolic) or 2 (linear)", source)
         for req in ("MAX_AX_VELO", "MAX_AX_ACCEL", "MAX_AX_JERK"):
             if req not in tbl:
                 raise MachineDataError(f"{sec}.{req}", None,
@@ -360,7 +399,10 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             velo_ffw_weight=float(tbl.get("VELO_FFW_WEIGHT", 0.0)),
             soft_accel_factor=float(tbl.get("SOFT_ACCEL_FACTOR", 1.0)),
             g00_accel_factor=float(tbl.get("G00_ACCEL_FACTOR", 1.0)),
-            g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)))))
+            g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)),
+            accel_reduction_speed_point=float(tbl.get("ACCEL_REDUCTION_SPEED_POINT", 1.0)),
+            accel_reduction_factor=float(tbl.get("ACCEL_REDUCTION_FACTOR", 0.0)),
+            accel_type_drive=int(tbl.get("ACCEL_TYPE_DRIVE", 0)))))
     for geo in ("X", "Y", "Z"):
         if geo not in axes_raw:
             raise MachineDataError(f"axis.{geo}", None, "geometry axes X, Y and Z are "
