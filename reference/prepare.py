@@ -34,6 +34,8 @@ from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_M
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 from .rounding import round_corners
+from .tangential import apply_tangential
+from .trc import apply_trc
 
 _PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
 _STOP_AT_END_M = {0: "M0 programmed stop", 1: "M1 optional stop", 2: "M2 program end",
@@ -234,7 +236,12 @@ def _exact_path_stops(path: Path, program: Program) -> Path:
 
 
 def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
-    """Warnings for programmed features the path does not apply yet (TRC, TANG).
+    """Warnings for programmed features the path does not apply.
+
+    Tool radius compensation (:mod:`reference.trc`) and tangential control
+    (:mod:`reference.tangential`) are applied by :func:`build_path` now; what they
+    cannot model is an error there, naming the line. Nothing is left to warn about; the
+    function stays as the place for the next such feature.
 
     Parameters
     ----------
@@ -245,18 +252,8 @@ def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
     tuple[ProgramWarning, ...]
         At most one warning per feature, naming the first line that uses it.
     """
-    out: list[ProgramWarning] = []
-    trc = next((b for b in program.blocks if b.tool_compensation != "G40"), None)
-    if trc is not None:
-        out.append(ProgramWarning(program.file, trc.line,
-                                  f"tool radius compensation {trc.tool_compensation} is not "
-                                  "applied: the path is the programmed contour"))
-    tang = next((b for b in program.blocks if b.tangential is not None), None)
-    if tang is not None:
-        out.append(ProgramWarning(program.file, tang.line,
-                                  "tangential control is not applied: the following axis "
-                                  "moves only as programmed"))
-    return tuple(out)
+    del program
+    return ()
 
 
 def require_axes(path: Path, limits: MachineLimits) -> None:
@@ -314,9 +311,10 @@ def build_path(program: Program, machine: Machine) -> Path:
     The heuristic (:func:`reference.planner.plan`), the oracle's callers and the
     comparison all take their path from here, so the gap measures velocity planning
     alone (DESIGN section 1): the programmed contour (:func:`prepare`) over the axes the
-    machine knows (:func:`restrict_to_machine`), with the corners of blocks in
-    G641..G645 rounded (:func:`reference.rounding.round_corners`); tool radius
-    compensation, once modelled, belongs here too.
+    machine knows (:func:`restrict_to_machine`), then the stages in the control's order
+    (DESIGN section 5): tool radius compensation (:func:`reference.trc.apply_trc`),
+    tangential control (:func:`reference.tangential.apply_tangential`) and the corner
+    rounding of blocks in G641..G645 (:func:`reference.rounding.round_corners`).
 
     Parameters
     ----------
@@ -334,10 +332,17 @@ def build_path(program: Program, machine: Machine) -> Path:
     PathError
         Arc geometry out of tolerance (names file and line).
     MachineDataError
-        The program moves an axis the machine has no limits for (names axis and line).
+        The program moves an axis the machine has no limits for, or tangential control
+        turns one (names axis and line).
+    PathError
+        Tool radius compensation or tangential control cannot build the path: a missing
+        tool radius, the tool does not fit (the control's collision alarm), a model limit
+        (names file and line).
     """
     path = restrict_to_machine(prepare(program), machine.limits)
     _check_motion_times(path)
+    path = apply_trc(path, program, machine)
+    path = apply_tangential(path, program, machine)
     path = round_corners(path, program, machine)
     return path
 
