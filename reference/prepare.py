@@ -23,6 +23,8 @@ to the reference planner, not to the path.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .core.errors import MachineDataError, PathError
@@ -34,8 +36,8 @@ from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_M
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 from .rounding import round_corners
-from .tangential import apply_tangential
-from .trc import apply_trc
+from .tangential import TangentialResult, tangential_path
+from .trc import TrcResult, compensate_path
 
 _PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
 _STOP_AT_END_M = {0: "M0 programmed stop", 1: "M1 optional stop", 2: "M2 program end",
@@ -339,12 +341,35 @@ def build_path(program: Program, machine: Machine) -> Path:
         tool radius, the tool does not fit (the control's collision alarm), a model limit
         (names file and line).
     """
+    return path_stages(program, machine).path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PathStages:
+    """The stages of :func:`build_path` with what each decided (for ``inspect``).
+
+    Attributes
+    ----------
+    trc : reference.trc.TrcResult
+        Tool radius compensation: the compensated path, its blocks and corners.
+    tangential : reference.tangential.TangentialResult
+        Tangential control: the path with the following axes, their corners.
+    path : Path
+        The final path (after rounding; its ``rounding`` table says what was rounded).
+    """
+
+    trc: TrcResult
+    tangential: TangentialResult
+    path: Path
+
+
+def path_stages(program: Program, machine: Machine) -> PathStages:
+    """:func:`build_path` with the result of every stage kept (same path, same errors)."""
     path = restrict_to_machine(prepare(program), machine.limits)
     _check_motion_times(path)
-    path = apply_trc(path, program, machine)
-    path = apply_tangential(path, program, machine)
-    path = round_corners(path, program, machine)
-    return path
+    trc = compensate_path(path, program, machine)
+    tang = tangential_path(trc.path, program, machine)
+    return PathStages(trc, tang, round_corners(tang.path, program, machine))
 
 
 def _check_motion_times(path: Path) -> None:
@@ -365,5 +390,5 @@ def _check_motion_times(path: Path) -> None:
                         f"resolution); raise the feed or split the block", worst)
 
 
-__all__ = ["build_path", "prepare", "require_axes", "restrict_to_machine",
-           "unmodelled_features", "KIND_CODES"]
+__all__ = ["PathStages", "build_path", "path_stages", "prepare", "require_axes",
+           "restrict_to_machine", "unmodelled_features", "KIND_CODES"]

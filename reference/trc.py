@@ -247,8 +247,8 @@ class _El:
     Lines: programmed ends ``P0, P1``, direction ``t``; offset ends ``A0, A1``; the
     approach line also its own direction ``pre`` (it is not parallel to ``t``).
     Arcs: centre ``c``, signed sweep ``S`` (CCW > 0), offset ends ``A0, A1`` on the
-    offset circle(s); ``dS0``/``dS1`` the sweep removed at the start / added at the end
-    by corners (signed in the arc's direction).
+    offset circle(s); ``dS0``/``dS1`` how far corners moved the start / end angle (rad,
+    counter-clockwise positive): the new sweep is ``S - dS0 + dS1``.
     """
 
     __slots__ = ("j", "block", "is_arc", "P0", "P1", "t", "c", "S", "R0", "R1", "A0", "A1",
@@ -287,7 +287,7 @@ def _move_end(el: _El, X) -> None:
     if el.is_arc:
         old = math.atan2(el.A1[1] - el.c[1], el.A1[0] - el.c[0])
         new = math.atan2(X[1] - el.c[1], X[0] - el.c[0])
-        el.dS1 += _wrap(new - old) * (1.0 if el.S > 0 else -1.0)
+        el.dS1 += _wrap(new - old)
     el.A1 = X
 
 
@@ -296,7 +296,7 @@ def _move_start(el: _El, X) -> None:
     if el.is_arc:
         old = math.atan2(el.A0[1] - el.c[1], el.A0[0] - el.c[0])
         new = math.atan2(X[1] - el.c[1], X[0] - el.c[0])
-        el.dS0 += _wrap(new - old) * (1.0 if el.S > 0 else -1.0)
+        el.dS0 += _wrap(new - old)
     el.A0 = X
 
 
@@ -811,7 +811,7 @@ class _Builder:
                 packed[k][rows] = ap[k]
             got = np.abs(ap["omega"] * ap["length"])
             if not np.allclose(got, np.abs(sweep), rtol=0.0, atol=1e-6):
-                raise AssertionError("TRC: an arc was rebuilt with a different sweep")
+                raise AssertionError(f"TRC: an arc was rebuilt with a different sweep {got} {sweep} {s0} {s1} {cen}")
         owner_a = np.asarray(owner, dtype=np.int64)
         feed = path.feed[owner_a]
         rapid = path.rapid[owner_a]
