@@ -203,6 +203,9 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
         lu, lv = (path.axes.index(a) for a in tg.leading)
         k, off = tg.coupling, tg.offset_deg
         tu, tv = float(t0[j, lu]), float(t0[j, lv])
+        # an arc must lie in the leading plane (checked first: an arc in another plane
+        # may start with no tangent there and still move in it)
+        turn = _turn_deg(path, j, lu, lv, t0[j], t1[j], blk.line, program.file)
         if math.hypot(tu, tv) <= _PLANE_TANGENT_MIN:
             # no tangent in the leading plane: the axis keeps its angle (plus what the
             # program itself moves it by)
@@ -211,7 +214,6 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
             cur = float(c_end[j])
             continue
         phi0 = math.degrees(math.atan2(tv, tu))
-        turn = _turn_deg(path, j, lu, lv, t0[j], t1[j], blk.line, program.file)
         if phi_prev is None:
             # at TANGON (or after a gap): the branch nearest to where the axis is
             want = (cur - off - prog0) / k if k != 0 else phi0
