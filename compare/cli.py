@@ -105,7 +105,8 @@ def _write_tangential(out, program, stages) -> None:
     if not corners:
         return
     lines = {b.index: b.line for b in program.blocks}
-    out.write(f"tangential control: {len(corners)} tangent steps\n")
+    n = len(corners)
+    out.write(f"tangential control: {n} tangent step{'' if n == 1 else 's'}\n")
     out.write(f"{'line':>6} {'axis':<4} {'step_deg':>9} action\n")
     for c in corners:
         out.write(f"{lines[c.block]:>6} {c.axis:<4} {c.step_deg:>9.3f} {c.action}\n")
