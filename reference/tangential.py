@@ -142,12 +142,23 @@ def tangential_path(path: Path, program: Program, machine: Machine) -> Tangentia
         plane (names the line).
     """
     blocks = program.blocks
-    active = [b for b in blocks if b.tangential is not None]
-    if not active or path.n_segments == 0:
+    # consecutive blocks share one modal state: look at each distinct one once, and at
+    # each tangential record with the first block that uses it (for messages)
+    seen: set[int] = set()
+    firsts: dict = {}
+    for b in blocks:
+        md = b.modal
+        if id(md) in seen:
+            continue
+        seen.add(id(md))
+        if md.tangential is not None and md.tangential not in firsts:
+            firsts[md.tangential] = b
+    if path.n_segments == 0 or not firsts:
         return TangentialResult(path)
     corners: list[TangentialCorner] = []
-    for axis in dict.fromkeys(b.tangential.axis for b in active):
-        first = next(b for b in active if b.tangential.axis == axis)
+    for axis in dict.fromkeys(t.axis for t in firsts):
+        mine = {t: b for t, b in firsts.items() if t.axis == axis}
+        first = min(mine.values(), key=lambda b: b.index)
         where = f"{program.file}:{first.line}"
         if axis not in machine.limits.names or axis not in path.axes:
             raise MachineDataError(f"axis.{axis}", None,
@@ -158,13 +169,12 @@ def tangential_path(path: Path, program: Program, machine: Machine) -> Tangentia
         if not path.rotary[f]:
             raise PathError(f"{where}: the following axis {axis} of tangential control "
                             "must be a rotary axis", first.index)
-        for b in active:
-            if b.tangential.axis == axis:
-                for lead in b.tangential.leading:
-                    if lead not in ("X", "Y", "Z") or lead not in path.axes:
-                        raise PathError(f"{program.file}:{b.line}: the leading axes of "
-                                        f"TANG({axis}, ...) must be geometry axes (X, Y, Z), "
-                                        f"got {lead}", b.index)
+        for t, b in mine.items():
+            for lead in t.leading:
+                if lead not in ("X", "Y", "Z") or lead not in path.axes:
+                    raise PathError(f"{program.file}:{b.line}: the leading axes of "
+                                    f"TANG({axis}, ...) must be geometry axes (X, Y, Z), "
+                                    f"got {lead}", b.index)
         path, got = _follow(path, program, machine, axis, f)
         corners.extend(got)
     return TangentialResult(path, tuple(corners))
@@ -186,11 +196,21 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
     cur = float(q0[0, f])                 # where the axis is
     phi_prev: float | None = None         # last defined tangent angle, degrees
     was_on = False
+    # Python numbers per segment at once (numpy element access costs a microsecond)
+    block_of = path.block.tolist()
+    prog0_l, prog1_l = q0[:, f].tolist(), q1[:, f].tolist()
+    t0_l = t0.tolist()
+    is_arc = (path.radius > 0).tolist()
+    follow: dict[int, object] = {}        # modal state -> its tangential record for axis
+    rounds: dict[int, bool] = {}          # block -> a rounding mode governs its end corner
     for j in range(m):
-        blk = blocks[int(path.block[j])]
-        tg = blk.tangential if (blk.tangential is not None
-                                and blk.tangential.axis == axis) else None
-        prog0, prog1 = float(q0[j, f]), float(q1[j, f])
+        blk = blocks[block_of[j]]
+        key = id(blk.modal)
+        if key not in follow:
+            t = blk.modal.tangential
+            follow[key] = t if (t is not None and t.axis == axis) else None
+        tg = follow[key]
+        prog0, prog1 = prog0_l[j], prog1_l[j]
         if tg is None:
             if was_on:
                 phi_prev, was_on = None, False
@@ -202,10 +222,11 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
         was_on = True
         lu, lv = (path.axes.index(a) for a in tg.leading)
         k, off = tg.coupling, tg.offset_deg
-        tu, tv = float(t0[j, lu]), float(t0[j, lv])
+        tu, tv = t0_l[j][lu], t0_l[j][lv]
         # an arc must lie in the leading plane (checked first: an arc in another plane
         # may start with no tangent there and still move in it)
-        turn = _turn_deg(path, j, lu, lv, t0[j], t1[j], blk.line, program.file)
+        turn = _turn_deg(path, j, lu, lv, t0[j], t1[j], blk.line, program.file) if (
+            is_arc[j]) else 0.0
         if math.hypot(tu, tv) <= _PLANE_TANGENT_MIN:
             # no tangent in the leading plane: the axis keeps its angle (plus what the
             # program itself moves it by)
@@ -224,10 +245,12 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
         target1 = k * (phi0 + turn) + off + prog1
         step = abs(target0 - cur) / abs(k) if k != 0 else abs(target0 - cur)
         if step > _ANGLE_TOL_DEG:
-            before = int(path.block[j - 1]) if j > 0 else -1
-            rounding = before >= 0 and (blocks[before].continuous_mode in ROUNDING_MODES
-                                        or blocks[before].rnd_mm > 0
-                                        or blocks[before].rndm_mm > 0)
+            before = block_of[j - 1] if j > 0 else -1
+            if before >= 0 and before not in rounds:
+                bb = blocks[before]
+                rounds[before] = (bb.continuous_mode in ROUNDING_MODES or bb.rnd_mm > 0
+                                  or bb.rndm_mm > 0)
+            rounding = before >= 0 and rounds[before]
             if tg.tlift and step > eps and not rounding:
                 tlift_at[j] = cur
                 c_start[j] = target0
@@ -239,7 +262,7 @@ def _follow(path: Path, program: Program, machine: Machine, axis: str,
                               tg.tlift and step > eps) else
                              f"step within EPS_TLIFT_TANG_STEP {eps:g} deg" if tg.tlift
                              else "no TLIFT"))
-            corners.append(TangentialCorner(axis, int(path.block[j]), step, action))
+            corners.append(TangentialCorner(axis, block_of[j], step, action))
         else:
             c_start[j] = cur
         c_end[j] = target1

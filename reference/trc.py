@@ -86,7 +86,7 @@ import numpy as np
 
 from .core.errors import PathError
 from .core.geometry import KIND_CODES, Path, arc_segments, line_segments
-from .core.tolerances import POS_TOL_MM, TANGENT_TOL_RAD
+from .core.tolerances import POS_TOL_MM
 from .machine import Machine
 from .nc.program import Block, Program
 from .splice import ROW_KEYS, copy_rows, splice
@@ -101,6 +101,10 @@ NGC_CORNER_TOL_RAD = 0.01
 #: 840C excerpt: the intersection is not used when it lies farther than this many tool
 #: radii from the contour.
 MD6_INTERSECTION_REACH = 1.5
+#: A corner whose deflection has a sine below this (and a cosine below 0) is a reversal,
+#: whose turn direction the tangents cannot tell: float64 round-off of unit tangents is
+#: about 1e-16, a real corner of 1e-12 rad moves the offset by 5e-12 mm at r = 5 mm.
+REVERSAL_SIN = 1e-12
 
 
 # ------------------------------------------------------------------ results
@@ -326,7 +330,9 @@ def compensate_path(path: Path, program: Program, machine: Machine) -> TrcResult
     """
     blocks = program.blocks
     m = path.n_segments
-    if m == 0 or all(b.tool_compensation == "G40" for b in blocks):
+    # consecutive blocks share one modal state: look at each distinct one once
+    if m == 0 or all(md.tool_compensation == "G40"
+                     for md in {id(b.modal): b.modal for b in blocks}.values()):
         return TrcResult(path)
     comp = [blocks[int(b)].tool_compensation for b in path.block]
     runs: list[tuple[list[int], int | None]] = []
@@ -403,8 +409,12 @@ class _Builder:
                                           "LinuxCNC compensates in G17 and G18 only")
         r, side = self._radius(first)
         label = "G41" if side > 0 else "G42"
-        for j in run:
-            b = blocks[int(path.block[j])]
+        seen = None
+        for bi in path.block[run].tolist():
+            b = blocks[bi]
+            if b.modal is seen:          # consecutive blocks share their modal state
+                continue
+            seen = b.modal
             if b.plane != plane:
                 raise self._fail(b.index, f"plane change ({plane} -> {b.plane}) while tool "
                                           "radius compensation is active; program G40 first")
@@ -493,26 +503,30 @@ class _Builder:
         """Plane elements of a run (``None`` for segments without plane motion)."""
         path = self.path
         out: list[_El | None] = []
-        for j in run:
-            blk = int(path.block[j])
-            L = float(path.length[j])
-            o = path.origin[j]
+        js = np.asarray(run, dtype=np.int64)
+        # the run's columns as Python numbers at once (element access to numpy arrays
+        # costs a microsecond each)
+        cols = zip(js.tolist(), path.block[js].tolist(), path.length[js].tolist(),
+                   path.origin[js, u].tolist(), path.origin[js, v].tolist(),
+                   path.radius[js].tolist(), path.omega[js].tolist(),
+                   path.theta0[js].tolist(), path.dradius[js].tolist(),
+                   path.d[js, u].tolist(), path.d[js, v].tolist(),
+                   (path.e1[js, u] == 1.0).tolist(), (path.e2[js, v] == 1.0).tolist())
+        for j, blk, L, ou, ov, rad, om, th0, dr, du, dv, in_u, in_v in cols:
             e = _El()
             e.j, e.block, e.approach, e.pre = j, blk, False, None
             e.dS0 = e.dS1 = 0.0
-            if path.radius[j] > 0:
-                e1, e2 = path.e1[j], path.e2[j]
-                if not (e1[u] == 1.0 and e2[v] == 1.0):
+            if rad > 0:
+                if not (in_u and in_v):
                     raise self._fail(blk, "tool radius compensation on an arc outside the "
                                           "working plane (a rotated frame tilts it) is not "
                                           "modelled")
                 e.is_arc = True
-                e.c = (float(o[u]), float(o[v]))
-                e.S = float(path.omega[j]) * L
-                R0 = float(path.radius[j])
-                th0 = float(path.theta0[j])
+                e.c = (ou, ov)
+                e.S = om * L
+                R0 = rad
                 th1 = th0 + e.S
-                R1 = R0 + float(path.dradius[j]) * abs(e.S)
+                R1 = R0 + dr * abs(e.S)
                 e.R0, e.R1 = R0, R1
                 e.P0 = (e.c[0] + R0 * math.cos(th0), e.c[1] + R0 * math.sin(th0))
                 e.P1 = (e.c[0] + R1 * math.cos(th1), e.c[1] + R1 * math.sin(th1))
@@ -521,14 +535,13 @@ class _Builder:
                 e.t1 = (-sgn * math.sin(th1), sgn * math.cos(th1))
                 e.t = e.t0
             else:
-                d = path.d[j]
-                dp = (float(d[u]) * L, float(d[v]) * L)
+                dp = (du * L, dv * L)
                 lp = _norm(dp)
                 if lp <= POS_TOL_MM:
                     out.append(None)
                     continue
                 e.is_arc = False
-                e.P0 = (float(o[u]), float(o[v]))
+                e.P0 = (ou, ov)
                 e.P1 = _add(e.P0, dp)
                 e.t = (dp[0] / lp, dp[1] / lp)
                 e.t0 = e.t1 = e.t
@@ -563,12 +576,14 @@ class _Builder:
         theta = _angle_between(t1, t2)
         deg = math.degrees(theta)
         A, C = a.A1, b.A0
-        if theta <= TANGENT_TOL_RAD:
+        if _norm(_sub(C, A)) <= POS_TOL_MM:
+            # the offset elements meet (a tangential transition, or a kink too small to
+            # move the offset by a position tolerance): no transition, b starts at A
             _move_start(b, A)
             self.corners.append(TrcCorner(a.block, b.block, "tangential", "none", deg, 0.0))
             return []
         cross = _cross(t1, t2)
-        reversal = theta >= math.pi - TANGENT_TOL_RAD
+        reversal = _dot(t1, t2) < 0 and abs(cross) <= REVERSAL_SIN
         turn = -side if reversal else (1.0 if cross > 0 else -1.0)   # +1 left, -1 right
         P = a.P1
         if not reversal and side * cross > 0:
@@ -684,32 +699,30 @@ class _Builder:
 
     def _record(self, a: _El, b: _El, deg: float, action: str,
                 pieces: list[tuple]) -> list[tuple]:
-        length = 0.0
-        for p in pieces:
-            if p[0] == "seg":
-                length += _norm(_sub(p[2], p[1]))
-            else:
-                _, s0, s1, q, turn = p
-                R = _norm(_sub(s0, q))
-                a0 = math.atan2(s0[1] - q[1], s0[0] - q[0])
-                a1 = math.atan2(s1[1] - q[1], s1[0] - q[0])
-                sweep = (a1 - a0) % (2 * math.pi) if turn > 0 else (a0 - a1) % (2 * math.pi)
-                length += R * sweep
-        self.corners.append(TrcCorner(a.block, b.block, "outside", action, deg, length))
+        """Record the corner; the inserted pieces as row specs, chained end to start (a
+        piece shorter than POS_TOL_MM is left out and the chain closes over it, so no
+        gap opens; b then starts exactly where the last piece ends)."""
         specs = []
+        length = 0.0
+        at = a.A1
         for p in pieces:
+            end = p[2]
+            if _norm(_sub(end, at)) <= POS_TOL_MM:
+                continue
             if p[0] == "seg":
-                if _norm(_sub(p[2], p[1])) > POS_TOL_MM:
-                    specs.append(("line", p[1], p[2], b.block, _TRC))
+                specs.append(("line", at, end, b.block, _TRC))
+                length += _norm(_sub(end, at))
             else:
-                _, s0, s1, q, turn = p
-                if _norm(_sub(s1, s0)) > POS_TOL_MM:
-                    R = _norm(_sub(s0, q))
-                    a0 = math.atan2(s0[1] - q[1], s0[0] - q[0])
-                    a1 = math.atan2(s1[1] - q[1], s1[0] - q[0])
-                    sweep = (a1 - a0) % (2 * math.pi) if turn > 0 else \
-                        -((a0 - a1) % (2 * math.pi))
-                    specs.append(("arc", s0, s1, b.block, _TRC, q, sweep))
+                q, turn = p[3], p[4]
+                a0 = math.atan2(at[1] - q[1], at[0] - q[0])
+                a1 = math.atan2(end[1] - q[1], end[0] - q[0])
+                sweep = (a1 - a0) % (2 * math.pi) if turn > 0 else \
+                    -((a0 - a1) % (2 * math.pi))
+                specs.append(("arc", at, end, b.block, _TRC, q, sweep))
+                length += _norm(_sub(at, q)) * abs(sweep)
+            at = end
+        _move_start(b, at)
+        self.corners.append(TrcCorner(a.block, b.block, "outside", action, deg, length))
         return specs
 
     # ------------------------------------------------------------ checks
@@ -739,12 +752,16 @@ class _Builder:
         js = np.array(sorted(self.rows), dtype=np.int64)
         q0 = path.evaluate(path.s_breaks[js], segment=js)[0]
         q1 = path.evaluate(path.s_breaks[js + 1], segment=js)[0]
-        ends = {int(j): (q0[i], q1[i]) for i, j in enumerate(js)}
         owner: list[int] = []
         copy_src: list[int] = []
         copy_dst: list[int] = []
-        lines: list[tuple] = []          # (row, start, end, block, kind)
-        arcs: list[tuple] = []           # (row, start, end, centre, sweep, block, kind, e1, e2)
+        # rebuilt rows: start, end (all axes, lists), block, kind; arcs also centre,
+        # sweep and plane axes
+        lines: list[tuple] = []
+        arcs: list[tuple] = []
+        starts, stops = q0.tolist(), q1.tolist()
+        row_of = {int(j): i for i, j in enumerate(js.tolist())}
+        plane_of = {}
         for j in range(m):
             specs = self.rows.get(j)
             if specs is None:
@@ -752,15 +769,15 @@ class _Builder:
                 copy_dst.append(len(owner))
                 owner.append(j)
                 continue
-            pu, pv = (self.index[a] for a in
-                      _PLANES[self.program.blocks[int(path.block[j])].plane])
-            qs, qe = ends[j]
+            blk_mod = self.program.blocks[int(path.block[j])].plane
+            pu, pv = plane_of.get(blk_mod) or plane_of.setdefault(
+                blk_mod, tuple(self.index[a] for a in _PLANES[blk_mod]))
+            qs, qe = starts[row_of[j]], stops[row_of[j]]
             for spec in specs:
                 row = len(owner)
                 owner.append(j)
-                inserted = spec[4] == _TRC
-                p0 = qs.copy()
-                p1 = (qs if inserted else qe).copy()    # a transition: other axes at rest
+                p0 = list(qs)
+                p1 = list(qs if spec[4] == _TRC else qe)   # a transition: others at rest
                 if spec[1] is not None:
                     p0[pu], p0[pv] = spec[1]
                 if spec[2] is not None:
@@ -768,11 +785,9 @@ class _Builder:
                 if spec[0] == "line":
                     lines.append((row, p0, p1, spec[3], spec[4]))
                     continue
-                c = p0.copy()
+                c = list(p0)
                 c[pu], c[pv] = spec[5]
-                E1, E2 = np.zeros(n), np.zeros(n)
-                E1[pu], E2[pv] = 1.0, 1.0
-                arcs.append((row, p0, p1, c, spec[6], spec[3], spec[4], E1, E2))
+                arcs.append((row, p0, p1, c, spec[6], spec[3], spec[4], pu, pv))
         total = len(owner)
         packed = {k: np.zeros((total, n)) for k in ("origin", "e1", "e2", "d")}
         packed.update({k: np.zeros(total) for k in ("radius", "omega", "theta0", "length",
@@ -795,8 +810,11 @@ class _Builder:
             s1 = np.array([x[2] for x in arcs])
             cen = np.array([x[3] for x in arcs])
             sweep = np.array([x[4] for x in arcs])
-            E1 = np.array([x[7] for x in arcs])
-            E2 = np.array([x[8] for x in arcs])
+            k = np.arange(len(arcs))
+            E1 = np.zeros((len(arcs), n))
+            E2 = np.zeros((len(arcs), n))
+            E1[k, [x[7] for x in arcs]] = 1.0
+            E2[k, [x[8] for x in arcs]] = 1.0
 
             def plane_radius(q):
                 return np.hypot(np.sum((q - cen) * E1, axis=1), np.sum((q - cen) * E2, axis=1))
