@@ -57,10 +57,15 @@ other axes move as programmed):
   compensated start of the next element (perpendicular to its start tangent); NGC
   (``convert_straight_comp1``): to the end point moved by ``r`` perpendicular to the move
   itself, longer than ``r`` (else LinuxCNC's error), and the corner to the next element
-  is then treated like any other. The first moving block after G40 (a line, else an
+  is then treated like any other (an inside corner there cuts the entry line at the
+  intersection with the next offset; LinuxCNC moves its end back parallel to the
+  programmed move instead, a difference of the order of r times the small angle between
+  the two). The first moving block after G40 (a line, else an
   error) goes from the compensated end of the last element straight to its programmed
   end, whatever axes it names (so ``G40 G0 Z50`` moves the plane axes back too, as on
   LinuxCNC, whose canonical moves are absolute).
+* other axes (Z, rotary axes) move on the block's own element; an inserted transition
+  moves none of them (LinuxCNC moves rotary axes on its inserted arc: not modelled).
 * blocks in a compensated run that do not move in the plane (a Z infeed) stay at the
   compensated end of the element before them (the intermediate point ``P*`` of 9); the
   transition of the corner around them belongs to the next element in the plane.

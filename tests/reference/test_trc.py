@@ -491,3 +491,77 @@ def test_programs_without_compensation_keep_their_path_object():
     prog = parse_text("G1 X10 F100\nY10\n", "p.mpf")
     st = path_stages(prog, load_machine())
     assert st.trc.path is not None and not st.trc.blocks and not st.trc.corners
+
+
+# ============================================================= seeded random contours
+def _random_contour(rng) -> tuple[str, list[tuple]]:
+    """A random contour of lines and arcs (CR form, sweeps below 180 degrees) and the
+    programmed elements: ("line", p0, p1) or ("arc", centre, radius)."""
+    x, y, heading = 0.0, 0.0, 0.0
+    lines, elements = [], []
+    for _ in range(int(rng.integers(3, 9))):
+        heading += math.radians(rng.uniform(-150, 150)) if rng.random() < 0.6 else 0.0
+        if rng.random() < 0.5:
+            L = rng.uniform(5, 20)
+            nx, ny = x + L * math.cos(heading), y + L * math.sin(heading)
+            lines.append(f"G1 X{nx!r} Y{ny!r}")          # full precision: exact elements
+            elements.append(("line", (x, y), (nx, ny)))
+        else:
+            rad, sweep = rng.uniform(3, 30), math.radians(rng.uniform(10, 170))
+            ccw = rng.random() < 0.5
+            sgn = 1.0 if ccw else -1.0
+            cx = x - sgn * rad * math.sin(heading)
+            cy = y + sgn * rad * math.cos(heading)
+            a0 = math.atan2(y - cy, x - cx)
+            a1 = a0 + sgn * sweep
+            nx, ny = cx + rad * math.cos(a1), cy + rad * math.sin(a1)
+            lines.append(f"{'G3' if ccw else 'G2'} X{nx!r} Y{ny!r} CR={rad!r}")
+            elements.append(("arc", (cx, cy), rad))
+            heading += sgn * sweep
+        x, y = nx, ny
+    return "\n".join(lines), elements
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_random_contours_offset_every_element_by_exactly_r_or_name_the_line(seed):
+    """Seeded invariant: each compensated contour block's own segment lies exactly r from
+    its programmed element (distance to the line, or |distance to the centre - R|), each
+    transition circle r from the corner; the path is continuous; or the program is
+    refused with a PathError naming file and line (the tool does not fit)."""
+    rng = np.random.default_rng(seed)
+    body, elements = _random_contour(rng)
+    side = "G41" if rng.random() < 0.5 else "G42"
+    mode = ["G450", "G451", "G450 DISC=40"][int(rng.integers(0, 3))]
+    r = 1.0
+    text = (f"$TC_DP6[1,1]={r}\nT1 D1\nG0 X-10 Y-10\n{side} {mode} G1 X0 Y0 F3000\n"
+            f"{body}\nG40 G1 X-20 Y-20\nM30\n")
+    prog = parse_text(text, "t.mpf")
+    try:
+        st = path_stages(prog, load_machine())
+    except PathError as exc:
+        assert str(exc).startswith("t.mpf:") and str(exc).split(":")[1].isdigit()
+        return
+    path = st.path
+    assert _continuous(path)
+    for k, el in enumerate(elements):
+        segs = _segments_of_lines(prog, path, (5 + k,))
+        main = [i for i in segs if KIND_CODES[int(path.kind[i])] != "trc"]
+        assert len(main) == 1
+        p = _sample(path, main, 200)[:, :2]
+        if el[0] == "line":
+            a, b = np.array(el[1]), np.array(el[2])
+            t = (b - a) / np.linalg.norm(b - a)
+            d = np.abs((p - a) @ np.array([-t[1], t[0]]))
+        else:
+            d = np.abs(np.linalg.norm(p - np.array(el[1]), axis=1) - el[2])
+        # 1e-7 mm: the parser's centre from CR and the end points carries the round-off
+        # of coordinates of up to 100 mm through a square root
+        assert np.max(np.abs(d - r)) <= 1e-7, (seed, k, el[0])
+    for c in st.trc.corners:
+        if c.action == "circle":
+            blk = prog.blocks[c.next_block]
+            trc = [i for i in range(path.n_segments) if int(path.block[i]) == blk.index
+                   and KIND_CODES[int(path.kind[i])] == "trc"]
+            corner = np.array(blk.start[:2])
+            q = _sample(path, trc, 100)[:, :2]
+            assert np.max(np.abs(np.linalg.norm(q - corner, axis=1) - r)) <= 1e-7
