@@ -439,6 +439,12 @@ class _Builder:
             for j in run:
                 self.tblocks.append(TrcBlock(int(path.block[j]), "contour", label, 0.0))
             return
+        if self.ngc and els[0] is None:
+            # LinuxCNC takes the first move after G41/G42 as the entry move, whatever it
+            # moves (convert_straight_comp1): without motion in the plane it is too short
+            raise self._fail(int(path.block[run[0]]), "length of the cutter compensation "
+                                                      "entry move is not greater than the "
+                                                      "tool radius (LinuxCNC refuses it)")
         plane_els = [e for e in els if e is not None]
         if not plane_els:
             return

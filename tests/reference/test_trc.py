@@ -465,6 +465,9 @@ def test_ngc_dynamic_compensation_and_entry_length():
                                         r"entry move is not greater than the tool radius"):
         _path("G21\nG0 X0 Y-3\nG41.1 D8 G1 X0 Y0 F1000\nG1 X20\nG40 X20 Y-20\n",
               dialect="ngc", name="t.ngc")
+    with pytest.raises(PathError, match=r"t\.ngc:4: length of the cutter compensation "):
+        _path("G21\nG0 X0 Y-20\nG41.1 D8\nG1 Z-5 F1000\nG1 X20\nG40 X20 Y-20\n",
+              dialect="ngc", name="t.ngc")          # a plunge as the entry move
     with pytest.raises(PathError, match=r"t\.ngc:3: cutter compensation in the YZ plane"):
         _path("G21 G19\nG0 Y0 Z-20\nG41.1 D8 G1 Y0 Z0 F1000\nG1 Y20\nG40 Z-20\n",
               dialect="ngc", name="t.ngc")
