@@ -339,7 +339,7 @@ def compensate_path(path: Path, program: Program, machine: Machine) -> TrcResult
     if m == 0 or all(md.tool_compensation == "G40"
                      for md in {id(b.modal): b.modal for b in blocks}.values()):
         return TrcResult(path)
-    comp = [blocks[int(b)].tool_compensation for b in path.block]
+    comp = [blocks[b].modal.tool_compensation for b in path.block.tolist()]
     runs: list[tuple[list[int], int | None]] = []
     j = 0
     while j < m:
@@ -433,7 +433,6 @@ class _Builder:
                                           "while compensation is active; not modelled: "
                                           "program G40 first")
         u, v = (self.index[a] for a in _PLANES[plane])
-        self.u, self.v = u, v
         els = self._elements(run, u, v)
         if r <= 0.0:                     # D0 or a zero radius: the contour itself
             for j in run:
@@ -772,7 +771,7 @@ class _Builder:
         arcs: list[tuple] = []
         starts, stops = q0.tolist(), q1.tolist()
         row_of = {int(j): i for i, j in enumerate(js.tolist())}
-        plane_of = {}
+        plane_of: dict[str, tuple[int, int]] = {}
         for j in range(m):
             specs = self.rows.get(j)
             if specs is None:
@@ -780,9 +779,10 @@ class _Builder:
                 copy_dst.append(len(owner))
                 owner.append(j)
                 continue
-            blk_mod = self.program.blocks[int(path.block[j])].plane
-            pu, pv = plane_of.get(blk_mod) or plane_of.setdefault(
-                blk_mod, tuple(self.index[a] for a in _PLANES[blk_mod]))
+            plane = self.program.blocks[int(path.block[j])].plane
+            if plane not in plane_of:
+                plane_of[plane] = tuple(self.index[a] for a in _PLANES[plane])
+            pu, pv = plane_of[plane]
             qs, qe = starts[row_of[j]], stops[row_of[j]]
             for spec in specs:
                 row = len(owner)

@@ -325,6 +325,32 @@ def test_840c_md6_switches_by_the_distance_ac(mode, md6, expect, n_trc):
     assert _continuous(st.path)
 
 
+@pytest.mark.parametrize("kink, mode, expect", [
+    (5.0, "G450", "joined (840C: AC < MD6, 170..180 degrees, contour error)"),
+    (20.0, "G450", "circle (840C: AC < MD6, no usable intersection)"),
+    (20.0, "G451", "tangent lines (840C: AC < MD6, no usable intersection)"),
+])
+def test_840c_md6_where_the_intersection_is_too_far(monkeypatch, kink, mode, expect):
+    """840C excerpt: "If there is no intersection or the intersection is located too far
+    from the contour (> 1.5 tool radius), intermediate blocks are again inserted in the
+    angular range 90 < alpha < 170 ... In the angular range 170 < alpha < 180 the normal
+    circular block is approached ... The correct compensation is not reached until the
+    end (E) of the block." Arc corners keep their intersection within 1.5 r, so the
+    reach is set to 0 here to take that branch."""
+    import reference.trc as trc
+    monkeypatch.setattr(trc, "MD6_INTERSECTION_REACH", 0.0)
+    prog, st = _stages(_line_arc_program(mode, kink), _machine(CUTCOM_840C_MD6=10.0))
+    (corner,) = [c for c in st.trc.corners if c.side == "outside"]
+    assert corner.action == expect
+    assert _continuous(st.path)
+    if expect.startswith("joined"):
+        # the arc starts at A = (50, -5), the end of the line's offset, and ends on its
+        # offset circle (radius 25): a spiral, no inserted block
+        (arc,) = _segments_of_lines(prog, st.path, (6,))
+        q = st.path.evaluate(st.path.s_breaks[arc], segment=np.array([arc]))[0][0, :2]
+        assert np.allclose(q, (50.0, -R), atol=TOL) and st.path.dradius[arc] != 0
+
+
 def test_without_md6_the_same_corner_is_a_g450_circle():
     prog, st = _stages(_line_arc_program("G450", 20.0))
     (corner,) = [c for c in st.trc.corners if c.side == "outside"]
