@@ -208,3 +208,20 @@ def test_the_tangential_axis_limits_the_path_speed_on_a_small_arc():
     assert row.v_peak <= cap * (1 + 1e-6)
     assert row.v_peak >= 0.95 * cap                          # and it runs at it
     assert row.time_s >= row.length_mm / cap
+
+
+def test_without_tlift_the_corner_speed_accounts_for_the_following_axis():
+    """10: without TLIFT "FAxis is a path-synchronous axis: its velocity jump enters the
+    G64 overload check". A 90 degree corner before a 10 mm line: C turns 90 degrees over
+    that line (9 deg/mm), so crossing the corner at v steps C's velocity by 9 v deg/s;
+    the allowance A (ovl - 1) T_ipo of C is 720 deg/s^2 * 0.2 * 0.004 s = 0.576 deg/s,
+    hence v <= 0.064 mm/s; without tangential control X and Y allow 1.6 mm/s (by hand,
+    default machine: 2 m/s^2, 1.2, 4 ms)."""
+    m = load_machine()
+    body = "G1 X10 Y0 F3000\nX10 Y10\nM30\n"
+    for text, cap in ((TANG.format(k=1, off=0) + body, 0.576 / 9.0), (body, 1.6)):
+        prog = parse_text(text, "t.mpf")
+        res = plan(prog, m, path=build_path(prog, m))
+        (first,) = [r for r in res.blocks if r.line == text.splitlines().index(
+            "G1 X10 Y0 F3000") + 1]
+        assert first.v_exit == pytest.approx(cap, rel=1e-6)
