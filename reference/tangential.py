@@ -142,17 +142,16 @@ def tangential_path(path: Path, program: Program, machine: Machine) -> Tangentia
         plane (names the line).
     """
     blocks = program.blocks
-    # consecutive blocks share one modal state: look at each distinct one once, and at
+    # consecutive blocks share one modal state: look at each change of it once, and at
     # each tangential record with the first block that uses it (for messages)
-    seen: set[int] = set()
     firsts: dict = {}
+    prev = None
     for b in blocks:
         md = b.modal
-        if id(md) in seen:
-            continue
-        seen.add(id(md))
-        if md.tangential is not None and md.tangential not in firsts:
-            firsts[md.tangential] = b
+        if md is not prev:
+            prev = md
+            if md.tangential is not None and md.tangential not in firsts:
+                firsts[md.tangential] = b
     if path.n_segments == 0 or not firsts:
         return TangentialResult(path)
     corners: list[TangentialCorner] = []
