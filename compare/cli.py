@@ -65,6 +65,11 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         out.write(f"path stages: not evaluated ({exc})\n")
         stages = None
     if stages is not None:
+        final = stages.path
+        if stages.trc.blocks or stages.tangential.corners:
+            out.write(f"path both planners run on: {final.n_segments} segments, "
+                      f"{final.total_length:.3f} mm (after tool radius compensation, "
+                      "tangential control and rounding)\n")
         _write_trc(out, program, stages)
         _write_tangential(out, program, stages)
         _write_rounding(out, program, stages.path.rounding)
