@@ -19,6 +19,7 @@ from typing import Any
 from .core.errors import MachineDataError
 from .core.limits import AxisLimits, MachineLimits
 from .core.units import m_to_mm, mm_min_to_mm_s, rev_to_deg
+from .tools import EMPTY_TOOLS, ToolTable, tools_from_toml
 
 DEFAULT_MACHINE = "default"
 BUNDLED_MACHINES = ("default", "linuxcnc_xyz")
@@ -61,6 +62,10 @@ _CHANNEL_KEYS: dict[str, _Key] = {
     "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465", 1e-6),
     "SMOOTH_ORI_TOL": _Key((int, float), "deg", 0.0, 90.0, "SD42466", 1e-6),
     "CUTCOM_CORNER_LIMIT": _Key((int, float), "deg", 0.0, 180.0, "MD20210", 1e-3),
+    "CUTCOM_CURVE_INSERT_LIMIT": _Key((int, float), "deg", -1e-12, 180.0, "MD20230"),
+    "CUTCOM_MAX_DISC": _Key((int, float), "", -1e-12, 100.0, "MD20220 (0..100)"),
+    "CUTCOM_840C_MD6": _Key((int, float), "mm", -1e-12, 100.0,
+                            "840C MD6 TRC switch-over threshold, 0 = off"),
     "acceleration_mode": _Key(str, "", doc="BRISK | SOFT"),
     "MAX_PATH_JERK": _Key((int, float), "m/s^3", 0.0, 1e6, "MD20600", 1e-3),
     "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560", 1e-3),
@@ -177,7 +182,16 @@ class ChannelSettings:
     smooth_ori_tol_deg : float
         SD42466 SMOOTH_ORI_TOL, degrees.
     cutcom_corner_limit_deg : float
-        MD20210 CUTCOM_CORNER_LIMIT, degrees.
+        MD20210 CUTCOM_CORNER_LIMIT, degrees: at outside corners whose deflection (the
+        change of direction) exceeds it, G451 switches to G450 (sinumerik-model 9).
+    cutcom_curve_insert_limit_deg : float
+        MD20230 CUTCOM_CURVE_INSERT_LIMIT, degrees: outside corners whose deflection is
+        below it get the intersection instead of a transition circle (default 10 [M]).
+    cutcom_max_disc : float
+        MD20220 CUTCOM_MAX_DISC: the largest DISC value accepted (default 50 [M]).
+    cutcom_840c_md6_mm : float
+        Emulate the 840C's MD6 rule at outside corners with arcs (sinumerik-model 9 and
+        the 840C excerpt), threshold in mm; 0 = off (840D behaviour).
     acceleration_mode : {"BRISK", "SOFT"}
         Default group-21 mode.
     max_path_jerk : float
@@ -196,6 +210,9 @@ class ChannelSettings:
     smooth_contour_tol_mm: float = 0.05
     smooth_ori_tol_deg: float = 1.0
     cutcom_corner_limit_deg: float = 100.0
+    cutcom_curve_insert_limit_deg: float = 10.0
+    cutcom_max_disc: float = 50.0
+    cutcom_840c_md6_mm: float = 0.0
     acceleration_mode: str = "SOFT"
     max_path_jerk: float = 1e8
     g0_tolerance_factor: float = 3.0
@@ -218,6 +235,9 @@ class Machine:
         Channel machine data.
     axis_settings : tuple[tuple[str, AxisSettings], ...]
         Per-axis settings by axis name.
+    tools : ToolTable
+        Tool radii per tool and cutting edge (``[tools]``, and a LinuxCNC tool table
+        given with ``--tool-table``), for tool radius compensation.
     """
 
     name: str
@@ -225,6 +245,7 @@ class Machine:
     limits: MachineLimits
     channel: ChannelSettings
     axis_settings: tuple[tuple[str, AxisSettings], ...]
+    tools: ToolTable = EMPTY_TOOLS
 
     def settings_of(self, axis: str) -> AxisSettings:
         """Per-axis settings by axis name (defaults for an unknown axis)."""
@@ -286,7 +307,8 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
     Parameters
     ----------
     data : dict
-        The TOML document as a dict (sections ``machine``, ``channel``, ``axis.<NAME>``).
+        The TOML document as a dict (sections ``machine``, ``channel``, ``axis.<NAME>``,
+        ``tools``: see :mod:`reference.tools`).
     source : str
         Where it came from, for messages.
 
@@ -300,9 +322,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         Unknown section or key, wrong type, non-positive or implausible value.
     """
     for sec in data:
-        if sec not in ("machine", "channel", "axis"):
+        if sec not in ("machine", "channel", "axis", "tools"):
             raise MachineDataError(sec, data[sec], "unknown section; expected [machine], "
-                                   "[channel] and [axis.<NAME>]", source)
+                                   "[channel], [axis.<NAME>] and [tools]", source)
     for sec in ("machine", "channel"):
         if sec in data and not isinstance(data[sec], dict):
             raise MachineDataError(sec, data[sec], f"must be a table: a [{sec}] section with "
@@ -347,6 +369,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         smooth_contour_tol_mm=float(ch.get("SMOOTH_CONTUR_TOL", 0.05)),
         smooth_ori_tol_deg=float(ch.get("SMOOTH_ORI_TOL", 1.0)),
         cutcom_corner_limit_deg=float(ch.get("CUTCOM_CORNER_LIMIT", 100.0)),
+        cutcom_curve_insert_limit_deg=float(ch.get("CUTCOM_CURVE_INSERT_LIMIT", 10.0)),
+        cutcom_max_disc=float(ch.get("CUTCOM_MAX_DISC", 50.0)),
+        cutcom_840c_md6_mm=float(ch.get("CUTCOM_840C_MD6", 0.0)),
         acceleration_mode=mode,
         max_path_jerk=m_to_mm(float(ch.get("MAX_PATH_JERK", 1e5))),
         g0_tolerance_factor=float(ch.get("G0_TOLERANCE_FACTOR", 3.0)),
@@ -408,8 +433,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             raise MachineDataError(f"axis.{geo}", None, "geometry axes X, Y and Z are "
                                    "required", source)
     limits = MachineLimits(axes=tuple(axes), t_ipo_s=t_ipo, name=name)
+    tools = tools_from_toml(data["tools"], source) if "tools" in data else EMPTY_TOOLS
     return Machine(name=name, source=source, limits=limits, channel=channel,
-                   axis_settings=tuple(settings))
+                   axis_settings=tuple(settings), tools=tools)
 
 
 def _decode(data: bytes, source: str) -> str:

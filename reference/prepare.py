@@ -37,7 +37,7 @@ planner (:mod:`reference.planner.stops`), not to the path.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,6 +50,8 @@ from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_M
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 from .rounding import round_corners
+from .tangential import TangentialResult, tangential_path
+from .trc import TrcResult, compensate_path
 
 #: Stop reason where geometry axes move in one block only (sinumerik-model 5.2).
 GEOMETRY_AXES_STOP = "geometry axes move in one block only"
@@ -267,9 +269,12 @@ def _exact_path_stops(path: Path, program: Program) -> Path:
 
 
 def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
-    """Warnings for programmed features the path does not apply yet (TRC, TANG), or that
-    one side of the comparison does not know (DRIVE: the heuristic reduces the
-    acceleration above the knee, the oracle does not).
+    """Warnings for programmed features one side of the comparison does not know.
+
+    Tool radius compensation (:mod:`reference.trc`) and tangential control
+    (:mod:`reference.tangential`) are applied by :func:`build_path`; what they cannot
+    model is an error there, naming the line. DRIVE: the heuristic reduces the
+    acceleration above the knee, the oracle does not.
 
     Parameters
     ----------
@@ -281,16 +286,6 @@ def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
         At most one warning per feature, naming the first line that uses it.
     """
     out: list[ProgramWarning] = []
-    trc = next((b for b in program.blocks if b.tool_compensation != "G40"), None)
-    if trc is not None:
-        out.append(ProgramWarning(program.file, trc.line,
-                                  f"tool radius compensation {trc.tool_compensation} is not "
-                                  "applied: the path is the programmed contour"))
-    tang = next((b for b in program.blocks if b.tangential is not None), None)
-    if tang is not None:
-        out.append(ProgramWarning(program.file, tang.line,
-                                  "tangential control is not applied: the following axis "
-                                  "moves only as programmed"))
     drive = next((b for b in program.blocks if b.accel_mode == "DRIVE"), None)
     if drive is not None:
         out.append(ProgramWarning(program.file, drive.line,
@@ -357,9 +352,10 @@ def build_path(program: Program, machine: Machine) -> Path:
     The heuristic (:func:`reference.planner.plan`), the oracle's callers and the
     comparison all take their path from here, so the gap measures velocity planning
     alone (DESIGN section 1): the programmed contour (:func:`prepare`) over the axes the
-    machine knows (:func:`restrict_to_machine`), with the corners of blocks in
-    G641..G645 rounded (:func:`reference.rounding.round_corners`); tool radius
-    compensation, once modelled, belongs here too.
+    machine knows (:func:`restrict_to_machine`), then the stages in the control's order
+    (DESIGN section 5): tool radius compensation (:func:`reference.trc.apply_trc`),
+    tangential control (:func:`reference.tangential.apply_tangential`) and the corner
+    rounding of blocks in G641..G645 (:func:`reference.rounding.round_corners`).
 
     Parameters
     ----------
@@ -377,12 +373,42 @@ def build_path(program: Program, machine: Machine) -> Path:
     PathError
         Arc geometry out of tolerance (names file and line).
     MachineDataError
-        The program moves an axis the machine has no limits for (names axis and line).
+        The program moves an axis the machine has no limits for, or tangential control
+        turns one (names axis and line).
+    PathError
+        Tool radius compensation or tangential control cannot build the path: a missing
+        tool radius, the tool does not fit (the control's collision alarm), a model limit
+        (names file and line).
     """
+    return path_stages(program, machine).path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PathStages:
+    """The stages of :func:`build_path` with what each decided (for ``inspect``).
+
+    Attributes
+    ----------
+    trc : reference.trc.TrcResult
+        Tool radius compensation: the compensated path, its blocks and corners.
+    tangential : reference.tangential.TangentialResult
+        Tangential control: the path with the following axes, their corners.
+    path : Path
+        The final path (after rounding; its ``rounding`` table says what was rounded).
+    """
+
+    trc: TrcResult
+    tangential: TangentialResult
+    path: Path
+
+
+def path_stages(program: Program, machine: Machine) -> PathStages:
+    """:func:`build_path` with the result of every stage kept (same path, same errors)."""
     path = restrict_to_machine(prepare(program), machine.limits)
     _check_motion_times(path)
-    path = round_corners(path, program, machine)
-    return path
+    trc = compensate_path(path, program, machine)
+    tang = tangential_path(trc.path, program, machine)
+    return PathStages(trc, tang, round_corners(tang.path, program, machine))
 
 
 def _check_motion_times(path: Path) -> None:
@@ -403,5 +429,6 @@ def _check_motion_times(path: Path) -> None:
                         f"resolution); raise the feed or split the block", worst)
 
 
-__all__ = ["GEOMETRY_AXES_STOP", "build_path", "prepare", "require_axes",
+__all__ = ["GEOMETRY_AXES_STOP", "PathStages", "build_path", "path_stages", "prepare",
+           "require_axes",
            "restrict_to_machine", "unmodelled_features", "KIND_CODES"]
