@@ -151,7 +151,8 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         raise ValueError(f"unknown bound set {reference.bound_set!r}; "
                          f"known: {', '.join(BOUND_SETS)}")
     ref_prof = reference.profile
-    ref_report = reference.report or check_profile(path, limits, ref_prof)
+    ref_report = reference.report or check_profile(path, limits, ref_prof,
+                                                   steps=reference.steps)
     opt_prof = oracle.profile
     opt_report = check_profile(path, limits, opt_prof) if opt_prof is not None else None
 

@@ -20,6 +20,7 @@ from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import BlockRow
+from reference.core.rules import STEPS_AT_BREAKS
 from reference.core.tolerances import RATIO_TOL
 
 #: Kinds of blocks the planner inserts (they have no NC line of their own).
@@ -51,6 +52,9 @@ class Side:
     ratio_tol : float
         A constraint counts as violated above ``1 + ratio_tol``: ``RATIO_TOL`` for
         computed profiles, more for measured ones (see :mod:`compare.recorded`).
+    steps : str
+        Where its acceleration may step (``check_profile``'s ``steps``): ``"breaks"``
+        for a planned motion, ``"spread"`` for a recording sampled at the IPO cycle.
     """
 
     name: str
@@ -59,6 +63,7 @@ class Side:
     causes: Mapping[int, str] | None = None
     report: ConstraintReport | None = None
     ratio_tol: float = RATIO_TOL
+    steps: str = STEPS_AT_BREAKS
 
 
 @dataclass(frozen=True, slots=True)

@@ -29,6 +29,7 @@ from typing import Callable, TextIO
 import numpy as np
 
 from reference.core.constraints import BOUND_SETS
+from reference.core.rules import STEPS_SPREAD
 from reference.core.errors import TrajectoryError
 from reference.core.geometry import Path
 from reference.core.holds import with_holds
@@ -269,7 +270,7 @@ def check_recorded(file: str | FsPath, program: Program, machine: Machine, *,
                      f"{100 * info['scale']:.2f} % to put each of them in place; the "
                      f"recording may not follow this path closely.")
     c = compare_profiles(path, limits, Side("recorded", prof, bound_set,
-                                            ratio_tol=tol),
+                                            ratio_tol=tol, steps=STEPS_SPREAD),
                          oracle_result(sol), program=program.file, machine=machine.name,
                          program_lines=tuple(program.lines), notes=notes)
     max_dev = max_deviation if max_deviation is not None else max(

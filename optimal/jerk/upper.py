@@ -4,11 +4,10 @@
    (:func:`optimal.problem.build_grid_problem`, solved by the fast sweep), slowed to
    :data:`~optimal.jerk.tolerances.WARM_START_SPEED_FRACTION` of its speed.
 2. *NLP*: :func:`optimal.jerk.backends.solve_nlp` (CasADi + IPOPT).
-3. *Exact profile*: node speeds and interval durations are kept; on every interval the
-   start acceleration and the constant jerk are re-solved from the two integration
-   equalities, so positions and speeds meet the knots exactly
-   (:class:`~reference.core.profile.Profile` checks both). The acceleration then steps
-   at knots by the solver's residual only (1e-9 of the acceleration unit).
+3. *Exact profile*: node positions, speeds and accelerations and interval durations
+   are kept, the jerk of each interval runs its acceleration from one node value to the
+   next, so the acceleration is continuous at every knot inside a segment, as the
+   rulebook asks (:func:`exact_profile`).
 4. *Verification*: ``check_profile`` judges the profile under ``BOUND_SETS["jerk"]``;
    what the nodes missed (jerk and acceleration between nodes on arcs, the speed peak
    inside an interval) is repaired by stretching time
@@ -129,20 +128,29 @@ def _row_excess(problem: JerkProblem, c: np.ndarray, a: np.ndarray, dt: np.ndarr
     return lam
 
 
-def exact_profile(problem: JerkProblem, c: np.ndarray, dt: np.ndarray,
-                  block: np.ndarray) -> Profile:
-    """The piecewise-constant-jerk profile through node speeds ``c`` and durations ``dt``.
+def exact_profile(problem: JerkProblem, c: np.ndarray, a: np.ndarray, a_end: np.ndarray,
+                  dt: np.ndarray, block: np.ndarray) -> Profile:
+    """The piecewise-constant-jerk profile of an NLP solution.
 
-    On interval ``k`` (length ``D``, duration ``h``) the start acceleration ``a`` and
-    jerk ``j`` solve ``a h + j h^2 / 2 = c_{k+1} - c_k`` and
-    ``a h^2 / 2 + j h^3 / 6 = D - c_k h`` exactly.
+    On interval ``k`` the acceleration runs linearly from the node value ``a_k`` to the
+    interval's end value ``e_k`` (``= a_{k+1}`` except at segment breaks, where the NLP
+    has a separate variable for the step), so the jerk is ``(e_k - a_k) / dt_k`` and the
+    acceleration is continuous at every knot inside a segment exactly as the rulebook
+    asks (:data:`reference.core.rules.STEPS_AT_BREAKS`). Node positions and speeds are
+    the NLP's; the constant-jerk motion from each knot reaches the next one up to the
+    NLP's residual of the integration equalities (:data:`optimal.jerk.tolerances.IPOPT_TOL`
+    in scaled units), far inside :class:`~reference.core.profile.Profile`'s consistency
+    tolerance; the checker judges the motion from each knot.
 
     Parameters
     ----------
     problem : JerkProblem
         For the grid and the units.
-    c : numpy.ndarray, shape (N + 1,)
-        Dimensionless node speeds (clipped to ``[0, c_max]``).
+    c, a : numpy.ndarray, shape (N + 1,)
+        Dimensionless node speeds (clipped to ``[0, c_max]``) and accelerations (on
+        leaving the node).
+    a_end : numpy.ndarray, shape (N,)
+        Dimensionless acceleration at the end of every interval.
     dt : numpy.ndarray, shape (N,)
         Dimensionless durations (> 0).
     block : numpy.ndarray of int, shape (N,)
@@ -157,13 +165,10 @@ def exact_profile(problem: JerkProblem, c: np.ndarray, dt: np.ndarray,
     c = np.clip(c, 0.0, problem.c_max)
     h = dt * u.time_s
     v = c * u.speed
-    D = np.diff(problem.grid.s)
-    X = v[1:] - v[:-1]
-    Y = D - v[:-1] * h
-    a = (6.0 * Y - 2.0 * X * h) / (h * h)
-    j = 2.0 * (X - a * h) / (h * h)
+    a0 = a[:-1] * u.accel
+    j = (a_end * u.accel - a0) / h
     t = np.concatenate(([0.0], np.cumsum(h)))
-    return Profile(t=t, s=problem.grid.s, v=v, a=a, j=j, block=block)
+    return Profile(t=t, s=problem.grid.s, v=v, a=a0, j=j, block=block)
 
 
 def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperResult:
@@ -191,7 +196,7 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperRes
         return UpperResult(False, None, 1.0, np.inf, None, nlp, problem, empty,
                            f"IPOPT: {nlp.message} after {nlp.iterations} iterations")
     block = path.block[grid.segment]
-    prof = exact_profile(problem, nlp.c, nlp.dt, block)
+    prof = exact_profile(problem, nlp.c, nlp.a, nlp.a_end, nlp.dt, block)
     report = check_profile(path, limits, prof)
     lam = time_scale_factor(report, BOUND_SETS["jerk"])
     if not np.isfinite(lam):

@@ -19,16 +19,26 @@ Constraints (:data:`CONSTRAINTS`)
     per axis ``|q'_i s'' + q''_i v^2| <= a_max_i`` (tangential plus centripetal part).
 ``jerk``
     per axis ``|q'_i s''' + 3 q''_i v s'' + q'''_i v^3| <= j_max_i`` inside intervals,
-    **plus acceleration steps**: wherever an axis acceleration ``A_i`` steps (a knot
-    where the path acceleration jumps, a segment break where the tangent or the
-    curvature vector jumps while moving, the start and end of the profile, whose
-    surroundings are taken to be at rest with zero acceleration), the control spreads
-    the step over one IPO cycle (sinumerik-model 6.3), so the step counts as the jerk
-    ``|delta A_i| / t_ipo``, ``A_i = q'_i s'' + q''_i v^2`` on each side. It is judged
-    against ``path_trans_jerk_i`` (MD32432) at a segment break where the curvature
-    vector jumps (:func:`reference.core.rules.curvature_jumps`) while the
-    path moves (``v > VEL_TOL_MM_S``), and against ``j_max_i`` everywhere else. BRISK profiles (acceleration steps by design)
-    therefore show large jerk ratios; that is expected, their bound set has no jerk.
+    **plus acceleration steps** (the rulebook, :data:`reference.core.rules.STEPS_AT_BREAKS`):
+    where the geometry makes an axis acceleration ``A_i = q'_i s'' + q''_i v^2`` step
+    (a segment break where the tangent or the curvature vector jumps, the start and end
+    of the profile, whose surroundings are taken to be at rest with zero acceleration)
+    the control spreads the step over one IPO cycle (sinumerik-model 6.3), so it counts
+    as the jerk ``|delta A_i| / t_ipo``, judged against ``path_trans_jerk_i`` (MD32432)
+    at a segment break where the curvature vector jumps
+    (:func:`reference.core.rules.curvature_jumps`) while the path moves
+    (``v > VEL_TOL_MM_S``) and against ``j_max_i`` everywhere else (a knot within the
+    position tolerance of a break counts as at the break). Inside a segment a
+    jerk-limited motion has a continuous acceleration: the steps at its other knots,
+    summed per segment and axis, must stay within
+    ``ACCEL_CONTINUITY_TOL_REL * j_max_i * t_ipo`` (round-off; the value reported is that
+    sum over ``t_ipo``, the limit ``ACCEL_CONTINUITY_TOL_REL * j_max_i``). Without this, a
+    profile with many knots could build up acceleration in steps, each within the
+    one-cycle allowance, faster than any jerk-limited motion. A recording sampled at the
+    IPO cycle is judged with ``steps="spread"`` instead
+    (:data:`reference.core.rules.STEPS_SPREAD`): every knot's step counts as
+    ``|delta A_i| / t_ipo``. BRISK profiles (acceleration steps by design) show large jerk
+    ratios; that is expected, their bound set has no jerk.
 ``feed``
     path speed ``v <= F`` of the segment (``F = inf`` for G0: nothing to check). ``s``
     is the arc length of the geometry axes, or of the moving axes where only extra
@@ -104,9 +114,11 @@ from .errors import ProfileError
 from .geometry import Path, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
-from .rules import (axis_acceleration, axis_jerk, axis_velocity, axis_velocity_jumps,
-                    curvature_jumps, jump_ratio, step_jerk_limit)
-from .tolerances import MOVING_AXIS_TOL, POS_TOL_MM, RATIO_TOL, VEL_TOL_MM_S
+from .rules import (STEPS_AT_BREAKS, STEPS_SPREAD, axis_acceleration, axis_jerk,
+                    axis_velocity, axis_velocity_jumps, curvature_jumps, jump_ratio,
+                    step_jerk_limit)
+from .tolerances import (ACCEL_CONTINUITY_TOL_REL, MOVING_AXIS_TOL, POS_TOL_MM, RATIO_TOL,
+                         VEL_TOL_MM_S)
 
 __all__ = ["BOUND_SETS", "CONSTRAINTS", "ConstraintReport", "ConstraintResult", "UNITS",
            "check_profile", "scale_time", "time_scale_factor"]
@@ -336,7 +348,8 @@ class _Ctx:
     n_blocks: int
 
 
-def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> ConstraintReport:
+def check_profile(path: Path, limits: MachineLimits, profile: Profile, *,
+                  steps: str = STEPS_AT_BREAKS) -> ConstraintReport:
     """Judge a profile against the machine limits on its path.
 
     Parameters
@@ -347,6 +360,11 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
         Machine limits; must define every axis of the path.
     profile : Profile
         The motion ``s(t)``; its knots must span ``[0, path.total_length]`` (mm).
+    steps : {"breaks", "spread"}
+        Where the path acceleration may step
+        (:data:`~reference.core.rules.STEPS_AT_BREAKS` for planned motions, the
+        default; :data:`~reference.core.rules.STEPS_SPREAD` for a recording sampled at
+        the IPO cycle); see ``jerk`` in the module docstring.
 
     Returns
     -------
@@ -361,6 +379,9 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
     MachineDataError
         ``limits`` lacks an axis of the path.
     """
+    if steps not in (STEPS_AT_BREAKS, STEPS_SPREAD):
+        raise ValueError(f"steps must be {STEPS_AT_BREAKS!r} or {STEPS_SPREAD!r}, "
+                         f"got {steps!r}")
     lim = limits.for_axes(path.axes)
     # judge the axes that move (exact: the others have zero derivatives everywhere, so
     # every ratio of theirs is 0); a 2-D contour on an XYZ machine samples two columns
@@ -387,7 +408,7 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile) -> Constr
         seg = path.segment_index(0.5 * (prof.s[:-1] + prof.s[1:]))
         ctx = _Ctx(path, lim, limits.t_ipo_s, prof, h, seg, n_blocks)
         _check_intervals(ctx, worst)
-        _check_steps(ctx, jerk_step)
+        _check_steps(ctx, jerk_step, steps)
         _check_breaks(ctx, worst)
         _check_frequency(ctx, worst["frequency"])
     else:
@@ -650,11 +671,22 @@ def _axis_acc_at_knots(ctx: _Ctx, kn: np.ndarray, side: str) -> np.ndarray:
     return np.where(valid[:, None], acc, 0.0), ddq, valid, seg
 
 
-def _check_steps(ctx: _Ctx, w: _Worst) -> None:
-    """Axis acceleration steps at knots, spread over one IPO cycle (jerk)."""
+def _check_steps(ctx: _Ctx, w: _Worst, steps: str) -> None:
+    """Axis acceleration steps at knots (jerk; the rule in the module docstring).
+
+    ``steps = "breaks"``: a step at a segment break or a path end counts as the jerk
+    ``|delta A| / t_ipo``; at every other knot the acceleration is continuous, and the
+    steps there, summed per segment and axis, count against
+    ``ACCEL_CONTINUITY_TOL_REL * j_max * t_ipo``. ``steps = "spread"``: every knot's
+    step counts as ``|delta A| / t_ipo`` (a recording sampled at the IPO cycle).
+    """
     p, path, lim = ctx.prof, ctx.path, ctx.lim
     K = p.n_intervals
     knots = np.arange(K + 1)
+    win = POS_TOL_MM * max(1.0, path.total_length)
+    n = len(path.axes)
+    inner_sum = np.zeros((path.n_segments, n))     # summed inner steps per segment, axis
+    inner_max = np.zeros(path.n_segments)           # largest single inner step (to place)
     for lo, hi in _chunks(np.full(K + 1, 4)):
         kn = knots[lo:hi]
         acc_l, ddq_l, val_l, seg_l = _axis_acc_at_knots(ctx, kn, "left")
@@ -666,7 +698,42 @@ def _check_steps(ctx: _Ctx, w: _Worst) -> None:
         val = step / ctx.t_ipo
         # the block the motion is in just before the knot (the first block at the start)
         blk = path.block[np.where(val_l, seg_l, seg_r)]
-        w.update(val / jlim, val, jlim, p.s[kn], p.t[kn], blk, path.axes)
+        if steps == STEPS_SPREAD:
+            w.update(val / jlim, val, jlim, p.s[kn], p.t[kn], blk, path.axes)
+            continue
+        s_k = p.s[kn]
+        nb = np.clip(np.searchsorted(path.s_breaks, s_k), 1, path.n_segments)
+        near = np.minimum(np.abs(s_k - path.s_breaks[nb - 1]),
+                          np.abs(path.s_breaks[nb] - s_k)) <= win
+        at_break = ~val_l | ~val_r | (seg_l != seg_r) | near
+        if np.any(at_break):
+            b = at_break
+            w.update(val[b] / jlim[b], val[b], jlim[b], s_k[b], p.t[kn][b], blk[b],
+                     path.axes)
+        inner = ~at_break
+        if np.any(inner):
+            np.add.at(inner_sum, seg_l[inner], step[inner])
+            np.maximum.at(inner_max, seg_l[inner], step[inner].max(axis=1))
+    if steps == STEPS_SPREAD or not np.any(inner_sum):
+        return
+    # continuity inside segments: one row per segment (placed at its largest step)
+    tol = ACCEL_CONTINUITY_TOL_REL * lim.j_max[None, :] * ctx.t_ipo
+    ratio = inner_sum / tol
+    segs = np.flatnonzero(inner_max > 0)
+    where_s = np.empty(segs.size)
+    where_t = np.empty(segs.size)
+    for lo, hi in _chunks(np.full(K + 1, 4)):
+        kn = knots[lo:hi]
+        acc_l, _, val_l, seg_l = _axis_acc_at_knots(ctx, kn, "left")
+        acc_r, _, val_r, seg_r = _axis_acc_at_knots(ctx, kn, "right")
+        big = np.abs(acc_r - acc_l).max(axis=1)
+        hit = val_l & val_r & (seg_l == seg_r) & (big == inner_max[seg_l]) & (big > 0)
+        idx = np.searchsorted(segs, seg_l[hit])
+        where_s[idx] = p.s[kn][hit]
+        where_t[idx] = p.t[kn][hit]
+    w.update(ratio[segs], inner_sum[segs] / ctx.t_ipo,
+             np.broadcast_to(ACCEL_CONTINUITY_TOL_REL * lim.j_max, (segs.size, n)),
+             where_s, where_t, path.block[segs], path.axes)
 
 
 def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:

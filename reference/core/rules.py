@@ -23,6 +23,17 @@ junction velocity jump (MD32310)
     *feasible* cap (every speed at or below it passes the checker, with a round-off
     margin) and the *relaxed* cap (no speed above it passes the checker). A lower bound
     uses the relaxed one, a planner that must pass the checker the feasible one.
+acceleration steps (jerk)
+    A jerk-limited motion planned along the path (:data:`STEPS_AT_BREAKS`) may step its
+    axis accelerations only where the geometry forces it: at a segment break (the
+    tangent or the curvature vector jumps) and at the path ends (the surroundings rest
+    with zero acceleration), each step spread over one IPO cycle and held to
+    ``Jstep_i T_ipo`` (:func:`step_jerk_limit`); inside a segment its acceleration is
+    continuous up to round-off (:data:`~reference.core.tolerances.ACCEL_CONTINUITY_TOL_REL`).
+    The jerk lower bound (:mod:`optimal.jerk.lower`) is proved for exactly this class,
+    and the checker judges planned profiles by it. A trajectory *sampled* at the IPO cycle
+    (a recording, :data:`STEPS_SPREAD`) steps at every sample; there each step counts as
+    the jerk ``|delta A_i| / T_ipo``.
 curvature jump
     A break has a curvature jump when some component of ``q''`` differs by more than
     :data:`~reference.core.tolerances.CURVATURE_JUMP_TOL_PER_MM` across it; then the
@@ -43,6 +54,12 @@ from .tolerances import (CURVATURE_JUMP_TOL_PER_MM, RATIO_TOL, ROUNDOFF_MARGIN_R
 #: The two flavours of a cap derived from a checker rule (see :func:`junction_speed_cap`).
 FEASIBLE = "feasible"
 RELAXED = "relaxed"
+
+#: Where a planned motion's acceleration may step: segment breaks and path ends only
+#: (module docstring, "acceleration steps").
+STEPS_AT_BREAKS = "breaks"
+#: A trajectory sampled at the IPO cycle: every sample's step is a jerk spread over it.
+STEPS_SPREAD = "spread"
 
 
 # ============================================================================ tangency

@@ -74,3 +74,12 @@ MOVING_AXIS_TOL = 1e-9
 #: 2e-6 s, longer than its own braking phase, and its profile no longer integrates.
 #: Same bound as the longest dwell (reference.nc.state.MAX_DWELL_S).
 MAX_BLOCK_MOTION_S = 1e6
+
+#: Axis acceleration steps at the knots inside a segment, summed per segment and axis,
+#: that a jerk-limited planned motion may carry as round-off, as a fraction of the
+#: one-cycle allowance ``j_max * t_ipo`` (reference.core.rules, "acceleration steps").
+#: The heuristic's S-curves show at most 2e-8 mm/s^2 per knot (their knots recompute
+#: the acceleration from closed forms), against 1e-8 * 40 m/s^3 * 4 ms = 1.6e-6 mm/s^2
+#: on the default mill; the jerk lower bound allows for it (optimal.jerk.lower), where
+#: it moves the bound by about 1e-10 relative.
+ACCEL_CONTINUITY_TOL_REL = 1e-8
