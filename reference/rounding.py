@@ -35,6 +35,9 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    * clamp: ``d <= c min(L1, L2)`` with ``c = rounding_length_clamp`` (0.5: "the
      rounding distance cannot exceed half the length of the original participating
      blocks", the G644 excerpt; 5.3); ``d`` at or below MIN_SEGMENT_LENGTH_MM: too small;
+     with G642/G645 the window may reach across short blocks that continue the same
+     straight line, ``L1``, ``L2`` then being those straight chains
+     (:func:`_across_blocks`; the blocks it covers whole are no longer interpolated);
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
    junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
    and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
@@ -48,8 +51,11 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 Model limits, stated: the rounding is a tangent arc (G1 continuous, curvature jump
 ``1/R`` at both ends), also for G642/G645 where the control inserts a smoother polynomial;
 G643/G644 insert the same segment (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions with curvature jumps and rounding across
-several short blocks are not modelled.
+G645's rounding of tangential transitions with curvature jumps is not modelled; a window
+reaches across short blocks only along a straight chain (several corners closer than
+their windows are rounded one by one, each clamped), and tangential transitions between
+short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
+which would merge them, are not modelled), so each such block keeps its own IPO cycle.
 """
 
 from __future__ import annotations
@@ -69,6 +75,19 @@ from .nc.program import Program
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
 #: Modes that round only where G64 would have to reduce the speed (4.3).
 _OVERLOAD_CHECKED = ("G641", "G642", "G645")
+
+#: Modes whose tolerance-based rounding window may reach across several short blocks
+#: (:func:`_across_blocks`). G641 and the ADIS digit (4) are limited by the block lengths
+#: (5.3: "the rounding area is also limited by the block lengths"); G643 rounds inside
+#: the original blocks (5.5); G644's distance "cannot exceed half the length of the
+#: original participating blocks" (excerpt) -- all three keep the one-block clamp.
+_ACROSS_BLOCKS = ("G642", "G645")
+
+#: A rounding window reaches across short blocks only where the lines it covers are so
+#: nearly parallel that the rounding's start ``C - d t1`` and the path point ``d`` before
+#: the corner differ by at most this, mm: a tenth of the 1e-9 mm to which consecutive
+#: segments meet, so the rounded path stays continuous to that.
+CHAIN_MEET_MM = 1e-10
 
 #: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
 _RADIUS_MODES = ("RND", "RNDM")
@@ -183,9 +202,15 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
     # --- rounding distance by mode ----------------------------------------------------
     theta = deflection_angle(t1, t2)
-    d = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, decide)
-    lens = np.minimum(path.length[a], path.length[b])
-    cap = ch.rounding_length_clamp * lens
+    d, multi = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, decide)
+    # clamp (5.3, the G644 excerpt): c times the shorter participating block; where the
+    # mode rounds across short blocks, the participating "block" on each side is the
+    # straight chain of blocks the window may cover (:func:`_straight_chains`)
+    c = ch.rounding_length_clamp
+    cap = c * np.minimum(path.length[a], path.length[b])
+    first, last = a.copy(), b.copy()
+    if multi.any():
+        cap, first, last = _across_blocks(path, attrs, a, b, d, cap, c, multi & (reason < 0))
     clamped = d > cap
     d = np.minimum(d, cap)
     decide(~(d > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
@@ -228,7 +253,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
         distance_mm=d * zero, length_mm=radius * theta * zero,
         deviation_mm=d * np.tan(theta / 4.0) * zero, radius_mm=radius * zero,
-        clamped=clamped & ins, v_g64=v64, v_round=v_round)
+        clamped=clamped & ins, v_g64=v64, v_round=v_round,
+        first_block=np.where(ins, path.block[first], ka).astype(np.int64),
+        last_block=np.where(ins, path.block[last], kb).astype(np.int64))
     if not ins.any():                     # nothing to insert: same path, with the table
         keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
@@ -239,8 +266,10 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
-               t2: np.ndarray, theta: np.ndarray, decide) -> np.ndarray:
-    """Tangent distance per corner by mode, before the block-length clamp, mm."""
+               t2: np.ndarray, theta: np.ndarray, decide) -> tuple[np.ndarray, np.ndarray]:
+    """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
+    and whether the corner's window may reach across short blocks (G642/G645 with a
+    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -288,7 +317,116 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
     decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
-    return np.where(np.isfinite(d), d, 0.0)
+    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == "tol")
+    return np.where(np.isfinite(d), d, 0.0), multi
+
+
+def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Maximal runs of line segments that one rounding window may cover, and their lengths.
+
+    Two consecutive segments are in one run when both are lines of consecutive program
+    blocks (no block between), the break between them is tangential (the shared rule,
+    :func:`reference.core.rules.is_tangential`) and carries no stop, and both blocks
+    agree in group-10 mode, acceleration mode, feed and G0: the blocks of a run are then
+    one straight stretch of the contour that the control can replace in part by a
+    rounding block without anything else changing along it.
+
+    Returns
+    -------
+    run : numpy.ndarray of int, shape (m,)
+        Run index of each segment (non-decreasing).
+    run_length : numpy.ndarray, shape (max(run) + 1,)
+        Length of each run, mm.
+    """
+    blk = path.block
+    line = path.kind == _LINE
+    ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
+    ok &= attrs["mode"][blk[:-1]] == attrs["mode"][blk[1:]]
+    ok &= attrs["accel"][blk[:-1]] == attrs["accel"][blk[1:]]
+    ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
+    sel = np.flatnonzero(ok)
+    ok[sel] = is_tangential(path.d[sel], path.d[sel + 1], FEASIBLE)
+    run = np.concatenate(([0], np.cumsum(~ok)))
+    return run, np.bincount(run, weights=path.length)
+
+
+def _across_blocks(path: Path, attrs: dict[str, np.ndarray], a: np.ndarray, b: np.ndarray,
+                   d: np.ndarray, cap: np.ndarray, c: float, sel: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clamp and window ends of corners whose rounding may span several short blocks.
+
+    Model [I] of rounding across short blocks (issue item: "where the documented modes
+    allow rounding across several short blocks"): with G642/G645 the tolerance, not the
+    block, fixes the rounding distance (5.4: ``d`` from MD33100 / SD42465 / CTOL), and
+    the rounding "replaces the area near the original angular transition" (FB1 excerpt,
+    5.1) -- so where the blocks beside the corner are shorter than ``d``, the window
+    runs on into the blocks before and after as long as they continue the same straight
+    line (:func:`_straight_chains`), and those blocks are covered by the rounding block
+    (what the control then interpolates is one rounding block instead of several short
+    ones, so the one-IPO-cycle-per-block cap applies to the rounding's length, 5.3).
+    The clamp "at most half of the participating blocks" (the G644 excerpt) then applies
+    to the straight chain on each side: two windows on one chain never overlap. A window
+    does not pass a non-tangential break: several corners closer together than their
+    windows are rounded one by one, each clamped (a blend over several corners is not
+    modelled).
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray of int, shape (k,)
+        Segments before and after each corner (lines).
+    d : numpy.ndarray, shape (k,)
+        Tangent distance by mode, before any clamp, mm.
+    cap : numpy.ndarray, shape (k,)
+        The one-block clamp ``c min(L_a, L_b)``, mm.
+    c : float
+        The clamp factor (``rounding_length_clamp``).
+    sel : numpy.ndarray of bool, shape (k,)
+        Corners that may reach across blocks.
+
+    Returns
+    -------
+    cap : numpy.ndarray, shape (k,)
+        The clamp, on ``sel`` ``c`` times the shorter straight chain, mm.
+    first, last : numpy.ndarray of int, shape (k,)
+        First and last segment the window ``[S - d', S + d']`` touches (``a`` and ``b``
+        unless it reaches further; ``d' = min(d, cap)``).
+    """
+    first, last = a.copy(), b.copy()
+    run, run_len = _straight_chains(path, attrs)
+    o = np.flatnonzero(sel)
+    wide = np.minimum(c * np.minimum(run_len[run[a[o]]], run_len[run[b[o]]]), d[o])
+    reach = wide > np.minimum(cap[o], d[o])
+    o, wide = o[reach], wide[reach]
+    if o.size == 0:
+        return cap, first, last
+    sb = path.s_breaks
+    corner = sb[a[o] + 1]
+    f = np.maximum(np.searchsorted(sb, corner - wide, side="right") - 1, 0)
+    g = np.minimum(np.searchsorted(sb, corner + wide, side="left") - 1, path.n_segments - 1)
+    # the lines of a chain are tangential (angle <= TANGENT_TOL_RAD), not bit-parallel:
+    # the rounding starts at C - d t1 on the corner's own line, the covered part of the
+    # chain ends at the path point S - d; they differ by at most d max_j |t_j - t_a|
+    # (sum of the covered lengths times their direction errors). Where that could exceed
+    # CHAIN_MEET_MM the window stays within the two blocks (the one-block clamp).
+    err = np.maximum(_max_dir_error(path, f, a[o], a[o]),
+                     _max_dir_error(path, b[o], g, b[o])) * wide
+    good = err <= CHAIN_MEET_MM
+    o, f, g, wide = o[good], f[good], g[good], wide[good]
+    cap = cap.copy()
+    cap[o] = wide
+    first[o], last[o] = f, g
+    return cap, first, last
+
+
+def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
+                   ) -> np.ndarray:
+    """``max_{lo <= j <= hi} |t_j - t_ref|`` per range (segment directions), shape (k,)."""
+    out = np.zeros(lo.size)
+    cnt = hi - lo + 1
+    owner = np.repeat(np.arange(lo.size), cnt)
+    flat = lo[owner] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    np.maximum.at(out, owner, np.linalg.norm(path.d[flat] - path.d[ref[owner]], axis=1))
+    return out
 
 
 def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarray,
@@ -347,6 +485,36 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, radius: n
     return np.where(soft, np.minimum(out, np.minimum(v_j, v_k)), out)
 
 
+def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Length cut from the start and from the end of every segment by the windows
+    ``[S_c - d, S_c + d]`` around the corners at the ends of segments ``a``, mm, shape (m,)
+    each (at most the segment's length each; a covered segment gets its whole length).
+
+    Windows are disjoint (each is at most half of the straight chain on either side) and
+    contain their corner, so a segment is cut at its start only by the window of the
+    corner before it and at its end only by the window of the corner after it. The cut is
+    ``d - (distance from the corner)``, which is exactly ``d`` at the corner's own two
+    segments (the one-block case keeps its exact trims).
+    """
+    sb = path.s_breaks
+    s0, s1 = sb[:-1], sb[1:]
+    corner = sb[a + 1]
+    trim_start = np.zeros(path.n_segments)
+    trim_end = np.zeros(path.n_segments)
+    # window whose corner is at or before the segment's start, and whose reach covers it
+    i = np.searchsorted(corner, s0, side="right") - 1
+    hit = i >= 0
+    reach = np.where(hit, d[np.maximum(i, 0)] - (s0 - corner[np.maximum(i, 0)]), 0.0)
+    trim_start = np.where(hit & (reach > 0), np.minimum(reach, path.length), 0.0)
+    # window whose corner is at or after the segment's end
+    i = np.searchsorted(corner, s1, side="left")
+    hit = i < corner.size
+    ic = np.minimum(i, corner.size - 1)
+    reach = np.where(hit, d[ic] - (corner[ic] - s1), 0.0)
+    trim_end = np.where(hit & (reach > 0), np.minimum(reach, path.length), 0.0)
+    return trim_start, trim_end
+
+
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
               table: RoundingTable) -> Path:
     """The rounded path: lines shortened, arcs inserted after segments ``a``, spans moved.
@@ -361,13 +529,11 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         Unit directions of the lines before and after.
     """
     m = path.n_segments
-    trim_start = np.zeros(m)
-    trim_end = np.zeros(m)
-    trim_end[a] = d
-    trim_start[a + 1] = d
+    trim_start, trim_end = _window_trims(path, a, d)
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
-    # meet tangentially and the line is dropped
+    # meet tangentially and the line is dropped; a line inside a window that reaches
+    # across short blocks (:func:`_across_blocks`) is covered whole and dropped too
     keep = length > MIN_SEGMENT_LENGTH_MM
     has_arc = np.zeros(m, bool)
     has_arc[a] = True

@@ -79,6 +79,11 @@ class RoundingTable:
     v_g64, v_round : numpy.ndarray, shape (k,)
         The G64 corner speed and the model's rounding speed (centripetal, curvature
         jump, one IPO cycle), mm/s (``nan`` where not evaluated).
+    first_block, last_block : numpy.ndarray of int, shape (k,)
+        First and last program block the rounding window touches: ``block`` and
+        ``next_block`` unless the window reaches across short blocks (G642/G645), in
+        which case the blocks strictly between ``first_block`` and ``block`` (and
+        between ``next_block`` and ``last_block``) are covered by the rounding whole.
     """
 
     block: np.ndarray
@@ -92,6 +97,8 @@ class RoundingTable:
     clamped: np.ndarray
     v_g64: np.ndarray
     v_round: np.ndarray
+    first_block: np.ndarray
+    last_block: np.ndarray
 
     @property
     def n(self) -> int:
@@ -102,6 +109,12 @@ class RoundingTable:
     def inserted(self) -> np.ndarray:
         """True per corner where a rounding segment was inserted, shape (k,)."""
         return self.reason == 0
+
+    @property
+    def blocks_spanned(self) -> np.ndarray:
+        """Program blocks the rounding window touches (2 for a rounding between two
+        blocks, more across short blocks; 0 where none was inserted), shape (k,)."""
+        return np.where(self.inserted, self.last_block - self.first_block + 1, 0)
 
     def reason_text(self, i: int) -> str:
         """The reason of corner ``i`` as words."""
