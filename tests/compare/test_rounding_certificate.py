@@ -52,5 +52,23 @@ def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, caps
     rows = [r.split() for r in out.splitlines() if r.strip().startswith(("3/4", "4/5", "5/6"))]
     # 90 degree corners, ADIS 0.5: d = R = 0.5, length pi/4, deviation 0.5 (sqrt 2 - 1)
     assert rows[0][:6] == ["3/4", "G641", "0.5000", "0.7854", "0.20711", "0.5000"]
-    assert rows[0][6] == "rounded"
-    assert " ".join(rows[1][6:]) == "none: stop between the blocks"
+    # G64 corner speed by hand (spec 4.2): each axis may jump by A (ovl - 1) T_ipo =
+    # 2000 * 0.2 * 0.004 = 1.6 mm/s; at 90 degrees an axis jumps by v, so 96 mm/min
+    assert rows[0][6] == "96.0"
+    assert rows[0][8] == "rounded"
+    assert rows[1][6:8] == ["-", "-"]               # not evaluated: the stop decides
+    assert " ".join(rows[1][8:]) == "none: stop between the blocks"
+
+
+def test_inspect_names_a_rounding_across_short_blocks(tmp_path: Path, capsys) -> None:
+    """Issue 13 items 4 and 5: a G642 window that covers short blocks is listed with the
+    lines it spans. 90 degree corner, CTOL 0.2: d = 0.2 / tan(22.5 deg) = 0.4828 mm,
+    beyond the 0.2 mm blocks X20.8 -> X21 and X20.6 -> X20.8 into X20.4 -> X20.6
+    (line 5); after the corner it stays in the block Y10 (line 8)."""
+    prog = tmp_path / "steps.mpf"
+    prog.write_text("G90 G642 CTOL=0.2 BRISK F4000\nG1 X0 Y0\nX20\nX20.4\nX20.6\nX20.8\n"
+                    "X21\nY10\n")
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    row = next(r for r in out.splitlines() if r.strip().startswith("7/8"))
+    assert "0.4828" in row and row.endswith("rounded across lines 5..8 (short blocks)")
