@@ -77,6 +77,14 @@ one segment (lines, arcs, helices).
   is at most ``sup|g''| dtau^2 / 8`` for a quantity ``g(tau)`` sampled at time step
   ``dtau``; on arcs ``g''`` is dominated by ``(omega v)^2 g``, which gives the bound
   above, plus terms from the time variation of ``s''`` and ``v`` inside the interval.
+  On circles and helices the samples at that step are taken only where they can
+  matter: a first pass samples at :data:`ARC_COARSE_FACTOR` times the step, and a
+  coarse step is sampled finely only where its end values plus ``B D^2/8`` could exceed
+  the largest value sampled on the interval (``D`` the coarse step, ``B`` a rigorous
+  bound on the quantity's second time derivative inside the interval, from the
+  circle's derivative amplitudes and the interval's largest speed, path acceleration
+  and path jerk: :func:`_arc_curvature_bounds`). A step left coarse cannot hold a
+  larger value, so the bound above holds unchanged.
   After sampling, the worst sample of each interval and quantity is refined once by
   the vertex of the parabola through it and its neighbours, evaluated exactly; this
   can only raise the maximum found and, for smooth maxima, brings the deficit to order
