@@ -330,8 +330,9 @@ def plot_gaps(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -> st
             ax.set_xlabel("block (source line), in program order")
         else:
             ax.xaxis.set_major_locator(MaxNLocator(nbins=12, integer=True))
-            ax.set_xlabel(f"block in execution order (1 … {n}; loops repeat lines, so "
-                          "only the worst blocks are labelled with their source line)")
+            ax.set_xlabel(f"block in execution order (1 … {n}; loops and inserted blocks "
+                          "repeat lines, so only the worst blocks are labelled with their "
+                          "source line)")
             y0, y1 = ax.get_ylim()            # room for the labels above the spikes
             ax.set_ylim(y0, y1 + 0.12 * (y1 - y0))
             pos = {id(r): k for k, r in enumerate(rows)}
