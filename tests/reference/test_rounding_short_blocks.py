@@ -196,3 +196,25 @@ def test_short_segments_program_under_g642(name):
     for i in np.flatnonzero(t.inserted):
         d = t.distance_mm[i]
         assert t.blocks_spanned[i] == 2 * math.ceil(d / 0.0254 - 1e-9)
+
+
+def test_every_span_lies_on_its_segments_after_rounding():
+    """Spans before the first rounding are kept as they are, the others move: either
+    way each span must start and end at the path position of its own segments (the
+    invariant every per-block number relies on) and the segments must be the block's.
+    A G64 prefix (unchanged spans), then G642 windows across short blocks (the first
+    reaching back into blocks before its corner), then RND."""
+    text = ("G17 G90 G64 F3000\nG1 X0 Y0\nX5\nY5\nX10\nG642\nX10.01\nX10.02\nX10.03\n"
+            "Y10\nX20 RND=1\nY20\nX20.01\nX20.02\nY25\n")
+    prog = parse_text(text)
+    path = build_path(prog, machine())
+    assert int(path.rounding.inserted.sum()) >= 3
+    assert int(np.max(path.rounding.blocks_spanned)) > 2
+    sb = path.s_breaks
+    for sp in path.blocks:
+        assert sp.s_start == sb[sp.first_segment]
+        assert sp.s_end == sb[sp.first_segment + sp.n_segments]
+        segs = range(sp.first_segment, sp.first_segment + sp.n_segments)
+        assert all(path.block[k] == sp.block for k in segs)
+    assert sum(sp.n_segments for sp in path.blocks) == path.n_segments
+    assert_continuous(path)
