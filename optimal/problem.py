@@ -438,7 +438,8 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
       most its cap and the static limit :func:`pair_mvc` (which the rows at that node
       imply).
 
-    Spirals (no closed form of the fourth derivative here) and lines get no margin. A
+    Spirals and clothoids (no closed form of the fourth derivative here) and lines get
+    no margin. A
     margin is at most half of ``A_j`` (it is only an efficiency device: the checker
     and time scaling keep the upper bound valid whatever it is).
 
@@ -451,7 +452,8 @@ def interior_margins(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray,
     n = path.n_axes
     seg = grid.segment
     out = np.zeros((N, n))
-    arc = np.flatnonzero((path.radius[seg] > 0) & (path.dradius[seg] == 0))
+    arc = np.flatnonzero((path.radius[seg] > 0) & (path.dradius[seg] == 0)
+                         & (path.sharpness[seg] == 0))
     if arc.size == 0:
         return out
     sa = seg[arc]

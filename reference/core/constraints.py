@@ -67,9 +67,10 @@ one segment (lines, arcs, helices).
 * **Lines** (``q' = d`` constant, ``q'' = q''' = 0``): axis velocity, acceleration and
   jerk are ``|d_i|`` times polynomials of degree 2, 1, 0 in ``tau``; their maxima are
   taken exactly at the interval ends and the stationary point of ``v`` (``s''= 0``).
-* **Arcs and helices**: dense samples, uniform in time, at an angular step of at most
+* **Arcs, helices and clothoids**: dense samples, uniform in time, at an angular step of
+  at most
   :data:`ARC_SAMPLE_STEP_RAD` (0.125 deg) *at the interval's peak speed* (so also where
-  the motion is fastest; on a spiral at its largest angular rate
+  the motion is fastest; on a spiral or clothoid at its largest angular rate
   :attr:`~reference.core.geometry.PlaneAmplitudes.omega_max`), at least
   :data:`MIN_ARC_SAMPLES` per sub-interval, plus the stationary point of ``v``. A maximum of a cos-type function sampled at step
   ``dphi`` is missed by at most ``1 - cos(dphi/2) <= dphi^2/8`` of its amplitude:
@@ -598,7 +599,9 @@ def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
     On a circle or helix of radius ``r`` and angular rate ``w`` (rad/mm) the in-plane
     part of the m-th path derivative of axis ``i`` has the amplitude ``rho_i r |w|^m``
     (``rho_i`` the axis' plane weight), and the helix adds the constant ``d_i`` to the
-    first derivative only. With ``V``, ``A``, ``J`` the largest ``|v|``, path
+    first derivative only; on a clothoid the in-plane norms are bounded by
+    :func:`_clothoid_derivative_norms` (an axis' share of a plane vector is at most
+    ``rho_i`` times its norm). With ``V``, ``A``, ``J`` the largest ``|v|``, path
     acceleration ``|a|`` and path jerk ``|j|`` on the interval (``j`` is constant in an
     interval, so its time derivative is 0), differentiating the axis velocity
     ``q1 v``, acceleration ``q1 a + q2 v^2`` and jerk ``q1 j + 3 q2 v a + q3 v^3``
@@ -618,14 +621,36 @@ def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
     J = np.abs(p.j[k])
     r, w = path.radius[seg], np.abs(path.omega[seg])
     rho = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)           # (N, n)
-    a1 = np.abs(path.d[seg]) + rho * (r * w)[:, None]
-    a2, a3, a4, a5 = (rho * (r * w ** m)[:, None] for m in (2, 3, 4, 5))
+    # norms of the in-plane parts of q', ..., q^(5): r |w|^m on circles
+    norms = [r * w ** m for m in range(1, 6)]
+    cl = np.flatnonzero(path.sharpness[seg])
+    if cl.size:
+        for m, val in enumerate(_clothoid_derivative_norms(
+                np.abs(path.sharpness[seg[cl]]), path.length[seg[cl]])):
+            norms[m][cl] = val
+    a1 = np.abs(path.d[seg]) + rho * norms[0][:, None]
+    a2, a3, a4, a5 = (rho * nm[:, None] for nm in norms[1:])
     V, A, J = V[:, None], A[:, None], J[:, None]
     b_vel = a3 * V ** 3 + 3 * a2 * V * A + a1 * J
     b_acc = a4 * V ** 4 + 6 * a3 * V ** 2 * A + 3 * a2 * A ** 2 + 4 * a2 * V * J
     b_jerk = (a5 * V ** 5 + 10 * a4 * V ** 3 * A + 15 * a3 * V * A ** 2
               + 10 * a3 * V ** 2 * J + 10 * a2 * A * J)
     return b_vel, b_acc, b_jerk
+
+
+def _clothoid_derivative_norms(c: np.ndarray, length: np.ndarray) -> list[np.ndarray]:
+    """Bounds of ``|q^(m)|``, ``m = 1..5``, on clothoid pieces of curvature rate ``c``
+    and length ``L`` (``kappa = c sigma <= K = c L``), shape (N,) each.
+
+    With ``T``, ``N`` the unit tangent and normal (``T' = kappa N``, ``N' = -kappa T``,
+    ``kappa' = c``): ``q' = T``, ``q'' = kappa N``, ``q''' = c N - kappa^2 T``,
+    ``q'''' = -3 c kappa T - kappa^3 N``, ``q5 = (kappa^4 - 3 c^2) T - 6 c kappa^2 N``;
+    ``T``, ``N`` orthonormal, so the norms are at most ``1``, ``K``, ``hypot(c, K^2)``,
+    ``hypot(3 c K, K^3)`` and ``hypot(max(K^4, 3 c^2), 6 c K^2)``.
+    """
+    K = c * length
+    return [np.ones_like(c), K, np.hypot(c, K * K), np.hypot(3 * c * K, K ** 3),
+            np.hypot(np.maximum(K ** 4, 3 * c * c), 6 * c * K * K)]
 
 
 def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
@@ -643,7 +668,8 @@ def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
     ``|g''| <= B`` exceeds the chord between two of its points by at most
     ``B D^2 / 8``). A step left coarse therefore holds no larger value than one already
     found, and each interval's maxima are those of the fine sampling or larger (all
-    values exact): the documented deficit bound holds unchanged. Spirals are sampled at
+    values exact): the documented deficit bound holds unchanged. Circles, helices and clothoids
+    are pruned so; spirals are sampled at
     the fine step throughout.
 
     ``frac0, frac1`` (default 0 and 1) restrict each row to the time piece

@@ -612,3 +612,67 @@ def test_coarse_sampling_finds_the_highest_of_nearly_equal_peaks(monkeypatch, fa
     brute = np.max(np.abs(dq * acc[:, None] + ddq * (v * v)[:, None])) / 1e4
     got = rep.worst("acceleration").ratio
     assert brute * (1 - 6e-7) <= got <= brute * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("factor", [8, 64])
+def test_sampling_on_clothoid_pairs_against_brute_force(monkeypatch, factor):
+    """The checker's accuracy statement holds on clothoid roundings too (their coarse
+    steps are pruned by bounds from :func:`_clothoid_derivative_norms`): lines with
+    clothoid pairs of 30..170 deg between them, random BRISK-like and SOFT motions,
+    against a brute-force grid per segment (1e5 points, both sides of every knot)."""
+    from reference.core.geometry import KIND_CODES, clothoid_pair_shape, clothoid_pieces
+    monkeypatch.setattr(cmod, "ARC_COARSE_FACTOR", factor)
+    rng = np.random.default_rng(21)
+    lim = MachineLimits(tuple(AxisLimits(n, 1e3, 1e4, 1e6, 1.2, 1.0) for n in AX), T_IPO)
+    la = lim.for_axes(AX)
+    for case in range(6):
+        pos, t_in = np.zeros(3), np.array([1.0, 0.0, 0.0])
+        pieces, blk = [], 0
+        for _ in range(3):
+            end = pos + rng.uniform(0.5, 3.0) * t_in
+            pieces.append(line_segments(pos[None], end[None], GEO, np.array([blk])))
+            ang = np.radians(rng.uniform(30.0, 170.0)) * rng.choice((-1.0, 1.0))
+            axis = rng.normal(size=3)
+            axis -= t_in * (axis @ t_in)
+            axis /= np.linalg.norm(axis)
+            t_out = np.cos(ang) * t_in + np.sin(ang) * axis
+            half = rng.uniform(0.05, 1.0)
+            pieces.append(clothoid_pieces(end[None], t_in[None], t_out[None],
+                                          np.array([half]), np.array([blk]),
+                                          KIND_CODES.index("rounding")))
+            d1, _ = clothoid_pair_shape(np.array([abs(ang)]))
+            pos = end + half * d1[0] * (t_in + t_out)
+            t_in, blk = t_out, blk + 1
+        end = pos + 2.0 * t_in
+        pieces.append(line_segments(pos[None], end[None], GEO, np.array([blk])))
+        p = path_from_pieces(AX, pieces)
+        L = p.total_length
+        vmax = rng.uniform(5.0, 40.0)
+        if case % 2:
+            s = np.linspace(0, L, 60)
+            v = vmax * np.sin(np.pi * s / L) ** 0.5 * (1 + 0.2 * np.sin(5 * s / L))
+            v[[0, -1]] = 0.0
+            prof = Profile.from_path_velocity(s, v)
+        else:
+            prof = motion(L, [("ramp", vmax, 2000.0, 40000.0), ("cruise", None),
+                              ("ramp", 0.0, 2000.0, 40000.0)])
+        rep = check_profile(p, lim, prof)
+        tb = prof.time_at(p.s_breaks)
+        kn = np.concatenate((np.nextafter(prof.t, -np.inf), prof.t,
+                             np.nextafter(prof.t, np.inf)))
+        ts = [np.union1d(np.linspace(t0, t1, 100_001), kn[(kn > t0) & (kn < t1)])
+              for t0, t1 in zip(tb[:-1], tb[1:])]
+        seg = np.concatenate([np.full(x.size, i) for i, x in enumerate(ts)])
+        s, v, a, j = prof.state(np.concatenate(ts))
+        s = np.clip(s, p.s_breaks[seg], p.s_breaks[seg + 1])
+        _, dq, ddq, dddq = p.evaluate(s, segment=seg)
+        vals = {
+            "velocity": np.abs(dq * v[:, None]) / la.v_max,
+            "acceleration": np.abs(dq * a[:, None] + ddq * (v * v)[:, None]) / la.a_max,
+            "jerk": np.abs(dq * j[:, None] + 3 * ddq * (v * a)[:, None]
+                           + dddq * (v ** 3)[:, None]) / la.j_max}
+        for name, val in vals.items():
+            b = val.max()
+            r = rep.components["jerk_interval"].ratio if name == "jerk" else \
+                rep.worst(name).ratio
+            assert b * (1 - 6e-7) <= r <= b * (1 + 1e-7), (case, name)
