@@ -377,8 +377,10 @@ def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarr
     blk = path.block
     line = path.kind == _LINE
     ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
-    ok &= attrs["mode"][blk[:-1]] == attrs["mode"][blk[1:]]
-    ok &= attrs["accel"][blk[:-1]] == attrs["accel"][blk[1:]]
+    # fixed-width strings compare in C; the object arrays would compare per element
+    mode, accel = attrs["mode"].astype("U8"), attrs["accel"].astype("U8")
+    ok &= mode[blk[:-1]] == mode[blk[1:]]
+    ok &= accel[blk[:-1]] == accel[blk[1:]]
     ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
     sel = np.flatnonzero(ok)
     ok[sel] = is_tangential(path.d[sel], path.d[sel + 1], FEASIBLE)
