@@ -97,7 +97,8 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
                     opt_prof: Profile | None, jerk_ref: bool, jerk_opt: bool) -> dict:
     """Per span holding inserted segments (corner rounding): a function that turns the
     span's one row piece into the block's own piece followed by one piece per inserted
-    segment (see :func:`compare_profiles` for the piece layout).
+    block (a run of inserted segments: a clothoid pair is one rounding; see
+    :func:`compare_profiles` for the piece layout).
 
     The inserted pieces are measured on each profile exactly
     (:func:`compare.inserted.stretch_motion`); the block keeps the rest of its time, so
@@ -112,12 +113,12 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
         return {}
     spans = path.blocks
     order = sorted(found)
-    segs = np.concatenate([found[i] for i in order])
+    runs = np.concatenate([found[i] for i in order])             # (R, 2) first, last
     sb = path.s_breaks
-    # the block's own stretch before its first inserted segment, then each inserted one
+    # the block's own stretch before its first inserted block, then each inserted one
     own0 = np.array([spans[i].s_start for i in order])
-    own1 = np.array([sb[found[i][0]] for i in order])
-    ins0, ins1 = sb[segs], sb[segs + 1]
+    own1 = np.array([sb[found[i][0, 0]] for i in order])
+    ins0, ins1 = sb[runs[:, 0]], sb[runs[:, 1] + 1]
 
     def measure(prof: Profile | None, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
         if prof is None or s0.size == 0:
@@ -133,7 +134,7 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
     own_o[has_own] = measure(opt_prof, own0[has_own], own1[has_own])
     cause_r = stretch_causes(path, limits, ref_prof, ins0, ins1, jerk_ref)
     cause_o = (stretch_causes(path, limits, opt_prof, ins0, ins1, jerk_opt)
-               if opt_prof is not None else ["-"] * segs.size)
+               if opt_prof is not None else ["-"] * runs.shape[0])
     table = path.rounding
     lines = {sp.block: sp.line for sp in spans}
     corner_of: dict[int, tuple[int, int]] = {}
@@ -146,17 +147,17 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
     pos = 0
     for n, i in enumerate(order):
         ks = found[i]
-        rows_r, rows_o = ins_r[pos:pos + ks.size], ins_o[pos:pos + ks.size]
-        cr, co = cause_r[pos:pos + ks.size], cause_o[pos:pos + ks.size]
-        pos += ks.size
+        nk = ks.shape[0]
+        rows_r, rows_o = ins_r[pos:pos + nk], ins_o[pos:pos + nk]
+        cr, co = cause_r[pos:pos + nk], cause_o[pos:pos + nk]
+        pos += nk
         sp = spans[i]
-        tail = bool(ks[-1] == sp.first_segment + sp.n_segments - 1
-                    and np.all(np.diff(ks) == 1))
+        tail = bool(ks[-1, 1] == sp.first_segment + sp.n_segments - 1 and nk == 1)
 
         def make(base, ks=ks, rows_r=rows_r, rows_o=rows_o, n=n, sp=sp, tail=tail, cr=cr,
                  co=co):
             kind, corner, line, source, s_start, length, stop, hold, mr, mo, lr, lo = base
-            ins_len = float(path.length[ks].sum())
+            ins_len = float(sum(sb[b + 1] - sb[a] for a, b in ks.tolist()))
             own = []
             for whole, part, own_part in ((mr, rows_r, own_r[n]), (mo, rows_o, own_o[n])):
                 t = whole[0] - float(np.nansum(part[:, 0]))
@@ -166,10 +167,10 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
             corner_here = corner_of.get(sp.block, (sp.line, sp.line))
             pieces = [(kind, corner, line, source, s_start, length - ins_len,
                        "" if tail else stop, hold, own[0], own[1], lr, lo)]
-            for j, k in enumerate(ks.tolist()):
-                last = j == ks.size - 1
+            for j, (k, k_end) in enumerate(ks.tolist()):
+                last = j == nk - 1
                 pieces.append((kinds[int(path.kind[k])], corner_here, corner_here[0], "",
-                               float(sb[k]), float(path.length[k]),
+                               float(sb[k]), float(sb[k_end + 1] - sb[k]),
                                stop if (tail and last) else "", 0.0,
                                tuple(float(x) for x in rows_r[j]),
                                tuple(float(x) for x in rows_o[j]), cr[j], co[j]))

@@ -24,13 +24,15 @@ _INSERTED_CODES = np.array([KIND_CODES.index(k) for k in INSERTED_KINDS], dtype=
 
 
 def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
-    """Inserted segments inside program-block spans.
+    """Inserted blocks inside program-block spans: runs of consecutive inserted segments
+    (a clothoid pair's two pieces are one rounding, one row).
 
     Returns
     -------
     dict
-        Span index (into ``path.blocks``) -> indices of the inserted segments in it,
-        ascending; spans that are themselves of an inserted kind are not split.
+        Span index (into ``path.blocks``) -> ``(first, last)`` segment of each run,
+        shape (r, 2), ascending; spans that are themselves of an inserted kind are not
+        split.
     """
     segs = np.flatnonzero(np.isin(path.kind, _INSERTED_CODES))
     if segs.size == 0:
@@ -44,7 +46,14 @@ def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
     for i, k in zip(owner.tolist(), segs.tolist()):
         if path.blocks[i].kind not in INSERTED_KINDS:
             out.setdefault(i, []).append(k)
-    return {i: np.array(v, dtype=np.int64) for i, v in out.items()}
+    runs = {}
+    for i, v in out.items():
+        ks = np.array(v, dtype=np.int64)
+        cut = np.flatnonzero(np.diff(ks) != 1) + 1
+        starts = np.concatenate(([0], cut))
+        ends = np.concatenate((cut, [ks.size])) - 1
+        runs[i] = np.column_stack((ks[starts], ks[ends]))
+    return runs
 
 
 def stretch_motion(profile: Profile, s0: np.ndarray, s1: np.ndarray) -> BlockMotion:

@@ -99,3 +99,21 @@ def test_report_without_a_program_draws_the_planned_path_alone(comparison):
     from dataclasses import replace
     assert plot_toolpath(replace(comparison, programmed=None)).startswith("data:image/svg")
 
+
+
+def test_a_clothoid_pair_is_one_inserted_row(tmp_path):
+    """Under SOFT a rounding is two clothoid pieces (two inserted blocks, spec 5.1 "one
+    or two intermediate blocks"); the rows show the rounding of a corner once, with the
+    pair's whole length and time."""
+    f = tmp_path / "soft.mpf"
+    f.write_text("G17 G90 G645 CTOL=0.2 SOFT F5000\nG0 X0 Y0\nG1 X20\nX40 Y6\nX60 Y0\nM30\n")
+    c = compare_program(str(f))
+    table = c.path.rounding
+    assert table.g2[table.inserted].all() and int(table.inserted.sum()) == 2
+    ins = [r for r in c.rows if r.inserted]
+    assert len(ins) == 2
+    for r in ins:
+        i = int(np.flatnonzero(table.inserted & (table.block == r.block))[0])
+        assert r.length_mm == pytest.approx(table.length_mm[i], rel=1e-12)
+    total = sum(r.t_reference_s for r in c.rows)
+    assert total == pytest.approx(c.reference_profile.duration, rel=1e-12)
