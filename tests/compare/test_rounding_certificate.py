@@ -89,3 +89,26 @@ def test_inspect_names_a_rounding_across_short_blocks(tmp_path: Path, capsys) ->
     out = capsys.readouterr().out
     row = next(r for r in out.splitlines() if r.strip().startswith("7/8"))
     assert "0.4828" in row and row.endswith("rounded (arc) across lines 5..8 (short blocks)")
+
+
+@pytest.mark.parametrize("machine", sorted(MACHINES))
+@pytest.mark.parametrize("name", G2)
+def test_clothoid_roundings_keep_the_jerk_certificate(name: str, machine: str,
+                                                      tmp_path: Path, capsys) -> None:
+    """The jerk oracle on the same clothoid-rounded paths (its lower bound takes the
+    worst-case suprema of the clothoid, optimal/jerk/lower.py): the heuristic, which
+    keeps the jerk bounds, is never below the certified lower bound."""
+    prog = tmp_path / f"{name}.mpf"
+    prog.write_text(PROGRAMS[name])
+    mfile = _machine_file(tmp_path, machine, prog.name)
+    out = tmp_path / "r.json"
+    rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report", "--quiet",
+                   "--bounds", "jerk", "--json", str(out)])
+    err = capsys.readouterr().err
+    assert rc in (0, 1), err
+    doc = json.loads(out.read_text())
+    ora, ref = doc["oracle"], doc["reference"]
+    assert ora["status"] in ("optimal", "gap_not_met"), ora
+    assert not ref["violations"], ref["violations"]
+    assert ora["lower_bound_s"] <= ora["upper_bound_s"]
+    assert ref["time_s"] >= ora["lower_bound_s"]
