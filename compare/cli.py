@@ -15,7 +15,8 @@ import numpy as np
 
 from reference.core.budget import DEFAULT_MAX_GRID_POINTS
 from reference.core.errors import FeedOracleError
-from reference.prepare import build_path, prepare
+from reference.core.geometry import KIND_CODES
+from reference.prepare import path_stages, prepare
 
 from .commands import number_at_least
 from .pipeline import load_inputs
@@ -39,7 +40,8 @@ def _fmt(x: float, nd: int = 3) -> str:
 
 def cmd_inspect(args: argparse.Namespace) -> int:
     """``feedoracle inspect``: print blocks, their segments and any warnings."""
-    inputs = load_inputs(args.program, args.machine, dialect=args.dialect)
+    inputs = load_inputs(args.program, args.machine, dialect=args.dialect,
+                         tool_table=args.tool_table, tool_table_units=args.tool_table_units)
     program, machine = inputs.program, inputs.machine
     path = prepare(program)       # the programmed contour, whatever axes the machine has
     out = sys.stdout
@@ -59,7 +61,21 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         out.write(f"{blk.line:>6} {span.label[:8]:<8} {span.kind:<5} {span.n_segments:>4} "
                   f"{span.length:>11.4f} {feed_s:>11} {blk.continuous_mode:<5} "
                   f"{stop[:30]:<30} {src}\n")
-    _write_rounding(out, program, machine)
+    try:
+        stages = path_stages(program, machine)
+    except FeedOracleError as exc:    # e.g. an axis without machine data: listed above
+        out.write(f"path stages: not evaluated ({exc})\n")
+        stages = None
+    if stages is not None:
+        final = stages.path
+        if stages.trc.blocks or stages.tangential.corners:
+            out.write(f"path both planners run on: {final.n_segments} segments, "
+                      f"{final.total_length:.3f} mm (after tool radius compensation, "
+                      "tangential control and rounding)\n")
+        _write_trc(out, program, stages)
+        _write_tangential(out, program, stages)
+        _write_rounding(out, program, stages.path.rounding)
+        _write_changed_segments(out, program, stages)
     for w in inputs.warnings:
         print(str(w), file=sys.stderr)
     if path.n_segments == 0:
@@ -69,14 +85,66 @@ def cmd_inspect(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _write_rounding(out, program, machine) -> None:
+def _write_trc(out, program, stages) -> None:
+    """Tool radius compensation: the role, side and radius of each compensated block, and
+    what was done at each corner (transition circle, intersection, DISC, ...)."""
+    trc = stages.trc
+    if not trc.blocks:
+        return
+    lines = {b.index: b.line for b in program.blocks}
+    out.write(f"tool radius compensation: {len(trc.blocks)} blocks, {len(trc.corners)} "
+              "corners\n")
+    out.write(f"{'line':>6} {'role':<9} {'side':<4} {'radius_mm':>9}\n")
+    for b in trc.blocks:
+        out.write(f"{lines[b.block]:>6} {b.role:<9} {b.side:<4} {b.radius_mm:>9.4f}\n")
+    if trc.corners:
+        out.write(f"{'corner':>13} {'side':<10} {'angle_deg':>9} {'inserted_mm':>11} "
+                  "action\n")
+        for c in trc.corners:
+            corner = f"{lines[c.block]}/{lines[c.next_block]}"
+            out.write(f"{corner:>13} {c.side:<10} {c.deflection_deg:>9.3f} "
+                      f"{c.inserted_mm:>11.4f} {c.action}\n")
+
+
+def _write_tangential(out, program, stages) -> None:
+    """Tangential control: where the following axis turns, by how much and how."""
+    corners = stages.tangential.corners
+    if not corners:
+        return
+    lines = {b.index: b.line for b in program.blocks}
+    n = len(corners)
+    out.write(f"tangential control: {n} tangent step{'' if n == 1 else 's'}\n")
+    out.write(f"{'line':>6} {'axis':<4} {'step_deg':>9} action\n")
+    for c in corners:
+        out.write(f"{lines[c.block]:>6} {c.axis:<4} {c.step_deg:>9.3f} {c.action}\n")
+
+
+def _write_changed_segments(out, program, stages) -> None:
+    """The segments of the blocks that compensation or tangential control changed, as
+    both planners run on them: kind (``trc``/``tlift`` for inserted ones), ends, radius."""
+    path = stages.path
+    touched = {b.block for b in stages.trc.blocks} | {
+        b.index for b in program.blocks if b.tangential is not None}
+    if not touched:
+        return
+    rows = [i for i in range(path.n_segments) if int(path.block[i]) in touched]
+    if not rows:
+        return
+    out.write(f"path segments of those blocks ({len(rows)}; axes {' '.join(path.axes)}):\n")
+    out.write(f"{'line':>6} {'kind':<8} {'length_mm':>10} {'radius':>9}  start -> end\n")
+    q0 = path.evaluate(path.s_breaks[rows], segment=rows)[0]
+    q1 = path.evaluate(path.s_breaks[[i + 1 for i in rows]], segment=rows)[0]
+    for k, i in enumerate(rows):
+        blk = program.blocks[int(path.block[i])]
+        a = " ".join(f"{x:.4f}" for x in q0[k])
+        b = " ".join(f"{x:.4f}" for x in q1[k])
+        out.write(f"{blk.line:>6} {KIND_CODES[int(path.kind[i])]:<8} {path.length[i]:>10.4f} "
+                  f"{path.radius[i]:>9.4f}  {a} -> {b}\n")
+
+
+def _write_rounding(out, program, table) -> None:
     """The rounding stage's decision per corner in G641..G645: the rounding's tangent
     distance, length, contour deviation and radius, or why no rounding was inserted."""
-    try:
-        table = build_path(program, machine).rounding
-    except FeedOracleError as exc:    # e.g. an axis without machine data: listed above
-        out.write(f"rounding: not evaluated ({exc})\n")
-        return
     if table is None or table.n == 0:
         return
     lines = {b.index: b.line for b in program.blocks}
@@ -125,6 +193,12 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--quiet", action="store_true", help="no progress output")
         sp.add_argument("--debug", action="store_true",
                         help="on an internal error (exit 3), print the traceback")
+        sp.add_argument("--tool-table", metavar="FILE", default=None,
+                        help="LinuxCNC tool table (T<n> P<n> D<diameter> lines) for cutter "
+                             "compensation; overrides [tools] of the machine data")
+        sp.add_argument("--tool-table-units", choices=("mm", "inch"), default="mm",
+                        help="units of the tool table (LinuxCNC keeps it in machine units; "
+                             "default mm)")
         sp.add_argument("--max-grid-points", metavar="N",
                         type=number_at_least(1.0, "a number of points >= 1"),
                         default=DEFAULT_MAX_GRID_POINTS,

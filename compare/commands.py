@@ -148,7 +148,9 @@ def register(sub: argparse._SubParsersAction, common: Callable) -> None:
 # --------------------------------------------------------------------- helpers
 def _load(program_file: str, args: argparse.Namespace) -> pipeline.Inputs:
     """Program and machine of the command line; their warnings go to stderr."""
-    inputs = pipeline.load_inputs(program_file, args.machine, dialect=args.dialect)
+    inputs = pipeline.load_inputs(program_file, args.machine, dialect=args.dialect,
+                                  tool_table=args.tool_table,
+                                  tool_table_units=args.tool_table_units)
     for w in inputs.warnings:
         print(str(w), file=sys.stderr)
     return inputs

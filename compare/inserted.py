@@ -1,7 +1,7 @@
 """Inserted blocks on their own comparison rows.
 
-The path stages that insert blocks (corner rounding, :mod:`reference.rounding`) attribute
-each inserted segment to the program block whose end is its corner, so every program
+The corner-rounding stage (:mod:`reference.rounding`) attributes each rounding to the
+program block whose end is its corner, so every program
 block keeps exactly one :class:`~reference.core.geometry.BlockSpan` and both planners'
 per-block numbers stay keyed by program block. For people, the comparison shows an
 inserted segment on a row of its own, named by its corner: this module finds those
@@ -20,7 +20,11 @@ from reference.core.rows import BlockMotion
 
 from .result import INSERTED_KINDS
 
-_INSERTED_CODES = np.array([KIND_CODES.index(k) for k in INSERTED_KINDS], dtype=np.int8)
+#: Inserted segments shown on rows of their own: corner roundings (issue 13). The
+#: segments tool radius compensation and tangential control insert (``trc``, ``tlift``)
+#: stay in the row of the block they belong to, as those stages define.
+_ROW_KINDS = ("rounding",)
+_INSERTED_CODES = np.array([KIND_CODES.index(k) for k in _ROW_KINDS], dtype=np.int8)
 
 
 def inserted_pieces(path: Path) -> dict[int, np.ndarray]:

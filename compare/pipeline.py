@@ -32,6 +32,7 @@ from reference.nc import parse_file
 from reference.nc.program import Program, ProgramWarning
 from reference.holds import imposed_holds
 from reference.prepare import build_path, prepare, unmodelled_features
+from reference.tools import load_linuxcnc_tool_table
 
 from . import engines
 from .comparison import Comparison, compare
@@ -69,7 +70,9 @@ class Inputs:
 
 
 def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
-                dialect: str | None = None) -> Inputs:
+                dialect: str | None = None,
+                tool_table: Union[str, "os.PathLike[str]", None] = None,
+                tool_table_units: str = "mm") -> Inputs:
     """Parse a program and load machine data; objects pass through unchanged.
 
     Parameters
@@ -80,6 +83,12 @@ def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
         Machine data, a ``machine.toml`` file or bundled name; ``None``: the default.
     dialect : {"sinumerik", "ngc"}, optional
         Dialect of a program file.
+    tool_table : path, optional
+        A LinuxCNC tool table file (:func:`reference.tools.load_linuxcnc_tool_table`);
+        its radii are added to the machine's tool table (``[tools]``), winning where
+        both name a tool.
+    tool_table_units : {"mm", "inch"}
+        Units of that file.
 
     Returns
     -------
@@ -93,6 +102,9 @@ def load_inputs(program: ProgramLike, machine: MachineLike = None, *,
         The program file cannot be read.
     """
     m = machine if isinstance(machine, Machine) else load_machine(machine)
+    if tool_table is not None:
+        m = replace(m, tools=m.tools.merged(load_linuxcnc_tool_table(tool_table,
+                                                                     tool_table_units)))
     p = program if isinstance(program, Program) else parse_file(program, dialect=dialect)
     return Inputs(program=p, machine=m)
 

@@ -81,11 +81,8 @@ is the upper bound that sets the number of grid points.
 
 Upper bound
 ===========
-The grid optimum ``b`` defines a motion with ``b`` linear in ``s`` per interval
-(:meth:`Profile.from_path_velocity`). ``check_profile`` judges it inside every interval;
-if any ratio of the ``acc`` bound set exceeds 1 the profile is slowed down in time by
-``time_scale_factor`` (velocity ratios scale with ``1/lam``, accelerations with
-``1/lam^2``), and ``upper_bound_s`` is the duration of that accepted profile.
+The motion behind the grid optimum, judged by ``check_profile`` and time-scaled until it
+is accepted, lives in :mod:`optimal.upper`.
 
 Units: mm, s. Shapes: ``N`` intervals, ``n`` axes.
 """
@@ -96,20 +93,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
-                                        scale_time, time_scale_factor)
-from reference.core.errors import InternalError
 from reference.core.geometry import Path, plane_amplitudes
-from reference.core.limits import AxisArrays, MachineLimits
-from reference.core.profile import Profile
+from reference.core.limits import AxisArrays
 
 from .arc_bounds import (REMAINDER_DIVISOR, envelope_rows, envelope_times, lower_envelopes,
                          slope_peak, tangential_slope_bound)
 from .backends.fast import sweep
 from .grid import Grid
-from .problem import (CAP_BOUND, DiscreteProblem, _assemble, common_node_caps,
-                      interval_geometry, moving_axes, pair_mvc)
-from .tolerances import LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
+from .problem import (CAP_BOUND, DiscreteProblem, RowWriter, _assemble, common_node_caps,
+                      interval_geometry, interval_times, moving_axes, pair_mvc)
+from .tolerances import ENVELOPE_CHUNK, LB_ROUND_IMPROVEMENT, LB_ROUNDOFF_REL, LB_ROUNDS
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -164,14 +157,96 @@ class _IntervalData:
     hi: np.ndarray            # (N, n) sup |q'_j| on the interval
     k3: np.ndarray            # (N, n) sup |q'''_j| on the segment
     travel: np.ndarray        # (N, n) upper bound of the axis travel int |q'_j| on I_k
+    mono: np.ndarray          # (N, n) -1/+1: b falls/rises where above the axis' S_j; 0
+    s_max: np.ndarray         # (N, n) sup of S_j = A_j / |q''_j| on I_k (where mono != 0)
 
 
-def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
+def _sinusoid_range(c: np.ndarray, ph: np.ndarray, off: np.ndarray, pa: np.ndarray,
+                    pb: np.ndarray, va: np.ndarray, vb: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Range of ``c cos(phi - ph) + off`` for ``phi`` between ``pa`` and ``pb``.
+
+    ``va, vb`` are its values at the ends (evaluated by the caller with the path's own
+    formulas, so that the ends agree with the rest of the code to the last bit); the
+    interior extremes are at ``phi = ph + k pi`` with values ``(-1)^k c + off``.
+
+    Shapes: ``c, ph, off, va, vb`` (K, n); ``pa, pb`` (K,).
+    """
+    lo = np.minimum(va, vb)
+    hi = np.maximum(va, vb)
+    p0 = np.minimum(pa, pb)[:, None]
+    p1 = np.maximum(pa, pb)[:, None]
+    k = np.ceil((p0 - ph) / np.pi)
+    for _ in range(3):                 # 2 interior extremes at most below 2 pi of sweep
+        crit = ph + k * np.pi
+        inside = (crit > p0) & (crit < p1)
+        val = c * np.where(np.mod(k, 2) == 0, 1.0, -1.0) + off
+        lo = np.where(inside, np.minimum(lo, val), lo)
+        hi = np.where(inside, np.maximum(hi, val), hi)
+        k = k + 1
+    wide = (p1 - p0)[:, 0] >= 2.0 * np.pi
+    if np.any(wide):                   # the whole sinusoid: both extremes
+        lo[wide] = np.minimum(lo[wide], -np.abs(c[wide]) + off[wide])
+        hi[wide] = np.maximum(hi[wide], np.abs(c[wide]) + off[wide])
+    return lo, hi
+
+
+def derivative_ranges(path: Path, grid: Grid, dq0: np.ndarray, ddq0: np.ndarray,
+                      dq1: np.ndarray, ddq1: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Exact ranges of every axis' ``q'_j`` and ``q''_j`` on the line, circle and helix
+    intervals.
+
+    On a circle or helix with plane vectors ``e1, e2``, radius ``r``, rate ``omega`` and
+    linear part ``d``: ``q'_j = r omega |e_j| cos(phi - atan2(-e1_j, e2_j)) + d_j`` and
+    ``q''_j = -r omega^2 |e_j| cos(phi - atan2(e2_j, e1_j))`` (``|e_j|`` the axis' share
+    of the arc plane): their extremes on an interval are at its ends and at the interior
+    extremes of the sinusoid (:func:`_sinusoid_range`). On lines both are constant.
+    Spirals and clothoids are left to the caller (``exact`` is False there).
+
+    Returns
+    -------
+    t_lo, t_hi, k_lo, k_hi : numpy.ndarray, shape (N, n)
+        Smallest and largest ``q'_j`` and ``q''_j`` on each interval.
+    exact : numpy.ndarray of bool, shape (N,)
+        Where the ranges are exact (lines, circles, helices).
+    tol : numpy.ndarray, shape (N, n)
+        Round-off bound of the ``q'`` range (a few ulps of its size); the ``q''`` range
+        carries ``tol`` times ``|omega|``.
+    """
+    seg = grid.segment
+    t_lo, t_hi = np.minimum(dq0, dq1), np.maximum(dq0, dq1)
+    k_lo, k_hi = np.minimum(ddq0, ddq1), np.maximum(ddq0, ddq1)
+    exact = ~_varying_curvature(path, seg)         # not on spirals and clothoids
+    circ_all = np.flatnonzero(exact & (path.radius[seg] > 0))
+    amp = np.zeros_like(dq0)
+    # in chunks of intervals: a dozen (chunk, n) temporaries each
+    for lo in range(0, circ_all.size, ENVELOPE_CHUNK):
+        circ = circ_all[lo:lo + ENVELOPE_CHUNK]
+        sc = seg[circ]
+        e1, e2 = path.e1[sc], path.e2[sc]
+        r, w = path.radius[sc], path.omega[sc]
+        plane = np.sqrt(e1 ** 2 + e2 ** 2)
+        pa = path.theta0[sc] + w * (grid.s[circ] - path.s_breaks[sc])
+        pb = path.theta0[sc] + w * (grid.s[circ + 1] - path.s_breaks[sc])
+        c1 = (r * w)[:, None] * plane
+        t_lo[circ], t_hi[circ] = _sinusoid_range(c1, np.arctan2(-e1, e2), path.d[sc], pa, pb,
+                                                 dq0[circ], dq1[circ])
+        c2 = -(r * w * w)[:, None] * plane
+        k_lo[circ], k_hi[circ] = _sinusoid_range(c2, np.arctan2(e2, e1), np.zeros_like(c2),
+                                                 pa, pb, ddq0[circ], ddq1[circ])
+        amp[circ] = np.abs(c1)
+    tol = 64.0 * np.finfo(np.float64).eps * (amp + np.abs(path.d[seg]) + 1.0)
+    return t_lo, t_hi, k_lo, k_hi, exact, tol
+
+
+def _interval_data(path: Path, lim: AxisArrays, grid: Grid,
+                   geometry: tuple[np.ndarray, ...] | None = None) -> _IntervalData:
     seg = grid.segment
     ds = np.diff(grid.s)
     N = ds.size
     n = path.n_axes
-    dq0, ddq0, dq1, ddq1 = interval_geometry(path, grid)
+    dq0, ddq0, dq1, ddq1 = (interval_geometry(path, grid) if geometry is None
+                            else geometry)
     mid = 0.5 * (grid.s[:-1] + grid.s[1:])
     _, dqm, ddqm, _ = path.evaluate(mid, segment=seg)
     r = path.radius[seg]
@@ -187,6 +262,18 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
     half = 0.5 * ds[:, None]
     lo = np.maximum(np.abs(dqm) - half * k2, 0.0)                    # inf |q'_j| on I_k
     hi = np.abs(dqm) + half * k2                                     # sup |q'_j| on I_k
+    # exact on lines, circles and helices (the Lipschitz bounds above are first order:
+    # at an interval ending where q'_j = 0 they give inf 0 and twice the sup)
+    t_lo, t_hi, k_lo, k_hi, exact, t_tol = derivative_ranges(path, grid, dq0, ddq0, dq1,
+                                                             ddq1)
+    keeps = exact[:, None] & ((t_lo >= t_tol) | (t_hi <= -t_tol))   # no sign change
+    lo = np.where(exact[:, None], np.where(keeps, np.minimum(np.abs(t_lo), np.abs(t_hi))
+                                           - t_tol, 0.0), lo)
+    lo = np.maximum(lo, 0.0)
+    hi = np.where(exact[:, None], np.maximum(np.abs(t_lo), np.abs(t_hi)) + t_tol, hi)
+    # one sign up to round-off (e.g. the interval ends exactly where q'_j = 0): the
+    # travel is still the chord, within D times the round-off bound
+    one_sign = exact[:, None] & ((t_lo >= -t_tol) | (t_hi <= t_tol))
     # ---- a-priori bound of b on each interval
     feed = path.feed[seg]
     b_bar = np.where(np.isfinite(feed), feed ** 2, np.inf)
@@ -235,10 +322,50 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid) -> _IntervalData:
         q0 = path.evaluate(grid.s[spi], segment=seg[spi])[0]
         q1 = path.evaluate(grid.s[spi + 1], segment=seg[spi])[0]
         chord[spi] = np.abs(q1 - q0) + ierr[spi] * ds[spi, None]
-    travel = np.where(lo > 0, np.minimum(chord, ds[:, None] * hi), ds[:, None] * hi)
+    chord_ok = (lo > 0) | one_sign
+    travel = np.where(chord_ok, np.minimum(chord + np.where(one_sign, t_tol, 0.0)
+                                           * ds[:, None], ds[:, None] * hi),
+                      ds[:, None] * hi)
+    # monotone envelopes (:func:`_monotone_peak`): q'_j and q''_j of one sign each
+    kmin = np.where(k_lo > 0, k_lo, np.where(k_hi < 0, -k_hi, 0.0))   # inf |q''_j|
+    t_pos, t_neg = t_lo >= -t_tol, t_hi <= t_tol
+    one = exact[:, None] & (t_pos ^ t_neg) & (kmin > np.abs(path.omega[seg])[:, None] * t_tol)
+    sign_t = np.where(t_pos, 1.0, -1.0)
+    sign_k = np.where(k_lo > 0, 1.0, -1.0)
+    mono = np.where(one, -sign_t * sign_k, 0.0)
+    with np.errstate(divide="ignore"):
+        s_max = np.where(one, lim.a_max[None, :] / np.where(one, kmin, 1.0), np.inf)
     return _IntervalData(ds, dq0, dq1, k2, lo, I0, I1, b_bar, node_mvc,
                          moving_axes(dq0, ddq0, dq1, ddq1), ierr, slope_tan, dqm, ddqm,
-                         hi, k3, travel)
+                         hi, k3, travel, mono, s_max)
+
+
+def _monotone_peak(geo: _IntervalData, b_node: np.ndarray) -> np.ndarray:
+    """Bound of ``b`` on each interval from one-signed geometry and node bounds.
+
+    Where ``q'_j`` and ``q''_j`` keep their signs on an interval and ``|q''_j| > 0``, a
+    motion with ``b > S_j = A_j / |q''_j|`` at a point meets
+    ``|q'_j a + q''_j b| <= A_j`` only with ``sign(a) = -sign(q'_j q''_j)`` (the centripetal
+    part alone exceeds the limit, so the tangential part must take it back): above the
+    curve ``S_j`` the speed can only fall (``mono = -1``) or only rise (``mono = +1``)
+    along ``s``. Going from a point ``s`` with ``b(s) > sup S_j`` towards the interval
+    start (``mono = -1``), ``b`` stays above ``sup S_j`` and does not decrease, so
+    ``b(s) <= b(s_k)``; hence ``b <= max(b(s_k), sup S_j)`` on the interval, and with
+    ``mono = +1`` the same from the end. The node bounds are valid for every feasible
+    motion, so these are too. This is what bounds the speed where the optimum threads
+    the minimum of the maximum-velocity curve on an arc (a first-order loss of the
+    Lipschitz tent there).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        mm^2/s^2, ``inf`` where no axis qualifies.
+    """
+    b0 = np.maximum(b_node[:-1], 0.0)[:, None]
+    b1 = np.maximum(b_node[1:], 0.0)[:, None]
+    cand = np.where(geo.mono < 0, np.maximum(b0, geo.s_max),
+                    np.where(geo.mono > 0, np.maximum(b1, geo.s_max), np.inf))
+    return cand.min(axis=1) if cand.shape[1] else np.full(cand.shape[0], np.inf)
 
 
 def _varying_curvature(path: Path, seg: np.ndarray) -> np.ndarray:
@@ -356,7 +483,7 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
     margin = np.where(good, slope, 0.0) * ds * ds / REMAINDER_DIVISOR
     E = np.where(good[:, None], geo.k2 * margin[:, None]
                  + geo.ierr * np.where(good, B, 0.0)[:, None], np.inf)
-    cols_c1, cols_c2, cols_h, row_axis = [], [], [], []
+    rows = RowWriter(N, 4 * len(geo.axes_used))
     if guide is not None:       # second-order rows (optimal.arc_bounds.envelope_rows)
         slope_g = np.where(good, slope, np.inf)
         env = lower_envelopes(ds, guide[:-1], guide[1:], lim.a_max, geo.dq_mid,
@@ -374,10 +501,8 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
                 # relax: drop one term at a time (b >= 0)
                 caps.add(left[both], hrow[both] / c1[both], CAP_BOUND)
                 caps.add(left[both] + 1, hrow[both] / c2[both], CAP_BOUND)
-            cols_c1.append(np.where(both, 0.0, c1))
-            cols_c2.append(np.where(both, 0.0, c2))
-            cols_h.append(np.where(fin, hrow, 1.0))
-            row_axis.append(j)
+            rows.append(np.where(both, 0.0, c1), np.where(both, 0.0, c2),
+                        np.where(fin, hrow, 1.0), j)
             if guide is None:
                 continue
             # the same row in second-order form (optimal.arc_bounds.envelope_rows)
@@ -395,19 +520,17 @@ def _relaxed_problem(path: Path, lim: AxisArrays, grid: Grid, geo: _IntervalData
                 caps.add(left[both] + 1, h2[both] / n2[both], CAP_BOUND)
             # where formed it replaces the first-order row in the same column (dropping
             # a valid row only relaxes; this keeps the sweep's column count)
-            cols_c1[-1] = np.where(ok, np.where(both, 0.0, n1), cols_c1[-1])
-            cols_c2[-1] = np.where(ok, np.where(both, 0.0, n2), cols_c2[-1])
-            cols_h[-1] = np.where(ok, h2, cols_h[-1])
+            l1, l2, lh = rows.last()
+            l1[ok] = np.where(both, 0.0, n1)[ok]
+            l2[ok] = np.where(both, 0.0, n2)[ok]
+            lh[ok] = h2[ok]
         # energy rows (step 2b of the module docstring): exact, no remainder
         e0 = geo.dq0[:, j] ** 2
         e1 = geo.dq1[:, j] ** 2
         he = 2.0 * lim.a_max[j] * geo.travel[:, j]
         for c1, c2 in ((-e0, e1), (e0, -e1)):
-            cols_c1.append(c1)
-            cols_c2.append(c2)
-            cols_h.append(he)
-            row_axis.append(j)
-    prob = _assemble(path, lim, grid, caps, cols_c1, cols_c2, cols_h, row_axis, "relaxed")
+            rows.append(c1, c2, he, j)
+    prob = _assemble(path, lim, grid, caps, rows, "relaxed")
     return Relaxation(prob, B, slope)
 
 
@@ -479,7 +602,8 @@ def tent_times(s: np.ndarray, b: np.ndarray, b_bar: np.ndarray, slope: np.ndarra
 
 
 def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROUNDS,
-                b_node: np.ndarray | None = None
+                b_node: np.ndarray | None = None,
+                geometry: tuple[np.ndarray, ...] | None = None
                 ) -> tuple[float, np.ndarray, Relaxation, np.ndarray]:
     """Certified lower bound of the motion time on ``grid`` (dwells excluded).
 
@@ -499,6 +623,8 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
         Upper bounds of ``b`` at the nodes that hold for *every* feasible motion (for
         example mapped from a relaxation on a coarser grid with :func:`node_bounds_on`);
         they are added as node caps and start the interval bounds.
+    geometry : tuple of numpy.ndarray, optional
+        :func:`optimal.problem.interval_geometry` of ``grid`` when the caller has it.
 
     Returns
     -------
@@ -511,18 +637,22 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
     b_hat : numpy.ndarray, shape (N + 1,)
         Its greatest element, mm^2/s^2.
     """
-    geo = _interval_data(path, lim, grid)
+    geo = _interval_data(path, lim, grid, geometry)
     B = geo.b_static
     if b_node is not None:
-        B = np.minimum(B, _gronwall_peak(geo, lim, b_node))
+        B = np.minimum(B, np.minimum(_gronwall_peak(geo, lim, b_node),
+                                     _monotone_peak(geo, b_node)))
     best = None
     guide = b_node if b_node is not None and np.all(np.isfinite(b_node)) else None
     for _ in range(max(rounds, 1)):
         rel = _relaxed_problem(path, lim, grid, geo, B, b_node, guide)
         b_hat, _, _ = sweep(rel.problem)
-        t = tent_times(grid.s, b_hat, rel.b_bar, rel.slope)
+        # the interval bound sharpened by this round's node bounds (valid for every
+        # feasible motion, as b_hat is)
+        b_in = np.minimum(rel.b_bar, _monotone_peak(geo, b_hat))
+        t = tent_times(grid.s, b_hat, b_in, rel.slope)
         # arcs: one-axis comparison envelopes, valid too; keep the larger estimate
-        t = np.maximum(t, envelope_times(geo.ds, b_hat[:-1], b_hat[1:], rel.b_bar,
+        t = np.maximum(t, envelope_times(geo.ds, b_hat[:-1], b_hat[1:], b_in,
                                          lim.a_max, geo.dq_mid, geo.ddq_mid, geo.lo,
                                          geo.hi, geo.k3))
         T = float(t.sum())
@@ -531,7 +661,8 @@ def lower_bound(path: Path, lim: AxisArrays, grid: Grid, *, rounds: int = LB_ROU
             best = (T, t, rel, b_hat)
         if not improved:
             break
-        B = np.minimum(B, _gronwall_peak(geo, lim, b_hat))
+        B = np.minimum(B, np.minimum(_gronwall_peak(geo, lim, b_hat),
+                                     _monotone_peak(geo, b_hat)))
         guide = b_hat
     T, t, rel, b_hat = best
     return T * (1.0 - LB_ROUNDOFF_REL), t, rel, b_hat
@@ -560,46 +691,3 @@ def node_bounds_on(new: Grid, old: Grid, b_hat: np.ndarray, b_bar: np.ndarray
     on_old = old.s[idx] == new.s
     k = np.clip(idx - 1, 0, b_bar.size - 1)
     return np.where(on_old, b_hat[idx], b_bar[k])
-
-
-def verified_profile(path: Path, limits: MachineLimits, s: np.ndarray, b: np.ndarray,
-                     block: np.ndarray, bounds: str = "acc"
-                     ) -> tuple[Profile, float, ConstraintReport]:
-    """The grid profile, judged by ``check_profile`` and time-scaled until accepted.
-
-    Parameters
-    ----------
-    path : Path
-        The path.
-    limits : MachineLimits
-        Machine limits.
-    s, b : numpy.ndarray, shape (N + 1,)
-        Nodes (mm) and squared speeds (mm^2/s^2).
-    block : numpy.ndarray of int, shape (N,)
-        NC block of each interval.
-    bounds : str
-        Bound set of :data:`BOUND_SETS`.
-
-    Returns
-    -------
-    profile : Profile
-        The accepted (possibly slowed-down) profile.
-    lam : float
-        Time-scale factor applied (>= 1).
-    report : ConstraintReport
-        The checker's report on the *unscaled* grid profile.
-    """
-    prof = Profile.from_path_velocity(s, np.sqrt(np.maximum(b, 0.0)), block)
-    report = check_profile(path, limits, prof)
-    lam = time_scale_factor(report, BOUND_SETS[bounds])
-    if not np.isfinite(lam):
-        # the grid problem obeys the rulebook's feasible caps, which the checker accepts
-        # by construction; a profile no time scaling can repair is a bug, not bad input
-        bad = [r for r in report.results if not np.isfinite(r.ratio)]
-        where = (f"{bad[0].constraint} at s = {bad[0].s:.6g} mm, block {bad[0].block}"
-                 if bad else "unknown constraint")
-        raise InternalError(f"the oracle's grid profile breaks {where} by an infinite "
-                            f"ratio; no time scaling repairs it")
-    if lam > 1.0:
-        prof = scale_time(prof, lam)
-    return prof, lam, report

@@ -35,16 +35,19 @@ from reference.core.profile import Profile
 from reference.core.rows import BlockRow, block_motion, block_rows
 
 from .backends import DEFAULT_BACKEND, get_backend
-from .bounds import lower_bound, node_bounds_on, verified_profile
+from .bounds import lower_bound, node_bounds_on
 from .grid import Grid, initial_grid, subdivide
 from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, DiscreteProblem,
-                      DiscreteResult, build_grid_problem, check_feed, interval_times)
+                      DiscreteResult, acceleration_slopes, build_grid_problem, check_feed,
+                      interval_geometry, interval_times, slopes_keep_positive)
 from .solution import IterationRecord, OptimalSolution
+from .upper import line_tents, upper_interval_times, verified_profile
 from .status import SolveStatus
 from .jerk.tolerances import DEFAULT_JERK_GAP_TOL
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE,
-                         LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET)
+                         LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET,
+                         SLOPE_SOLVES)
 
 SUPPORTED_BOUNDS = ("acc", "jerk")
 
@@ -375,19 +378,18 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         te = time.perf_counter()
         b_node = (node_bounds_on(grid, warm.grid, warm.b_hat, warm.b_bar)
                   if warm is not None else None)
+        geometry = interval_geometry(work, grid)
         lb, t_lb, rel, b_hat = lower_bound(
             work, lim, grid, b_node=b_node,
-            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM)
+            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM, geometry=geometry)
         warm = _WarmStart(grid, b_hat, rel.b_bar)
         del rel, b_node
         t_bound += time.perf_counter() - te
-        ta = time.perf_counter()
-        problem = build_grid_problem(work, lim, grid)
-        tb = time.perf_counter()
-        res = solve_fn(problem, backend_options)
-        tc = time.perf_counter()
-        t_build += (tb - ta) + res.build_time_s
-        t_solve += tc - tb - res.build_time_s
+        problem, res, gamma, dt_b, dt_s = _solve_grid(work, lim, grid, solve_fn,
+                                                      backend_options, geometry)
+        del geometry
+        t_build += dt_b
+        t_solve += dt_s
         if res.status == SolveStatus.INFEASIBLE:
             k = _first_blocked_interval(problem, res)
             blk = int(path.block[grid.segment[k]])
@@ -399,7 +401,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             status = SolveStatus.SOLVER_ERROR
             msg = f"backend {backend!r}: {res.status} ({res.message})"
             break
-        t_prim = interval_times(grid.s, res.b)
+        tents = line_tents(work, lim, grid)
+        t_prim = upper_interval_times(grid.s, res.b, gamma, tents)
         t_grid = float(t_prim.sum()) + hold_t
         best_lb = max(best_lb, lb + hold_t)
         budget = min(max_grid - grid.n_intervals, grid.n_intervals)
@@ -422,7 +425,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         # upper bound: the checker judges the grid profile, time scaling fixes excesses
         block_of = path.block[grid.segment]
         td = time.perf_counter()
-        prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds)
+        prof, lam, report = verified_profile(path, limits, grid.s, res.b, block_of, bounds,
+                                             gamma, tents)
         t_check += time.perf_counter() - td
         ub = prof.duration + hold_t
         if best is None or ub < best.upper_bound_s:
@@ -486,6 +490,48 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
         message=message, holds=holds)
+
+
+def _solve_grid(work: Path, lim, grid: Grid, solve_fn, options, geometry=None) -> tuple[DiscreteProblem, DiscreteResult, np.ndarray, float, float]:
+    """The grid problem with second-order rows (:mod:`optimal.problem`), solved.
+
+    Solve without slopes, estimate the slopes from that solution
+    (:func:`optimal.problem.acceleration_slopes`) and solve again with them; where a slope would let ``b`` sag towards 0 inside its interval it
+    is dropped and the problem solved once more. Every problem solved is a valid grid
+    problem (the checker judges its profile); the slopes only make it accurate.
+
+    Returns
+    -------
+    problem, result, gamma, build_s, solve_s
+        The last problem, its solution, the slopes it used, and the time spent
+        building and solving, s.
+    """
+    t_build = t_solve = 0.0
+    res = problem = None
+    g = guess = None
+    if geometry is None:
+        geometry = interval_geometry(work, grid)
+    for attempt in range(SLOPE_SOLVES + 2):
+        ta = time.perf_counter()
+        problem = None              # the previous problem goes before the next is built
+        problem = build_grid_problem(work, lim, grid, g, guess, geometry)
+        tb = time.perf_counter()
+        res = solve_fn(problem, options)
+        tc = time.perf_counter()
+        t_build += (tb - ta) + res.build_time_s
+        t_solve += tc - tb - res.build_time_s
+        g = problem.gamma
+        if res.b is None or res.status not in (SolveStatus.OPTIMAL,
+                                               SolveStatus.OPTIMAL_INACCURATE):
+            break
+        ok = slopes_keep_positive(grid, res.b, g)
+        if not np.all(ok):
+            g = np.where(ok, g, 0.0)           # drop the sagging slopes, solve again
+            continue
+        if attempt + 1 >= SLOPE_SOLVES:
+            break
+        g, guess = acceleration_slopes(grid, res.b), res.b
+    return problem, res, np.asarray(problem.gamma), t_build, t_solve
 
 
 def _report_progress(progress, it, grid, gap, tol, max_grid, frac, gaps) -> float:

@@ -113,3 +113,10 @@ REFINE_TARGET = 0.7
 #: keep them near 50 MB at any grid size (measured: unchunked they added 690 B per
 #: interval to the peak of a solve).
 ENVELOPE_CHUNK = 1 << 16
+
+#: Solves of the grid problem per refinement round (:func:`optimal.oracle._solve_grid`):
+#: the first without slopes, the second with the slopes estimated from the first
+#: solution. The sweep costs a few
+#: per cent of a round, and the estimated slopes make the grid optimum second-order
+#: accurate where it follows an axis limit along an arc.
+SLOPE_SOLVES = 2

@@ -19,6 +19,7 @@ from typing import Any
 from .core.errors import MachineDataError
 from .core.limits import AxisLimits, MachineLimits
 from .core.units import m_to_mm, mm_min_to_mm_s, rev_to_deg
+from .tools import EMPTY_TOOLS, ToolTable, tools_from_toml
 
 DEFAULT_MACHINE = "default"
 BUNDLED_MACHINES = ("default", "linuxcnc_xyz")
@@ -54,17 +55,27 @@ _MACHINE_KEYS: dict[str, _Key] = {
 _CHANNEL_KEYS: dict[str, _Key] = {
     "SMOOTHING_MODE": _Key(int, "", -1, 99999, "MD20480 decimal digit map"),
     "IGNORE_OVL_FACTOR_FOR_ADIS": _Key(bool, "", doc="MD20490"),
-    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0, "MD20460"),
+    "LOOKAH_SMOOTH_FACTOR": _Key((int, float), "%", -1e-12, 100.0,
+                                  "MD20460 (0 selects the internal 100 %)"),
     "ADAPT_PATH_DYNAMIC": _Key(list, "", doc="MD20465 [BRISK, SOFT], each >= 1"),
     "lookahead_blocks": _Key(int, "blocks", 0, 100000, "LookAhead horizon"),
     "SMOOTH_CONTUR_TOL": _Key((int, float), "mm", 0.0, 100.0, "SD42465", 1e-6),
     "SMOOTH_ORI_TOL": _Key((int, float), "deg", 0.0, 90.0, "SD42466", 1e-6),
     "CUTCOM_CORNER_LIMIT": _Key((int, float), "deg", 0.0, 180.0, "MD20210", 1e-3),
+    "CUTCOM_CURVE_INSERT_LIMIT": _Key((int, float), "deg", -1e-12, 180.0, "MD20230"),
+    "CUTCOM_MAX_DISC": _Key((int, float), "", -1e-12, 100.0, "MD20220 (0..100)"),
+    "CUTCOM_840C_MD6": _Key((int, float), "mm", -1e-12, 100.0,
+                            "840C MD6 TRC switch-over threshold, 0 = off"),
     "acceleration_mode": _Key(str, "", doc="BRISK | SOFT"),
     "MAX_PATH_JERK": _Key((int, float), "m/s^3", 0.0, 1e6, "MD20600", 1e-3),
     "G0_TOLERANCE_FACTOR": _Key((int, float), "", 0.0, 1000.0, "MD20560", 1e-3),
     "rounding_length_clamp": _Key((int, float), "", 0.0, 0.5, "block-length clamp c", 1e-3),
 }
+
+#: Largest MD35230 ACCEL_REDUCTION_FACTOR: a_red = (1 - factor) MAX_AX_ACCEL must stay a
+#: real acceleration (1 would stop the axis from accelerating above the knee at all);
+#: a reduction to less than 1 % is a typing error, not a drive.
+_DRIVE_FACTOR_MAX = 0.99
 
 _AXIS_KEYS: dict[str, _Key] = {
     "type": _Key(str, "", doc="linear | rotary"),
@@ -85,6 +96,11 @@ _AXIS_KEYS: dict[str, _Key] = {
     "SOFT_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32433", 1e-3),
     "G00_ACCEL_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32434", 1e-3),
     "G00_JERK_FACTOR": _Key((int, float), "", 0.0, 10.0, "MD32435", 1e-3),
+    "ACCEL_REDUCTION_SPEED_POINT": _Key((int, float), "", 0.0, 1.0,
+                                        "MD35220: share of MAX_AX_VELO, 0..1", 1e-3),
+    "ACCEL_REDUCTION_FACTOR": _Key((int, float), "", -1e-12, _DRIVE_FACTOR_MAX,
+                                   "MD35230: a_red = (1 - factor) MAX_AX_ACCEL, 0..0.99"),
+    "ACCEL_TYPE_DRIVE": _Key(int, "", None, None, "MD35240: 0 constant, 1 hyperbolic, 2 linear"),
 }
 
 
@@ -116,6 +132,15 @@ class AxisSettings:
         exact-stop settle model (:mod:`reference.holds`). Default 0.
     soft_accel_factor, g00_accel_factor, g00_jerk_factor : float
         MD32433 / MD32434 / MD32435.
+    accel_reduction_speed_point : float
+        MD35220 ACCEL_REDUCTION_SPEED_POINT: DRIVE reduces the acceleration above this
+        share of MAX_AX_VELO (1 = never). Default 1.
+    accel_reduction_factor : float
+        MD35230 ACCEL_REDUCTION_FACTOR: ``a_red = (1 - factor) MAX_AX_ACCEL``
+        (0 = no reduction). Default 0.
+    accel_type_drive : int
+        MD35240 ACCEL_TYPE_DRIVE, the characteristic above the knee: 0 constant,
+        1 hyperbolic, 2 linear (:mod:`reference.planner.drive`). Default 0.
     """
 
     compress_pos_tol_mm: float = 0.01
@@ -127,6 +152,9 @@ class AxisSettings:
     soft_accel_factor: float = 1.0
     g00_accel_factor: float = 1.0
     g00_jerk_factor: float = 1.0
+    accel_reduction_speed_point: float = 1.0
+    accel_reduction_factor: float = 0.0
+    accel_type_drive: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,7 +168,11 @@ class ChannelSettings:
     ignore_ovl_factor_for_adis : bool
         MD20490.
     lookahead_smooth_factor_pct : float
-        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss (0 = smoothing off here).
+        MD20460 LOOKAH_SMOOTH_FACTOR, % allowed time loss, as given. 0 (also the value
+        when the key is missing) selects the control's internal 100 %: "a smoothing
+        factor other than 0% prevents the default value of 100% from being used" (B1
+        excerpt; :func:`reference.planner.smoothing.effective_factor`). A small value
+        such as 1 % switches the smoothing practically off.
     adapt_path_dynamic : tuple[float, float]
         MD20465 ADAPT_PATH_DYNAMIC for [BRISK, SOFT]; 1.0 = off.
     lookahead_blocks : int
@@ -150,7 +182,16 @@ class ChannelSettings:
     smooth_ori_tol_deg : float
         SD42466 SMOOTH_ORI_TOL, degrees.
     cutcom_corner_limit_deg : float
-        MD20210 CUTCOM_CORNER_LIMIT, degrees.
+        MD20210 CUTCOM_CORNER_LIMIT, degrees: at outside corners whose deflection (the
+        change of direction) exceeds it, G451 switches to G450 (sinumerik-model 9).
+    cutcom_curve_insert_limit_deg : float
+        MD20230 CUTCOM_CURVE_INSERT_LIMIT, degrees: outside corners whose deflection is
+        below it get the intersection instead of a transition circle (default 10 [M]).
+    cutcom_max_disc : float
+        MD20220 CUTCOM_MAX_DISC: the largest DISC value accepted (default 50 [M]).
+    cutcom_840c_md6_mm : float
+        Emulate the 840C's MD6 rule at outside corners with arcs (sinumerik-model 9 and
+        the 840C excerpt), threshold in mm; 0 = off (840D behaviour).
     acceleration_mode : {"BRISK", "SOFT"}
         Default group-21 mode.
     max_path_jerk : float
@@ -169,6 +210,9 @@ class ChannelSettings:
     smooth_contour_tol_mm: float = 0.05
     smooth_ori_tol_deg: float = 1.0
     cutcom_corner_limit_deg: float = 100.0
+    cutcom_curve_insert_limit_deg: float = 10.0
+    cutcom_max_disc: float = 50.0
+    cutcom_840c_md6_mm: float = 0.0
     acceleration_mode: str = "SOFT"
     max_path_jerk: float = 1e8
     g0_tolerance_factor: float = 3.0
@@ -191,6 +235,9 @@ class Machine:
         Channel machine data.
     axis_settings : tuple[tuple[str, AxisSettings], ...]
         Per-axis settings by axis name.
+    tools : ToolTable
+        Tool radii per tool and cutting edge (``[tools]``, and a LinuxCNC tool table
+        given with ``--tool-table``), for tool radius compensation.
     """
 
     name: str
@@ -198,6 +245,7 @@ class Machine:
     limits: MachineLimits
     channel: ChannelSettings
     axis_settings: tuple[tuple[str, AxisSettings], ...]
+    tools: ToolTable = EMPTY_TOOLS
 
     def settings_of(self, axis: str) -> AxisSettings:
         """Per-axis settings by axis name (defaults for an unknown axis)."""
@@ -217,19 +265,28 @@ def _check(section: str, key: str, value: Any, spec: _Key, source: str) -> None:
         ok = isinstance(value, kinds)
     if not ok:
         want = " or ".join(k.__name__ for k in kinds).replace("int or float", "number")
-        raise MachineDataError(dotted, value, f"must be a {want}"
+        want = {"int": "n integer", "str": " string", "bool": " boolean"}.get(want, f" {want}")
+        raise MachineDataError(dotted, value, f"must be a{want}"
                                + (f" in {spec.unit}" if spec.unit else ""), source)
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         if value != value or value in (float("inf"), float("-inf")):
             raise MachineDataError(dotted, value, "must be finite", source)
         if spec.lo is not None and not value > spec.lo:
-            raise MachineDataError(dotted, value, f"must be > {spec.lo:g} {spec.unit}".rstrip(),
-                                   source)
+            # lo just below 0 stands for ">= 0" (0 itself allowed)
+            rule = ("must be >= 0" if -1e-9 < spec.lo < 0 else f"must be > {spec.lo:g}")
+            raise MachineDataError(dotted, value, f"{rule} {spec.unit}".rstrip(), source)
+        if spec.low is not None and value < spec.low and not spec.unit:
+            raise MachineDataError(dotted, value, f"is below the plausible minimum "
+                                   f"{spec.low:g} ({spec.doc})", source)
         if spec.low is not None and value < spec.low:
             raise MachineDataError(
                 dotted, value, f"is below the plausible minimum {spec.low:g} {spec.unit}; "
                 f"check the unit ({spec.doc} is given in {spec.unit})".replace(" ;", ";")
                 .replace("( is given in )", "(a factor)"), source)
+        if spec.hi is not None and value > spec.hi and not spec.unit:
+            # a share, a factor or a code: no unit to mix up
+            raise MachineDataError(dotted, value, f"must be <= {spec.hi:g} ({spec.doc})",
+                                   source)
         if spec.hi is not None and value > spec.hi:
             raise MachineDataError(
                 dotted, value, f"is above the plausible maximum {spec.hi:g} {spec.unit}; "
@@ -250,7 +307,8 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
     Parameters
     ----------
     data : dict
-        The TOML document as a dict (sections ``machine``, ``channel``, ``axis.<NAME>``).
+        The TOML document as a dict (sections ``machine``, ``channel``, ``axis.<NAME>``,
+        ``tools``: see :mod:`reference.tools`).
     source : str
         Where it came from, for messages.
 
@@ -264,9 +322,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         Unknown section or key, wrong type, non-positive or implausible value.
     """
     for sec in data:
-        if sec not in ("machine", "channel", "axis"):
+        if sec not in ("machine", "channel", "axis", "tools"):
             raise MachineDataError(sec, data[sec], "unknown section; expected [machine], "
-                                   "[channel] and [axis.<NAME>]", source)
+                                   "[channel], [axis.<NAME>] and [tools]", source)
     for sec in ("machine", "channel"):
         if sec in data and not isinstance(data[sec], dict):
             raise MachineDataError(sec, data[sec], f"must be a table: a [{sec}] section with "
@@ -311,6 +369,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
         smooth_contour_tol_mm=float(ch.get("SMOOTH_CONTUR_TOL", 0.05)),
         smooth_ori_tol_deg=float(ch.get("SMOOTH_ORI_TOL", 1.0)),
         cutcom_corner_limit_deg=float(ch.get("CUTCOM_CORNER_LIMIT", 100.0)),
+        cutcom_curve_insert_limit_deg=float(ch.get("CUTCOM_CURVE_INSERT_LIMIT", 10.0)),
+        cutcom_max_disc=float(ch.get("CUTCOM_MAX_DISC", 50.0)),
+        cutcom_840c_md6_mm=float(ch.get("CUTCOM_840C_MD6", 0.0)),
         acceleration_mode=mode,
         max_path_jerk=m_to_mm(float(ch.get("MAX_PATH_JERK", 1e5))),
         g0_tolerance_factor=float(ch.get("G0_TOLERANCE_FACTOR", 3.0)),
@@ -330,6 +391,9 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             if k not in _AXIS_KEYS:
                 _unknown(sec, k, v, _AXIS_KEYS, source)
             _check(sec, k, v, _AXIS_KEYS[k], source)
+        if tbl.get("ACCEL_TYPE_DRIVE", 0) not in (0, 1, 2):
+            raise MachineDataError(f"{sec}.ACCEL_TYPE_DRIVE", tbl["ACCEL_TYPE_DRIVE"],
+                                   "must be 0 (constant), 1 (hyperbolic) or 2 (linear)", source)
         for req in ("MAX_AX_VELO", "MAX_AX_ACCEL", "MAX_AX_JERK"):
             if req not in tbl:
                 raise MachineDataError(f"{sec}.{req}", None,
@@ -360,14 +424,18 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             velo_ffw_weight=float(tbl.get("VELO_FFW_WEIGHT", 0.0)),
             soft_accel_factor=float(tbl.get("SOFT_ACCEL_FACTOR", 1.0)),
             g00_accel_factor=float(tbl.get("G00_ACCEL_FACTOR", 1.0)),
-            g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)))))
+            g00_jerk_factor=float(tbl.get("G00_JERK_FACTOR", 1.0)),
+            accel_reduction_speed_point=float(tbl.get("ACCEL_REDUCTION_SPEED_POINT", 1.0)),
+            accel_reduction_factor=float(tbl.get("ACCEL_REDUCTION_FACTOR", 0.0)),
+            accel_type_drive=int(tbl.get("ACCEL_TYPE_DRIVE", 0)))))
     for geo in ("X", "Y", "Z"):
         if geo not in axes_raw:
             raise MachineDataError(f"axis.{geo}", None, "geometry axes X, Y and Z are "
                                    "required", source)
     limits = MachineLimits(axes=tuple(axes), t_ipo_s=t_ipo, name=name)
+    tools = tools_from_toml(data["tools"], source) if "tools" in data else EMPTY_TOOLS
     return Machine(name=name, source=source, limits=limits, channel=channel,
-                   axis_settings=tuple(settings))
+                   axis_settings=tuple(settings), tools=tools)
 
 
 def _decode(data: bytes, source: str) -> str:

@@ -15,13 +15,29 @@ LookAhead (sinumerik-model sections 3 and 5.2). Model choices, each a documented
 * M0, M1 (programmed stop), M2, M30 (end) in a moving block -> rest at its end;
   M6 (tool change) in a moving block -> rest at its start (aux output before motion);
   a positioning-axis block (SINUMERIK ``POS[A]=...``) -> rest at its start and its end;
-  other M, S, T, D, H words in a moving block are output during motion: no stop.
+  other M, S, T, D, H words in a moving block are output during motion: no stop;
+* SINUMERIK: geometry axes (X, Y, Z) move in one of two consecutive moving blocks but
+  not in the other (e.g. ``A30`` alone between two X blocks) -> rest between them.
 
-Stops that only the heuristic makes (BRISK/SOFT change, geometry axes appearing) belong
-to the reference planner, not to the path.
+The last rule is the function manual's list of transitions where "the axes stop between
+the blocks anyway" (sinumerik-model 5.2 group 1: "geometry axes move in one block but
+not in the other", next to "the next block has no path motion", the positioning-axis
+change and the auxiliary output before motion, which are path stops here too). It is a
+rule of the block sequence, not of velocity planning: the control stops there whatever
+the LookAhead would allow, because the path velocity changes its meaning (F and the path
+parameter refer to the geometry axes in one block and to the other axes in the next).
+So it is a path stop that every planner obeys, the oracle included; the gap does not
+charge it to the heuristic. NGC programs do not get it: LinuxCNC's planner blends a
+transition into or out of a rotary-only move (it skips only the blend arc and the
+tangency test there).
+
+Stops that only the heuristic makes (a BRISK/SOFT change) belong to the reference
+planner (:mod:`reference.planner.stops`), not to the path.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,6 +50,11 @@ from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_M
 from .machine import Machine
 from .nc.program import Block, Program, ProgramWarning
 from .rounding import round_corners
+from .tangential import TangentialResult, tangential_path
+from .trc import TrcResult, compensate_path
+
+#: Stop reason where geometry axes move in one block only (sinumerik-model 5.2).
+GEOMETRY_AXES_STOP = "geometry axes move in one block only"
 
 _PLANES = {"G17": ("X", "Y"), "G18": ("Z", "X"), "G19": ("Y", "Z")}
 _STOP_AT_END_M = {0: "M0 programmed stop", 1: "M1 optional stop", 2: "M2 program end",
@@ -111,6 +132,7 @@ def prepare(program: Program) -> Path:
     geo = np.sqrt(np.sum(delta[:, geometry] ** 2, axis=1))
     allax = np.sqrt(np.sum(delta ** 2, axis=1))
     line_len = np.where(geo > POS_TOL_MM, geo, allax)
+    geo_moves = is_arc | (geo > POS_TOL_MM)        # per block: X, Y or Z move
     del delta, geo, allax
     moving_line = is_motion & ~is_arc & (line_len > POS_TOL_MM)
     moving = moving_line | is_arc  # arcs decided below (a full circle has start == end)
@@ -167,6 +189,12 @@ def prepare(program: Program) -> Path:
 
     # --- stops at the m + 1 breaks -----------------------------------------------
     reasons = [""] * (m + 1)
+    # SINUMERIK: geometry axes in one of two consecutive moving blocks only (5.2)
+    geo_change = np.zeros(m + 1, dtype=bool)
+    if program.dialect == "sinumerik" and m >= 2:
+        geo_seg = geo_moves[rows]
+        geo_change[1:m] = geo_seg[1:] != geo_seg[:-1]
+
     spans: list[BlockSpan] = []
     next_break = 0            # break index in front of the next segment
     # Python numbers taken once from the arrays: a block's start is the very float
@@ -204,6 +232,13 @@ def prepare(program: Program) -> Path:
                 s_start=s_at[next_break], s_end=s_at[next_break],
                 first_segment=next_break, n_segments=0, stop_reason=why,
                 dwell_s=float(b.dwell_s or 0.0)))
+    # the geometry-axes stop last: a reason the program states (POS, M6, ...) names it
+    for k in np.flatnonzero(geo_change).tolist():
+        if not reasons[k]:
+            reasons[k] = GEOMETRY_AXES_STOP
+            i = int(rows[k - 1])                # the block that ends at break k
+            if not spans[i].stop_reason:
+                spans[i] = replace(spans[i], stop_reason=GEOMETRY_AXES_STOP)
     reasons[0] = reasons[0] or "start"
     reasons[m] = reasons[m] or "end"
 
@@ -234,7 +269,12 @@ def _exact_path_stops(path: Path, program: Program) -> Path:
 
 
 def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
-    """Warnings for programmed features the path does not apply yet (TRC, TANG).
+    """Warnings for programmed features one side of the comparison does not know.
+
+    Tool radius compensation (:mod:`reference.trc`) and tangential control
+    (:mod:`reference.tangential`) are applied by :func:`build_path`; what they cannot
+    model is an error there, naming the line. DRIVE: the heuristic reduces the
+    acceleration above the knee, the oracle does not.
 
     Parameters
     ----------
@@ -246,16 +286,14 @@ def unmodelled_features(program: Program) -> tuple[ProgramWarning, ...]:
         At most one warning per feature, naming the first line that uses it.
     """
     out: list[ProgramWarning] = []
-    trc = next((b for b in program.blocks if b.tool_compensation != "G40"), None)
-    if trc is not None:
-        out.append(ProgramWarning(program.file, trc.line,
-                                  f"tool radius compensation {trc.tool_compensation} is not "
-                                  "applied: the path is the programmed contour"))
-    tang = next((b for b in program.blocks if b.tangential is not None), None)
-    if tang is not None:
-        out.append(ProgramWarning(program.file, tang.line,
-                                  "tangential control is not applied: the following axis "
-                                  "moves only as programmed"))
+    drive = next((b for b in program.blocks if b.accel_mode == "DRIVE"), None)
+    if drive is not None:
+        out.append(ProgramWarning(program.file, drive.line,
+                                  "DRIVE: the heuristic reduces the acceleration above "
+                                  "ACCEL_REDUCTION_SPEED_POINT as the machine data set it "
+                                  "(MD35220, MD35230, MD35240); the oracle does not know "
+                                  "DRIVE and accelerates with MAX_AX_ACCEL, so the gap "
+                                  "includes that reduction"))
     return tuple(out)
 
 
@@ -314,9 +352,10 @@ def build_path(program: Program, machine: Machine) -> Path:
     The heuristic (:func:`reference.planner.plan`), the oracle's callers and the
     comparison all take their path from here, so the gap measures velocity planning
     alone (DESIGN section 1): the programmed contour (:func:`prepare`) over the axes the
-    machine knows (:func:`restrict_to_machine`), with the corners of blocks in
-    G641..G645 rounded (:func:`reference.rounding.round_corners`); tool radius
-    compensation, once modelled, belongs here too.
+    machine knows (:func:`restrict_to_machine`), then the stages in the control's order
+    (DESIGN section 5): tool radius compensation (:func:`reference.trc.apply_trc`),
+    tangential control (:func:`reference.tangential.apply_tangential`) and the corner
+    rounding of blocks in G641..G645 (:func:`reference.rounding.round_corners`).
 
     Parameters
     ----------
@@ -334,12 +373,42 @@ def build_path(program: Program, machine: Machine) -> Path:
     PathError
         Arc geometry out of tolerance (names file and line).
     MachineDataError
-        The program moves an axis the machine has no limits for (names axis and line).
+        The program moves an axis the machine has no limits for, or tangential control
+        turns one (names axis and line).
+    PathError
+        Tool radius compensation or tangential control cannot build the path: a missing
+        tool radius, the tool does not fit (the control's collision alarm), a model limit
+        (names file and line).
     """
+    return path_stages(program, machine).path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PathStages:
+    """The stages of :func:`build_path` with what each decided (for ``inspect``).
+
+    Attributes
+    ----------
+    trc : reference.trc.TrcResult
+        Tool radius compensation: the compensated path, its blocks and corners.
+    tangential : reference.tangential.TangentialResult
+        Tangential control: the path with the following axes, their corners.
+    path : Path
+        The final path (after rounding; its ``rounding`` table says what was rounded).
+    """
+
+    trc: TrcResult
+    tangential: TangentialResult
+    path: Path
+
+
+def path_stages(program: Program, machine: Machine) -> PathStages:
+    """:func:`build_path` with the result of every stage kept (same path, same errors)."""
     path = restrict_to_machine(prepare(program), machine.limits)
     _check_motion_times(path)
-    path = round_corners(path, program, machine)
-    return path
+    trc = compensate_path(path, program, machine)
+    tang = tangential_path(trc.path, program, machine)
+    return PathStages(trc, tang, round_corners(tang.path, program, machine))
 
 
 def _check_motion_times(path: Path) -> None:
@@ -360,5 +429,6 @@ def _check_motion_times(path: Path) -> None:
                         f"resolution); raise the feed or split the block", worst)
 
 
-__all__ = ["build_path", "prepare", "require_axes", "restrict_to_machine",
-           "unmodelled_features", "KIND_CODES"]
+__all__ = ["GEOMETRY_AXES_STOP", "PathStages", "build_path", "path_stages", "prepare",
+           "require_axes",
+           "restrict_to_machine", "unmodelled_features", "KIND_CODES"]

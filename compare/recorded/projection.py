@@ -1,6 +1,8 @@
 """Projection of recorded samples onto the program's path: the second stage.
 
-Each sample goes to the nearest point of the path, tracked monotonically in ``s`` (a
+Each sample goes to the nearest point of the path (over the geometry axes; over all axes
+where some segment moves other axes alone, such as a TLIFT block or a positioning axis,
+whose progress the geometry axes cannot show), tracked monotonically in ``s`` (a
 sample may only look a few chords ahead of the previous one, so a path that crosses
 itself is not short-cut; where the path passes a sample twice, the pass that keeps the
 advance per sample smoothest wins), then refined by Newton steps on the exact geometry
@@ -23,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.core.geometry import Path
-from reference.core.tolerances import POS_TOL_MM
+from reference.core.tolerances import MOVING_AXIS_TOL, POS_TOL_MM
 
 from .smoothing import estimate_noise
 
@@ -91,8 +93,13 @@ def project(path: Path, q: np.ndarray, t: np.ndarray | None = None) -> Projectio
     if path.n_segments == 0:
         return Projection(np.zeros(N), np.zeros(N))
     geo = path.geometry.copy()
-    use = geo if np.any(np.abs(path.d[:, geo]).sum() + path.radius.sum() > 0) and geo.any() \
-        else np.ones(path.n_axes, bool)
+    moves_geo = (path.radius > 0) | (np.abs(path.d[:, geo]).max(axis=1, initial=0.0)
+                                     > MOVING_AXIS_TOL)
+    # the geometry axes find a sample's place on the path, unless some segment moves
+    # other axes alone (a TLIFT block, a positioning axis): there the geometry rests and
+    # only all axes tell how far the motion got; the deviation stays the geometry's
+    measure = geo if moves_geo.any() and geo.any() else np.ones(path.n_axes, bool)
+    use = measure if moves_geo.all() else np.ones(path.n_axes, bool)
     sd, qd = _dense(path)
     qd, qu = qd[:, use], q[:, use]
     step = float(np.max(np.diff(sd))) if sd.size > 1 else 0.0
@@ -164,5 +171,5 @@ def project(path: Path, q: np.ndarray, t: np.ndarray | None = None) -> Projectio
                                                        (np.abs(x - s) < np.abs(best_s - s))))
         best_s, best_d = np.where(better, x, best_s), np.where(better, dist, best_d)
     s = np.maximum.accumulate(best_s)
-    dev = np.linalg.norm(path.evaluate(s)[0][:, use] - qu, axis=1)
+    dev = np.linalg.norm(path.evaluate(s)[0][:, measure] - q[:, measure], axis=1)
     return Projection(s=s, deviation=dev)

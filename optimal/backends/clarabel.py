@@ -110,6 +110,6 @@ def solve_discrete(problem: DiscreteProblem,
         return DiscreteResult(status, None, float("inf"), NAME, build, solve_t, iters,
                               f"cvxpy status {prob.status}")
     b = np.minimum(np.clip(np.asarray(x.value), 0.0, None) * b_unit, problem.cap)
-    T = float(interval_times(problem.s, b).sum())
+    T = float(interval_times(problem.s, b, problem.gamma).sum())
     return DiscreteResult(status, b, T, NAME, build, solve_t, iters,
                           f"cvxpy status {prob.status}")

@@ -38,6 +38,7 @@ Options: ``method`` (``"auto"``, ``"compiled"``, ``"vectorised"``, ``"sequential
 
 from __future__ import annotations
 
+import sys
 import time
 from typing import Mapping
 
@@ -50,6 +51,8 @@ from ..tolerances import (COMPILED_MIN_ROWS, RECURRENCE_MAX_ROUNDS, RECURRENCE_R
 from ._common import check_options
 
 NAME = "fast"
+#: Module of the compiled sweep (used for every size once some problem has loaded it).
+_KERNEL = __name__.rsplit(".", 1)[0] + ".kernel"
 INSTALL = "nothing (numpy and numba, both required)"
 OPTIONS: dict[str, type] = {"method": str, "max_rounds": int}
 
@@ -274,9 +277,11 @@ def sweep(problem: DiscreteProblem, *, method: str = "auto",
         Method actually used (``"compiled"``, ``"vectorised"``, ``"sequential"`` or
         mixed).
     """
-    if method == "compiled" or (method == "auto" and problem.c1.size >= COMPILED_MIN_ROWS):
+    if method == "compiled" or (method == "auto" and (problem.c1.size >= COMPILED_MIN_ROWS
+                                                      or _KERNEL in sys.modules)):
         # imported here: loading numba and the cached kernel costs about 0.5 s once per
-        # process, which small problems never recover
+        # process, which small problems never recover; once it is loaded (a large
+        # problem earlier in this process) every size uses it
         from .kernel import greatest_element
         b = greatest_element(np.ascontiguousarray(problem.cap),
                              np.ascontiguousarray(problem.c1),
@@ -324,7 +329,7 @@ def solve_discrete(problem: DiscreteProblem,
     b, rounds, how = sweep(problem, method=method,
                            max_rounds=int(opts.get("max_rounds", RECURRENCE_MAX_ROUNDS)))
     t1 = time.perf_counter()
-    dt = interval_times(problem.s, b)
+    dt = interval_times(problem.s, b, problem.gamma)
     if not np.all(np.isfinite(dt)):
         k = int(np.flatnonzero(~np.isfinite(dt))[0])
         return DiscreteResult(SolveStatus.INFEASIBLE, b, float("inf"), NAME, 0.0, t1 - t0,

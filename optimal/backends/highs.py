@@ -79,7 +79,7 @@ def solve_discrete(problem: DiscreteProblem,
     if res.status == 0 and res.x is not None:
         b = np.clip(res.x, 0.0, None) * scale
         b = np.minimum(b, problem.cap)
-        dt = interval_times(problem.s, b)
+        dt = interval_times(problem.s, b, problem.gamma)
         T = float(dt.sum())
         st = SolveStatus.OPTIMAL if np.isfinite(T) else SolveStatus.INFEASIBLE
         return DiscreteResult(st, b, T, NAME, t1 - t0, t2 - t1, int(res.nit), res.message)

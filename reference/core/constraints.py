@@ -110,7 +110,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .errors import ProfileError
-from .geometry import Path, plane_amplitudes
+from .geometry import Path, clothoid_derivative_norms, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
 from .rules import (axis_acceleration, axis_jerk, axis_velocity, axis_velocity_jumps,
@@ -600,8 +600,8 @@ def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
     part of the m-th path derivative of axis ``i`` has the amplitude ``rho_i r |w|^m``
     (``rho_i`` the axis' plane weight), and the helix adds the constant ``d_i`` to the
     first derivative only; on a clothoid the in-plane norms are bounded by
-    :func:`_clothoid_derivative_norms` (an axis' share of a plane vector is at most
-    ``rho_i`` times its norm). With ``V``, ``A``, ``J`` the largest ``|v|``, path
+    :func:`reference.core.geometry.clothoid_derivative_norms` (an axis' share of a plane
+    vector is at most ``rho_i`` times its norm). With ``V``, ``A``, ``J`` the largest ``|v|``, path
     acceleration ``|a|`` and path jerk ``|j|`` on the interval (``j`` is constant in an
     interval, so its time derivative is 0), differentiating the axis velocity
     ``q1 v``, acceleration ``q1 a + q2 v^2`` and jerk ``q1 j + 3 q2 v a + q3 v^3``
@@ -625,7 +625,7 @@ def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
     norms = [r * w ** m for m in range(1, 6)]
     cl = np.flatnonzero(path.sharpness[seg])
     if cl.size:
-        for m, val in enumerate(_clothoid_derivative_norms(
+        for m, val in enumerate(clothoid_derivative_norms(
                 np.abs(path.sharpness[seg[cl]]), path.length[seg[cl]])):
             norms[m][cl] = val
     a1 = np.abs(path.d[seg]) + rho * norms[0][:, None]
@@ -636,21 +636,6 @@ def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
     b_jerk = (a5 * V ** 5 + 10 * a4 * V ** 3 * A + 15 * a3 * V * A ** 2
               + 10 * a3 * V ** 2 * J + 10 * a2 * A * J)
     return b_vel, b_acc, b_jerk
-
-
-def _clothoid_derivative_norms(c: np.ndarray, length: np.ndarray) -> list[np.ndarray]:
-    """Bounds of ``|q^(m)|``, ``m = 1..5``, on clothoid pieces of curvature rate ``c``
-    and length ``L`` (``kappa = c sigma <= K = c L``), shape (N,) each.
-
-    With ``T``, ``N`` the unit tangent and normal (``T' = kappa N``, ``N' = -kappa T``,
-    ``kappa' = c``): ``q' = T``, ``q'' = kappa N``, ``q''' = c N - kappa^2 T``,
-    ``q'''' = -3 c kappa T - kappa^3 N``, ``q5 = (kappa^4 - 3 c^2) T - 6 c kappa^2 N``;
-    ``T``, ``N`` orthonormal, so the norms are at most ``1``, ``K``, ``hypot(c, K^2)``,
-    ``hypot(3 c K, K^3)`` and ``hypot(max(K^4, 3 c^2), 6 c K^2)``.
-    """
-    K = c * length
-    return [np.ones_like(c), K, np.hypot(c, K * K), np.hypot(3 * c * K, K ** 3),
-            np.hypot(np.maximum(K ** 4, 3 * c * c), 6 * c * K * K)]
 
 
 def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,

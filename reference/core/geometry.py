@@ -253,6 +253,21 @@ def _eval_clothoid(origin, e1, e2, sharpness, length, s):
     return q, dq, ddq, dddq
 
 
+def clothoid_derivative_norms(c: np.ndarray, length: np.ndarray) -> list[np.ndarray]:
+    """Bounds of ``|q^(m)|``, ``m = 1..5``, on clothoid pieces of curvature rate ``c``
+    and length ``L`` (``kappa = c sigma <= K = c L``), shape (N,) each.
+
+    With ``T``, ``N`` the unit tangent and normal (``T' = kappa N``, ``N' = -kappa T``,
+    ``kappa' = c``): ``q' = T``, ``q'' = kappa N``, ``q''' = c N - kappa^2 T``,
+    ``q'''' = -3 c kappa T - kappa^3 N``, ``q5 = (kappa^4 - 3 c^2) T - 6 c kappa^2 N``;
+    ``T``, ``N`` orthonormal, so the norms are at most ``1``, ``K``, ``hypot(c, K^2)``,
+    ``hypot(3 c K, K^3)`` and ``hypot(max(K^4, 3 c^2), 6 c K^2)``.
+    """
+    K = c * length
+    return [np.ones_like(c), K, np.hypot(c, K * K), np.hypot(3 * c * K, K ** 3),
+            np.hypot(np.maximum(K ** 4, 3 * c * c), 6 * c * K * K)]
+
+
 def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
                     half_length: np.ndarray, block: np.ndarray, kind_code: int
                     ) -> dict[str, np.ndarray]:

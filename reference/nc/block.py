@@ -51,6 +51,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     seen: dict[str, float] = {}
     m98_col = 0
     positioning: list[tuple[str, float, str, int]] = []   # POS[axis]=value
+    t_word = False                              # a T word in this block (edge D1 default)
+    d_word: tuple[float, int] | None = None     # the D word (edge; NGC: tool or diameter)
     block_feed: float | None = None             # a feed of this block only (POS with FA)
 
     def once(name: str, val: float, col: int) -> None:
@@ -121,6 +123,7 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             once(name, hash(w.value[1]), w.col)
             aux.append(("T", w.value[1]))
             ip.tool = w.value[1]
+            t_word = True
             continue
         val = ip.ev(st, w.value, w.col)
         if not math.isfinite(val):
@@ -152,9 +155,11 @@ def _block(ip: _Interp, st: Stmt) -> bool:
         elif name == "T":
             aux.append(("T", val))
             ip.tool = int(val)
+            t_word = True
         elif name == "D":
             aux.append(("D", val))
             ip.offset_no = int(val)
+            d_word = (val, w.col)
         elif name == "P":
             p_word = (val, w.col)
         elif name == "Q":
@@ -244,8 +249,11 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             p_word = None
         elif gi in (40, 41, 42):
             ip.trc = f"G{int(gi)}"
+            if ngc:
+                _ngc_comp_tool(ip, st, gi, d_word, col)
         elif ngc and gi in (41.1, 42.1):         # dynamic TRC: the D word is the diameter
             ip.trc = f"G{int(gi)}"
+            _ngc_comp_tool(ip, st, gi, d_word, col)
         elif not ngc and gi in (450, 451):
             ip.trc_corner = f"G{int(gi)}"
         elif ngc and gi == 10:
@@ -285,6 +293,11 @@ def _block(ip: _Interp, st: Stmt) -> bool:
             raise ip.err(st, col, f"unknown G code G{gi:g}")
     if m98_col:
         _m98(ip, st, m98_col, p_word)
+    if not ngc:                                 # the cutting edge TRC uses (D, D1 after T)
+        if d_word is not None:
+            ip.edge = int(d_word[0])
+        elif t_word:
+            ip.edge = 1
     # --- flags (SINUMERIK keywords) ------------------------------------------------
     frame_cmd = None
     for flag, col in st.flags:
@@ -345,6 +358,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
                 message = a[a.find('"') + 1:a.rfind('"')]
         elif name in ("TANG", "TANGON", "TANGOF", "TLIFT", "TANGDEL"):
             _tangential(ip, st, name, args, col)
+        elif not ngc and name == "$TC_DP6":
+            _tool_radius_assignment(ip, st, args, col)
         elif not ngc and name in _UNSUPPORTED_MOTION_SIN and not args:
             raise ip.err(st, col + 1, f"{name} ({_UNSUPPORTED_MOTION_SIN[name]}) is not "
                                       "supported: its points would not be on the modelled "
@@ -485,7 +500,8 @@ def _block(ip: _Interp, st: Stmt) -> bool:
     tang = ip.tang_defs.get(ip.tang_active) if ip.tang_active else None
     modal_values = (ip.plane, ip.mode10, ip.criterion, ip.adis, ip.adispos, ip.ctol, ip.otol,
                     tuple(sorted(ip.atol.items())), ip.naive_cam, ip.accel_mode, ip.trc,
-                    ip.trc_corner, ip.disc, ip.tool, ip.offset_no, tang, ip.rndm)
+                    ip.trc_corner, ip.disc, ip.tool, ip.offset_no, tang, ip.rndm,
+                    *_trc_tool(ip))
     if ip.last_modal_values == modal_values:
         modal = ip.modal
     else:
@@ -580,7 +596,8 @@ def _tangential(ip: _Interp, st: Stmt, name: str, args: str, col: int) -> None:
         if len(parts) < 3:
             raise ip.err(st, col, "TANG needs (following axis, leading axis 1, leading axis 2"
                                   "[, coupling])")
-        coupling = float(parts[3]) if len(parts) > 3 and parts[3] else 1.0
+        coupling = _call_number(ip, st, parts[3], col, "TANG coupling") if (
+            len(parts) > 3 and parts[3]) else 1.0
         ip.tang_defs[axis] = Tangential(axis=axis, leading=(parts[1], parts[2]),
                                         coupling=coupling)
         ip.add_axis(axis)
@@ -589,7 +606,8 @@ def _tangential(ip: _Interp, st: Stmt, name: str, args: str, col: int) -> None:
             raise ip.err(st, col, f"{name}({axis}) without a TANG({axis}, ...) definition")
         d = ip.tang_defs[axis]
         if name == "TANGON":
-            off = float(parts[1]) if len(parts) > 1 and parts[1] else 0.0
+            off = _call_number(ip, st, parts[1], col, "TANGON angle") if (
+                len(parts) > 1 and parts[1]) else 0.0
             ip.tang_defs[axis] = Tangential(d.axis, d.leading, d.coupling, off, d.tlift)
             ip.tang_active = axis
         elif name == "TLIFT":
@@ -602,3 +620,79 @@ def _tangential(ip: _Interp, st: Stmt, name: str, args: str, col: int) -> None:
                 raise ip.err(st, col, f"TANGDEL({axis}) while tangential control is on; "
                                       "TANGOF first")
             del ip.tang_defs[axis]
+
+
+def _call_number(ip: _Interp, st: Stmt, text: str, col: int, what: str) -> float:
+    """A numeric argument of a call such as ``TANG(C, X, Y, R1*2)``: an expression."""
+    try:
+        cur = Cursor(text)
+        node = parse_expr(cur)
+        if cur.peek():
+            raise ExprError(f"unexpected '{cur.peek()}'", cur.pos)
+    except ExprError as exc:
+        raise ip.err(st, col + 1, f"{what} '{text}': {exc}") from None
+    val = ip.ev(st, node, col + 1)
+    if not math.isfinite(val):
+        raise ip.err(st, col + 1, f"{what} '{text}' is not a finite number")
+    return val
+
+
+def _tool_radius_assignment(ip: _Interp, st: Stmt, text: str, col: int) -> None:
+    """SINUMERIK ``$TC_DP6[t, d] = r``: the radius of cutting edge ``d`` of tool ``t``.
+
+    Tool data are in the control's basic system (metric assumed: mm, also under G70);
+    a negative radius is kept (it moves the tool to the other side, as on the control).
+    A calculation in block preparation: it adds no stop to the path.
+    """
+    head, eq, value = text.partition("=")
+    lb, rb = head.find("["), head.rfind("]")
+    if not eq or lb < 0 or rb < lb or head[rb + 1:].strip():
+        raise ip.err(st, col + 1, f"'{text}': expected $TC_DP6[tool, edge] = radius")
+    index = [a for a in head[lb + 1:rb].split(",")]
+    if len(index) != 2:
+        raise ip.err(st, col + 1, f"'{text}': $TC_DP6 needs two indices [tool, edge]")
+    tool, edge = (_call_number(ip, st, a.strip(), col, "$TC_DP6 index") for a in index)
+    if tool != int(tool) or edge != int(edge) or tool < 0 or edge < 1:
+        raise ip.err(st, col + 1, f"'{text}': tool and edge must be whole numbers, tool >= 0 "
+                                  "and edge >= 1")
+    radius = _call_number(ip, st, value.strip(), col, "$TC_DP6 value")
+    if not abs(radius) <= MAX_COORDINATE_MM:
+        raise ip.err(st, col + 1, f"'{text}': a tool radius of {radius:g} mm is not a tool")
+    ip.tool_data[(int(tool), int(edge))] = radius
+
+
+def _ngc_comp_tool(ip: _Interp, st: Stmt, gi: float, d_word, col: int) -> None:
+    """NGC G40/G41/G42/G41.1/G42.1: where the compensation radius comes from (LinuxCNC
+    ``convert_cutter_compensation_on``): G41/G42 ``D<tool>`` names a tool of the tool
+    table (default: the current tool), G41.1/G42.1 ``D<diameter>`` gives the diameter."""
+    ip.ngc_comp_tool = None
+    ip.ngc_comp_radius = None
+    if gi == 40:
+        return
+    if gi in (41.1, 42.1):
+        if d_word is None:
+            raise ip.err(st, col, f"G{gi:g} with no D word (D is the tool diameter)")
+        ip.ngc_comp_radius = d_word[0] * ip.lin("X") / 2.0
+        return
+    if d_word is not None:
+        if d_word[0] != int(d_word[0]) or d_word[0] < 0:
+            raise ip.err(st, d_word[1], f"G{gi:g} D{d_word[0]:g}: D must be a whole tool "
+                                        "number >= 0")
+        ip.ngc_comp_tool = int(d_word[0])
+
+
+def _trc_tool(ip: _Interp) -> tuple:
+    """``(trc_tool, tool_radius_mm)`` of the modal state (see :class:`Modal`)."""
+    if ip.ngc:
+        if ip.ngc_comp_radius is not None:
+            return None, ip.ngc_comp_radius
+        tool = ip.ngc_comp_tool if ip.ngc_comp_tool is not None else ip.tool
+        if tool is None:
+            return None, None
+        return (tool, 1), ip.tool_data.get((tool, 1))
+    if ip.tool is None and ip.offset_no is None:
+        return None, None
+    key = (ip.tool, ip.edge)
+    if ip.edge == 0:
+        return key, 0.0                       # D0: no tool offset
+    return key, ip.tool_data.get(key)

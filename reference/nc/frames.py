@@ -174,9 +174,20 @@ def _ngc_frame(ip: _Interp) -> None:
 
 
 def _apply_g10(ip: _Interp, st: Stmt, axis_words, l_word, p_word, r_word) -> None:
-    """NGC ``G10 L2 Pn`` (work offset n, P0 = active; R = XY rotation, degrees) and
-    ``G10 L20`` (offset chosen so that the current point gets the given coordinates)."""
+    """NGC ``G10 L2 Pn`` (work offset n, P0 = active; R = XY rotation, degrees),
+    ``G10 L20`` (offset chosen so that the current point gets the given coordinates) and
+    ``G10 L1 P<tool> R<radius>`` (the tool table's radius, for cutter compensation)."""
     kind = int(l_word[0]) if l_word is not None else None
+    if kind == 1 and p_word is not None and r_word is not None:
+        # G10 L1 P<tool> R<radius>: the tool table's radius (cutter compensation uses it)
+        if p_word[0] != int(p_word[0]) or p_word[0] < 0:
+            raise ip.err(st, p_word[1], f"G10 L1 P{p_word[0]:g}: P must be a whole tool "
+                                        "number >= 0")
+        ip.tool_data[(int(p_word[0]), 1)] = r_word[0] * ip.lin("X")
+        if axis_words:
+            ip.warn(st, "G10 L1: tool length offsets are not modelled; only the radius R "
+                        "is used")
+        return
     if kind not in (2, 20):
         ip.warn(st, f"G10 L{kind if kind is not None else '?'} (tool or offset tables) has "
                     "no effect on the motion model")

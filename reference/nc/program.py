@@ -75,7 +75,7 @@ class Tangential:
 _MODAL_FIELDS = ("plane", "continuous_mode", "exact_stop_criterion", "adis_mm", "adispos_mm",
                  "contour_tol_mm", "orientation_tol_deg", "axis_tol", "naive_cam_tol_mm",
                  "accel_mode", "tool_compensation", "trc_corner", "disc", "tool",
-                 "tool_offset", "tangential", "rndm_mm")
+                 "tool_offset", "tangential", "rndm_mm", "trc_tool", "tool_radius_mm")
 _EXTRA_FIELDS = ("center", "turns", "dwell_s", "aux", "message", "comment",
                  "kept_unmodelled", "column_of_motion", "plane_basis", "rnd_mm")
 
@@ -121,6 +121,16 @@ class Modal:
     rndm_mm : float
         Modal rounding radius RNDM, mm (0 = off): every corner between lines gets a
         tangent arc of this radius.
+    trc_tool : tuple[int or str or None, int] or None
+        ``(tool, cutting edge)`` whose radius tool radius compensation uses. SINUMERIK:
+        the active T and D (a T without D selects edge D1, MD20270
+        CUTTING_EDGE_DEFAULT = 1; D0 is edge 0, no offset); NGC: the D word of the
+        G41/G42 block, else the last T word, edge 1. ``None`` before any T or D.
+    tool_radius_mm : float or None
+        Radius of that edge as the program itself defines it, mm: SINUMERIK
+        ``$TC_DP6[t,d]``, NGC ``G10 L1 P<t> R<r>`` or ``G41.1/G42.1 D<diameter>`` (half
+        the diameter); ``None`` when the program defines none (the machine's tool
+        table then applies, :class:`reference.machine.ToolTable`).
     """
 
     plane: Plane = "G17"
@@ -140,6 +150,8 @@ class Modal:
     tool_offset: int | None = None
     tangential: Tangential | None = None
     rndm_mm: float = 0.0
+    trc_tool: tuple[int | str | None, int] | None = None
+    tool_radius_mm: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

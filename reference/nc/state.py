@@ -106,6 +106,10 @@ class _Interp:
         self.disc = 0.0
         self.tool: int | None = None
         self.offset_no: int | None = None
+        self.edge = 1                # cutting edge for TRC (D; D1 after a T without D)
+        self.tool_data: dict[tuple, float] = {}  # (tool, edge) -> radius, mm ($TC_DP6, G10 L1)
+        self.ngc_comp_tool: int | None = None     # NGC: D word of the G41/G42 block
+        self.ngc_comp_radius: float | None = None  # NGC: G41.1/G42.1 D<diameter> / 2, mm
         self.spindle_rpm = 0.0       # last S word (for G4 S)
         self.cs: dict[int, _Frame] = {}   # NGC G10 L2 work offsets, by number (G54 = 1)
         self.cs_active = 1

@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .lookahead import Units
-from .profiles import UnitProfiles, ramp_time
+from .profiles import UnitProfiles, knee_ramp_time, ramp_time
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,7 +52,8 @@ class AdaptationFactors:
 
 
 def process_factor(dv: np.ndarray, acc: np.ndarray, jerk: np.ndarray,
-                   t_adapt: np.ndarray, f_max: np.ndarray) -> np.ndarray:
+                   t_adapt: np.ndarray, f_max: np.ndarray,
+                   duration: np.ndarray | None = None) -> np.ndarray:
     """Reduction factor of one velocity-change process.
 
     Parameters
@@ -66,6 +67,11 @@ def process_factor(dv: np.ndarray, acc: np.ndarray, jerk: np.ndarray,
         ``1/f``, s.
     f_max : numpy.ndarray
         ADAPT_PATH_DYNAMIC of the mode (>= 1).
+    duration : numpy.ndarray, optional
+        The process duration where it is not the plain ramp's (DRIVE: the ramp across
+        the knee, :func:`reference.planner.profiles.knee_ramp_time`); NaN elsewhere.
+        Lowering both accelerations of a DRIVE ramp by ``lambda`` stretches it by
+        ``lambda`` too, as a BRISK ramp.
 
     Returns
     -------
@@ -73,6 +79,8 @@ def process_factor(dv: np.ndarray, acc: np.ndarray, jerk: np.ndarray,
         ``lambda`` in ``[1, f_max]``.
     """
     T = ramp_time(dv, acc, jerk)
+    if duration is not None:
+        T = np.where(np.isnan(duration), T, duration)
     soft = np.isfinite(jerk)
     jf = np.where(soft, jerk, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -110,8 +118,17 @@ def adaptation_factors(units: Units, prof: UnitProfiles, base: Units,
     f_max = np.where(units.jerk_limited, adapt[1], adapt[0])
     with np.errstate(divide="ignore"):
         t_adapt = np.where(np.isfinite(units.frequency), 1.0 / units.frequency, 0.0)
-    rise = process_factor(prof.v_peak - prof.v_in, base.acc_up, base.jerk_up, t_adapt, f_max)
-    fall = process_factor(prof.v_peak - prof.v_out, base.acc_dn, base.jerk_dn, t_adapt, f_max)
+    t_rise = t_fall = None
+    drive = np.isfinite(base.knee)
+    if drive.any():
+        t_rise = np.where(drive, knee_ramp_time(prof.v_in, prof.v_peak, base.acc_up,
+                                                base.knee, base.knee_ratio), np.nan)
+        t_fall = np.where(drive, knee_ramp_time(prof.v_out, prof.v_peak, base.acc_dn,
+                                                base.knee, base.knee_ratio), np.nan)
+    rise = process_factor(prof.v_peak - prof.v_in, base.acc_up, base.jerk_up, t_adapt, f_max,
+                          t_rise)
+    fall = process_factor(prof.v_peak - prof.v_out, base.acc_dn, base.jerk_dn, t_adapt, f_max,
+                          t_fall)
     return AdaptationFactors(rise=rise, fall=fall)
 
 

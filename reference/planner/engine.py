@@ -44,8 +44,8 @@ from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
                        unit_profiles)
 from .result import (BlockTable, CornerRow, CornerTable, ReferencePlan,
                      TraceEntry)
-from .smoothing import smooth_velocity
-from .stops import ACCEL_MODES, SegmentModes, segment_modes
+from .smoothing import effective_factor, smooth_velocity
+from .stops import ACCEL_MODES, MODE_CODE, SegmentModes, segment_modes
 
 Progress = Callable[[str, float], None]
 
@@ -84,7 +84,7 @@ def _replan(units: Units, idx: np.ndarray, v_nodes: np.ndarray) -> UnitProfiles:
     """Unit profiles of units ``idx`` between the node speeds ``v_nodes``."""
     return unit_profiles(v_nodes[idx], v_nodes[idx + 1], units.length[idx], units.cap[idx],
                          units.acc_up[idx], units.jerk_up[idx], units.acc_dn[idx],
-                         units.jerk_dn[idx])
+                         units.jerk_dn[idx], units.knee[idx], units.knee_ratio[idx])
 
 
 def plan(program: Program, machine: Machine, *, path: Path | None = None,
@@ -150,7 +150,8 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
 
     report_progress("limit curves", 0.2)
     seg = segment_limits(path, machine, modes, params)
-    trace.append(("limit curves", _cause_counts("segment caps", seg.cap_cause)))
+    trace.append(("limit curves", _cause_counts("segment caps", seg.cap_cause)
+                  + _drive_note(seg, modes)))
 
     report_progress("corners", 0.3)
     lim = limits.for_axes(path.axes)
@@ -171,15 +172,16 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     trace.append(("profiles", _case_counts(prof, units)))
 
     report_progress("smoothing", 0.6)
-    if ch.lookahead_smooth_factor_pct > 0:
-        sm = smooth_velocity(units, speeds, prof, ch.lookahead_smooth_factor_pct,
-                             params.smoothing_rounds, _replan)
-        units, speeds, prof = sm.units, sm.speeds, sm.profiles
-        trace.append(("smoothing", f"LOOKAH_SMOOTH_FACTOR {ch.lookahead_smooth_factor_pct:g} "
-                                   f"%: {sm.n_bumps} bumps removed, moving time "
-                                   f"{sm.time_before:.6g} s -> {sm.time_after:.6g} s"))
-    else:
-        trace.append(("smoothing", "off (LOOKAH_SMOOTH_FACTOR = 0)"))
+    factor = effective_factor(ch.lookahead_smooth_factor_pct)
+    sm = smooth_velocity(units, speeds, prof, factor, params.smoothing_rounds, _replan)
+    units, speeds, prof = sm.units, sm.speeds, sm.profiles
+    md = ch.lookahead_smooth_factor_pct
+    trace.append(("smoothing", f"LOOKAH_SMOOTH_FACTOR {md:g} %"
+                               + (f" (0 selects the internal {factor:g} %)" if md <= 0 else "")
+                               + (": smoothing_rounds = 0, none removed (bare LookAhead)"
+                                  if params.smoothing_rounds == 0 else
+                                  f": {sm.n_bumps} bumps removed, moving time "
+                                  f"{sm.time_before:.6g} s -> {sm.time_after:.6g} s")))
 
     report_progress("adaptation", 0.7)
     adapt = tuple(ch.adapt_path_dynamic)
@@ -247,6 +249,21 @@ def _cause_counts(what: str, codes: np.ndarray) -> str:
     cnt = np.bincount(np.asarray(codes, dtype=np.int64), minlength=len(C.CAUSES))
     parts = [f"{C.CAUSES[i]} {int(c)}" for i, c in enumerate(cnt) if c]
     return f"{what} by cause: " + ", ".join(parts)
+
+
+def _drive_note(seg, modes: SegmentModes) -> str:
+    """DRIVE segments and their knees for the trace ("" without DRIVE)."""
+    n_drive = int(np.sum(modes.mode == MODE_CODE["DRIVE"]))
+    if not n_drive:
+        return ""
+    knee = np.isfinite(seg.knee)
+    if not knee.any():
+        return (f"; DRIVE: {n_drive} segments, none above a knee (no reduction set, or "
+                "the caps stay below ACCEL_REDUCTION_SPEED_POINT)")
+    r = seg.knee_ratio[knee]
+    return (f"; DRIVE: {int(knee.sum())} of {n_drive} segments above a knee, acceleration "
+            f"there {100 * r.min():.3g}..{100 * r.max():.3g} % of the one below (cause "
+            f"'axis acceleration'); the oracle does not reduce it: the gap includes it")
 
 
 def _case_counts(prof: UnitProfiles, units: Units) -> str:

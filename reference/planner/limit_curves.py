@@ -32,6 +32,12 @@ inequality. On lines these are exactly ``min_i A_i/|d_i|`` and ``min_i J_i/|d_i|
 Axis limits: MAX_AX_ACCEL times SOFT_ACCEL_FACTOR (SOFT) and G00_ACCEL_FACTOR (G0),
 MAX_AX_JERK times G00_JERK_FACTOR (G0); factors above 1 are clipped to 1 so that the
 plan never exceeds the limits the checker judges against.
+
+DRIVE segments (:mod:`reference.planner.drive`): above the segment's knee every axis
+acceleration ``A_i`` is its knee-shaped characteristic's share of it at the axis speed
+at the cap. The centripetal cap is taken again with these reduced ``A_i`` (no lower than
+the knee, below which the full ``A_i`` hold), and the tangential acceleration above the
+knee is ``knee_ratio`` times the one below it (both at the cap, as above).
 """
 
 from __future__ import annotations
@@ -45,7 +51,8 @@ from ..machine import Machine
 from . import causes as C
 from ..core.tolerances import MOVING_AXIS_TOL
 from .parameters import PlannerParameters
-from .stops import ACCEL_MODES, SegmentModes
+from .drive import drive_reduction
+from .stops import ACCEL_MODES, MODE_CODE, SegmentModes
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -66,6 +73,12 @@ class SegmentLimits:
         Smallest LOOKAH_FREQUENCY of the axes moving in the segment, Hz.
     moving : numpy.ndarray of bool, shape (m, n)
         Axes that move in the segment.
+    knee : numpy.ndarray
+        DRIVE: path speed above which the acceleration is reduced, mm/s (``inf``: none
+        below the cap).
+    knee_ratio : numpy.ndarray
+        DRIVE: tangential acceleration above the knee as a share of ``accel`` (1 without
+        a knee).
     """
 
     cap: np.ndarray
@@ -74,6 +87,8 @@ class SegmentLimits:
     jerk: np.ndarray
     frequency: np.ndarray
     moving: np.ndarray
+    knee: np.ndarray
+    knee_ratio: np.ndarray
 
 
 def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
@@ -185,6 +200,8 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
                                   (v_cent, C.AXIS_ACCELERATION), (v_jerk, C.JERK),
                                   (v_ipo, C.IPO_CAP)])
+    knee, share, cap, cause = _drive(path, machine, modes, lim, A, D, P, Q, moving, cap,
+                                     cause, params)
     acc = _accel_at(cap, A, D, P, Q, moving)
     # SOFT: leave the jerk budget share for 3 |q''| v a
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -194,5 +211,39 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     acc = np.where(soft, np.minimum(acc, a_j), acc)
     jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving), inf)
     freq = np.where(moving, lim.frequency_hz[None, :], np.inf).min(axis=1)
+    if np.isfinite(knee).any():
+        d = np.flatnonzero(np.isfinite(knee))
+        acc_hi = _accel_at(cap[d], A[d] * share[d], D[d], P[d], Q[d], moving[d])
+        knee_ratio = np.ones(m)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            knee_ratio[d] = np.clip(acc_hi / acc[d], 0.0, 1.0)
+    else:
+        knee_ratio = np.ones(m)
     return SegmentLimits(cap=cap, cap_cause=cause, accel=acc, jerk=jerk, frequency=freq,
-                         moving=moving)
+                         moving=moving, knee=knee, knee_ratio=knee_ratio)
+
+
+def _drive(path: Path, machine: Machine, modes: SegmentModes, lim, A, D, P, Q, moving,
+           cap: np.ndarray, cause: np.ndarray, params: PlannerParameters):
+    """DRIVE: knee per segment (m,), the per-axis acceleration shares above it (m, n),
+    and the caps and their causes with the centripetal limit at the reduced ``A_i``."""
+    m, n = A.shape
+    knee = np.full(m, np.inf)
+    drive = modes.mode == MODE_CODE["DRIVE"]
+    if not drive.any():
+        return knee, np.ones((m, n)), cap, cause
+    st = [machine.settings_of(a) for a in path.axes]
+    sp = np.array([x.accel_reduction_speed_point for x in st])
+    fac = np.array([x.accel_reduction_factor for x in st])
+    kind = np.array([x.accel_type_drive for x in st])
+    knee, share = drive_reduction(drive, moving, D + P, cap, lim.v_max, sp, fac, kind)
+    # centripetal above the knee with the reduced accelerations, not below the knee
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_cent = np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A * share / np.where(
+            Q > 0, Q, 1.0)), np.inf).min(axis=1)
+    lower = np.isfinite(knee) & (v_cent < cap)
+    new_cap = np.where(lower, np.maximum(v_cent, knee), cap)
+    cause = np.where(new_cap < cap, C.AXIS_ACCELERATION, cause)
+    knee = np.where(knee < new_cap, knee, np.inf)
+    share = np.where(np.isfinite(knee)[:, None], share, 1.0)
+    return knee, share, new_cap, cause

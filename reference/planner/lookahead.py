@@ -12,7 +12,10 @@ Three steps, all O(n) in the number of segments:
    beyond the horizon is weaker than the zero at its end), so instead of re-running a
    backward pass per block the stage computes one cap per break:
 
-   - BRISK: ``z_k^2 = 2 sum_{i=k}^{k+N-1} A_i L_i`` (exact, a cumulative sum);
+   - BRISK: ``z_k^2 = 2 sum_{i=k}^{k+N-1} A_i L_i`` (exact, a cumulative sum); a DRIVE
+     segment with a knee counts with its acceleration above the knee all the way down
+     (a cumulative sum still; the cap is lower than the knee-shaped braking would give:
+     safe, never faster than the characteristic allows);
    - SOFT: one jerk-limited braking ramp from ``z_k`` to rest over the horizon distance
      with the weakest ``A``, ``J`` of the horizon (a sliding-window minimum).
 
@@ -30,8 +33,9 @@ Three steps, all O(n) in the number of segments:
 
 3. **Passes** (:func:`lookahead_passes`): a backward pass from the end and a forward pass
    from the start over the units, each step the closed-form reachable speed of
-   :func:`reference.planner.profiles.ramp_reach` (dispatch on the unit's mode). Every pair
-   of consecutive node speeds is then joinable by one unit profile.
+   :func:`reference.planner.profiles.ramp_reach` (dispatch on the unit's mode: BRISK,
+   SOFT or DRIVE with a knee). Every pair of consecutive node speeds is then joinable by
+   one unit profile.
 """
 
 from __future__ import annotations
@@ -87,9 +91,10 @@ def horizon_caps(path: Path, seg: SegmentLimits, modes: SegmentModes, n_blocks: 
     if not inside.any():
         return z
     k, e = k[inside], e[inside]
-    cal = np.concatenate(([0.0], np.cumsum(seg.accel * path.length)))
+    acc = seg.accel * seg.knee_ratio         # DRIVE: the reduced acceleration (safe)
+    cal = np.concatenate(([0.0], np.cumsum(acc * path.length)))
     z_brisk = np.sqrt(2.0 * np.maximum(cal[e] - cal[k], 0.0))
-    a_min = _forward_window_min(seg.accel, n)[k]
+    a_min = _forward_window_min(acc, n)[k]
     j_min = _forward_window_min(seg.jerk, n)[k]
     dist = path.s_breaks[e] - path.s_breaks[k]
     z_soft = ramp_reach(np.zeros(k.size), dist, a_min, j_min)
@@ -127,6 +132,10 @@ class Units:
         Its cause.
     adapted_up, adapted_dn : numpy.ndarray of bool, shape (u,)
         Ramps whose dynamics the dynamic adaptation lowered.
+    knee : numpy.ndarray, shape (u,)
+        DRIVE: path speed above which the acceleration is reduced, mm/s (``inf``: none).
+    knee_ratio : numpy.ndarray, shape (u,)
+        DRIVE: share of ``acc_up``/``acc_dn`` above the knee (1 without a knee).
     """
 
     first_segment: np.ndarray
@@ -146,6 +155,8 @@ class Units:
     node_cause: np.ndarray
     adapted_up: np.ndarray
     adapted_dn: np.ndarray
+    knee: np.ndarray
+    knee_ratio: np.ndarray
 
     @property
     def n_units(self) -> int:
@@ -256,6 +267,9 @@ def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
         acc = np.minimum(acc, np.minimum.reduceat(thru, first))
     jerk = np.minimum.reduceat(seg.jerk, first)
     freq = np.minimum.reduceat(seg.frequency, first)
+    # DRIVE knees: DRIVE units are single segments (only SOFT segments merge)
+    knee = np.minimum.reduceat(seg.knee, first) if m else np.zeros(0)
+    knee_ratio = np.minimum.reduceat(seg.knee_ratio, first) if m else np.zeros(0)
     node_cap = junc.cap[nodes]
     node_cause = junc.cause[nodes]
     hz = horizon[nodes]
@@ -269,15 +283,28 @@ def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
                  path.s_breaks[first], cap=cap, cap_cause=cap_cause, acc_up=acc,
                  jerk_up=jerk, acc_dn=acc.copy(), jerk_dn=jerk.copy(), frequency=freq,
                  jerk_limited=np.isfinite(jerk), node_cap=node_cap, node_cause=node_cause,
-                 adapted_up=z, adapted_dn=z.copy())
+                 adapted_up=z, adapted_dn=z.copy(), knee=knee, knee_ratio=knee_ratio)
 
 
 # ----------------------------------------------------------------- passes
-def _reach_brisk(v: float, dist: float, acc: float, jerk: float) -> float:
+def _reach_brisk(v: float, dist: float, acc: float, jerk: float, knee: float,
+                 ratio: float) -> float:
     return math.sqrt(v * v + 2.0 * acc * dist)
 
 
-def _reach_soft(v: float, dist: float, acc: float, jerk: float) -> float:
+def _reach_drive(v: float, dist: float, acc: float, jerk: float, knee: float,
+                 ratio: float) -> float:
+    """BRISK with ``acc`` up to ``knee`` and ``ratio * acc`` above (scalar
+    :func:`reference.planner.profiles.knee_reach`)."""
+    e_k = knee * knee / (2.0 * acc)
+    x = (v * v + max(v * v - knee * knee, 0.0) * (1.0 / ratio - 1.0)) / (2.0 * acc) + dist
+    if x <= e_k:
+        return math.sqrt(2.0 * acc * x)
+    return math.sqrt(knee * knee + 2.0 * ratio * acc * (x - e_k))
+
+
+def _reach_soft(v: float, dist: float, acc: float, jerk: float, knee: float,
+                ratio: float) -> float:
     thr = acc * acc / jerk
     # jerk-limited: x^3 + p x + q = 0, dv = x^2
     p = 2.0 * v
@@ -301,8 +328,8 @@ def _reach_soft(v: float, dist: float, acc: float, jerk: float) -> float:
     return v + max(dv, 0.0)
 
 
-#: Reachable speed over a distance, by mode (index: jerk-limited).
-_REACH = (_reach_brisk, _reach_soft)
+#: Reachable speed over a distance, by mode (index: 0 BRISK, 1 SOFT, 2 DRIVE with a knee).
+_REACH = (_reach_brisk, _reach_soft, _reach_drive)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -341,7 +368,8 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     """Backward and forward passes over the units (closed-form steps).
 
     Each step first tries the cheap sufficient test :func:`_fits` (most nodes are bound
-    by their own limit) and computes the exact reachable speed only when it fails.
+    by their own limit; a DRIVE unit takes its reduced acceleration there, which keeps
+    the test sufficient) and computes the exact reachable speed only when it fails.
 
     Parameters
     ----------
@@ -355,9 +383,14 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     cap = units.node_cap.tolist()
     cause = units.node_cause.tolist()
     L = units.length.tolist()
-    jl = units.jerk_limited.astype(int).tolist()
+    drive = np.isfinite(units.knee)
+    jl = np.where(drive, 2, units.jerk_limited.astype(int)).tolist()
     ad, jd = units.acc_dn.tolist(), units.jerk_dn.tolist()
     au, ju = units.acc_up.tolist(), units.jerk_up.tolist()
+    kn, kr = units.knee.tolist(), units.knee_ratio.tolist()
+    # the cheap test with the acceleration above the knee (the smallest of a unit)
+    r_fit = np.where(drive, units.knee_ratio, 1.0)
+    ad_fit, au_fit = (units.acc_dn * r_fit).tolist(), (units.acc_up * r_fit).tolist()
     b = [0.0] * (n + 1)
     origin = [0] * (n + 1)
     b[n], origin[n] = cap[n], cause[n]
@@ -365,10 +398,10 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     fits = _fits
     for k in range(n - 1, -1, -1):
         be, c = b[k + 1], cap[k]
-        if c <= be or fits(be, c, L[k], ad[k], jd[k]):
+        if c <= be or fits(be, c, L[k], ad_fit[k], jd[k]):
             b[k], origin[k] = c, cause[k]
             continue
-        r = reach[jl[k]](be, L[k], ad[k], jd[k])
+        r = reach[jl[k]](be, L[k], ad[k], jd[k], kn[k], kr[k])
         if c <= r:
             b[k], origin[k] = c, cause[k]
         else:
@@ -378,10 +411,10 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     w[0] = b[0]
     for k in range(n):
         ws, bn = w[k], b[k + 1]
-        if bn <= ws or fits(ws, bn, L[k], au[k], ju[k]):
+        if bn <= ws or fits(ws, bn, L[k], au_fit[k], ju[k]):
             w[k + 1] = bn
             continue
-        f = reach[jl[k]](ws, L[k], au[k], ju[k])
+        f = reach[jl[k]](ws, L[k], au[k], ju[k], kn[k], kr[k])
         if bn <= f:
             w[k + 1] = bn
         else:

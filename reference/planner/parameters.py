@@ -67,7 +67,9 @@ class PlannerParameters:
         most with that value (0 < x <= 1). Default 0.5.
     smoothing_rounds : int
         LOOKAH_SMOOTH_FACTOR: rounds of bump removal, shortest bumps first; each round
-        can merge neighbouring bumps into a larger one. Default 3.
+        can merge neighbouring bumps into a larger one. 0 removes none: the bare
+        LookAhead, for studies (the control has no such setting: MD20460 = 0 selects
+        its internal 100 %). Default 3.
     adaptation_rounds : int
         ADAPT_PATH_DYNAMIC: rounds of "measure process durations, lower the dynamics,
         re-plan". Default 2.

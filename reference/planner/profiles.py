@@ -18,6 +18,16 @@ table :data:`reference.planner.stops.ACCEL_MODES`):
 * **BRISK** (``J = inf``): the same formulas with ``A/J = 0`` give the trapezoid: ramps
   of constant acceleration, duration ``dv/A``, distance ``(v_hi^2 - v_lo^2)/(2A)``.
 
+* **DRIVE** (``J = inf`` and a finite *knee*): the trapezoid with acceleration ``A``
+  up to the knee speed ``v_k`` and ``r A`` above it (``0 < r <= 1``, the knee-shaped
+  characteristic of :mod:`reference.planner.drive`). With the time and the distance
+  from rest, ``T(v) = v/A + max(v - v_k, 0) (1/r - 1)/A`` and
+  ``E(v) = v^2/(2A) + max(v^2 - v_k^2, 0) (1/r - 1)/(2A)``, a ramp between two speeds
+  takes ``T(v_hi) - T(v_lo)`` over ``E(v_hi) - E(v_lo)`` (``ds = v dv / a(v)``); the
+  reachable speed inverts ``E``, a square root on each side of the knee. The rise uses
+  phases 0 (``A``, below the knee) and 1 (``r A``), the fall phases 4 (``r A``) and 5
+  (``A``). Units without a knee pass ``knee = inf`` (or nothing) and plan as before.
+
 Closed forms: the ramp duration and distance above; the speed reachable over a distance
 (:func:`ramp_reach`) is the root of a depressed cubic (jerk-limited) or a quadratic
 (acceleration-limited). The peak without cruise (:func:`solve_peak`) is the root of a
@@ -88,11 +98,61 @@ def ramp_time(dv, acc, jerk) -> np.ndarray:
     return np.where(dv >= thr, dv / acc + acc / jerk, jerk_lim)
 
 
-def ramp_distance(v_lo, v_hi, acc, jerk) -> np.ndarray:
-    """Distance of the fastest ramp between two speeds (either direction), mm."""
+def ramp_distance(v_lo, v_hi, acc, jerk, knee=None, ratio=None) -> np.ndarray:
+    """Distance of the fastest ramp between two speeds (either direction), mm.
+
+    ``knee``, ``ratio`` (optional, BRISK only): DRIVE's knee speed (mm/s, ``inf`` for
+    none) and the share of ``acc`` above it.
+    """
     v_lo = np.asarray(v_lo, dtype=np.float64)
     v_hi = np.asarray(v_hi, dtype=np.float64)
-    return 0.5 * (v_lo + v_hi) * ramp_time(np.abs(v_hi - v_lo), acc, jerk)
+    plain = 0.5 * (v_lo + v_hi) * ramp_time(np.abs(v_hi - v_lo), acc, jerk)
+    if knee is None:
+        return plain
+    knee, ratio = _knee_args(knee, ratio)
+    drive = np.abs(knee_effort(v_hi, acc, knee, ratio) - knee_effort(v_lo, acc, knee, ratio))
+    return np.where(np.isfinite(knee), drive, plain)
+
+
+def _knee_args(knee, ratio):
+    """``(knee, ratio)`` as float arrays (``inf`` and 1 when ``knee`` is None)."""
+    if knee is None:
+        return np.asarray(np.inf), np.asarray(1.0)
+    return np.asarray(knee, dtype=np.float64), np.asarray(ratio, dtype=np.float64)
+
+
+def knee_time(v, acc, knee, ratio) -> np.ndarray:
+    """``T(v)``: time to reach speed ``v`` from rest with ``A`` up to the knee and
+    ``ratio * A`` above it, s (``knee = inf``: ``v/A``)."""
+    v = np.asarray(v, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        above = np.maximum(v - knee, 0.0)
+    return v / acc + np.where(above > 0, above * (1.0 / ratio - 1.0), 0.0) / acc
+
+
+def knee_effort(v, acc, knee, ratio) -> np.ndarray:
+    """``E(v)``: distance to reach speed ``v`` from rest (see :func:`knee_time`), mm."""
+    v = np.asarray(v, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        above = np.maximum(v * v - np.asarray(knee) ** 2, 0.0)
+    return (v * v + np.where(above > 0, above * (1.0 / ratio - 1.0), 0.0)) / (2.0 * acc)
+
+
+def knee_ramp_time(v_lo, v_hi, acc, knee, ratio) -> np.ndarray:
+    """Duration of a DRIVE ramp between two speeds (either order), s."""
+    return np.abs(knee_time(v_hi, acc, knee, ratio) - knee_time(v_lo, acc, knee, ratio))
+
+
+def knee_reach(v, dist, acc, knee, ratio) -> np.ndarray:
+    """Largest speed reachable from ``v`` over ``dist`` (DRIVE ramp), mm/s."""
+    x = knee_effort(v, acc, knee, ratio) + np.maximum(dist, 0.0)
+    knee = np.asarray(knee, dtype=np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):
+        e_k = np.where(np.isfinite(knee), knee * knee / (2.0 * acc), np.inf)
+        below = np.sqrt(2.0 * acc * np.minimum(x, e_k))
+        above = np.sqrt(np.where(np.isfinite(knee), knee * knee, 0.0)
+                        + 2.0 * ratio * acc * np.maximum(x - e_k, 0.0))
+    return np.where(x <= e_k, below, above)
 
 
 def _ramp_distance_slope(v_lo, v_hi, acc, jerk) -> np.ndarray:
@@ -105,8 +165,15 @@ def _ramp_distance_slope(v_lo, v_hi, acc, jerk) -> np.ndarray:
     return 0.5 * ramp_time(dv, acc, jerk) + 0.5 * (v_lo + v_hi) * dT
 
 
-def _ramp_distance_and_slope(v_lo, v_hi, acc, jerk):
+def _ramp_distance_and_slope(v_lo, v_hi, acc, jerk, knee=None, ratio=None):
     """``ramp_distance(v_lo, v_hi)`` and its derivative in ``v_hi`` (v_hi >= v_lo)."""
+    if knee is not None:
+        d, sl = _ramp_distance_and_slope(v_lo, v_hi, acc, jerk)
+        knee, ratio = _knee_args(knee, ratio)
+        dk = knee_effort(v_hi, acc, knee, ratio) - knee_effort(v_lo, acc, knee, ratio)
+        sk = v_hi / (acc * np.where(v_hi > knee, ratio, 1.0))
+        fin = np.isfinite(knee)
+        return np.where(fin, dk, d), np.where(fin, sk, sl)
     dv = np.maximum(v_hi - v_lo, 0.0)
     thr = acc * acc / jerk
     jf = _finite_j(jerk)
@@ -142,7 +209,7 @@ def _depressed_cubic_root(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.maximum(x, 0.0)
 
 
-def ramp_reach(v, dist, acc, jerk) -> np.ndarray:
+def ramp_reach(v, dist, acc, jerk, knee=None, ratio=None) -> np.ndarray:
     """Largest speed ``v2 >= v`` with ``ramp_distance(v, v2) <= dist``.
 
     By symmetry it is also the largest speed from which a ramp ends at ``v`` within
@@ -156,12 +223,21 @@ def ramp_reach(v, dist, acc, jerk) -> np.ndarray:
         Available distance, mm (>= 0; ``inf`` gives ``inf``).
     acc, jerk : array_like
         Limits; ``jerk = inf`` for BRISK (then ``sqrt(v^2 + 2 A dist)``).
+    knee, ratio : array_like, optional
+        DRIVE (BRISK only): knee speed, mm/s (``inf``: none), and the share of ``acc``
+        above it (:func:`knee_reach`).
 
     Returns
     -------
     numpy.ndarray
         mm/s.
     """
+    if knee is not None:
+        plain = ramp_reach(v, dist, acc, jerk)
+        knee, ratio = _knee_args(knee, ratio)
+        with np.errstate(invalid="ignore"):
+            drive = knee_reach(v, dist, acc, knee, ratio)
+        return np.where(np.isfinite(knee) & np.isfinite(dist), drive, plain)
     v, dist, acc, jerk = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
                                                for x in (v, dist, acc, jerk)))
     out = np.full(v.shape, np.inf)
@@ -196,7 +272,8 @@ def ramp_peak_accel(dv, acc, jerk) -> np.ndarray:
 
 
 # ----------------------------------------------------------------- unit peak
-def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn) -> np.ndarray:
+def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn, knee=None,
+               ratio=None) -> np.ndarray:
     """Peak speed of time-optimal unit profiles.
 
     The peak ``vp`` is the largest value in ``[max(v0, v1), cap]`` with
@@ -206,9 +283,14 @@ def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn) -> np.ndar
     ``[max(v0, v1), min(cap, reach(v0), reach(v1))]`` and returns the lower end (whose
     distance never exceeds ``L``).
 
+    With a DRIVE knee ``g`` is C1 on each side of the knee and continuous across it
+    (its slope drops there); the safeguarded iteration handles the kink.
+
     Parameters
     ----------
     v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn : numpy.ndarray, shape (n,)
+    knee, ratio : numpy.ndarray, shape (n,), optional
+        DRIVE knee speed (``inf``: none) and share of the acceleration above it.
 
     Returns
     -------
@@ -216,14 +298,19 @@ def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn) -> np.ndar
         mm/s.
     """
     v0, v1, L, cap = (np.asarray(x, dtype=np.float64) for x in (v0, v1, length, cap))
+    has_knee = knee is not None and bool(np.any(np.isfinite(knee)))
+    if has_knee:
+        knee = np.broadcast_to(np.asarray(knee, dtype=np.float64), v0.shape)
+        ratio = np.broadcast_to(np.asarray(ratio, dtype=np.float64), v0.shape)
+    kk = (lambda idx: (knee[idx], ratio[idx])) if has_knee else (lambda idx: (None, None))
     lo = np.maximum(v0, v1)
-    hi = np.minimum(cap, np.minimum(ramp_reach(v0, L, acc_up, jerk_up),
-                                    ramp_reach(v1, L, acc_dn, jerk_dn)))
+    hi = np.minimum(cap, np.minimum(ramp_reach(v0, L, acc_up, jerk_up, *kk(slice(None))),
+                                    ramp_reach(v1, L, acc_dn, jerk_dn, *kk(slice(None)))))
     hi = np.maximum(hi, lo)
 
     def g_slope(x, idx):
-        d0, s0 = _ramp_distance_and_slope(v0[idx], x, acc_up[idx], jerk_up[idx])
-        d1, s1 = _ramp_distance_and_slope(v1[idx], x, acc_dn[idx], jerk_dn[idx])
+        d0, s0 = _ramp_distance_and_slope(v0[idx], x, acc_up[idx], jerk_up[idx], *kk(idx))
+        d1, s1 = _ramp_distance_and_slope(v1[idx], x, acc_dn[idx], jerk_dn[idx], *kk(idx))
         return d0 + d1 - L[idx], s0 + s1
 
     vp = hi.copy()
@@ -231,8 +318,12 @@ def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn) -> np.ndar
     if todo.size == 0:
         return vp
     # start at the root of the acceleration-limited bound of g (a quadratic, exact for
-    # BRISK and for ramps that reach A on both sides): g <= g_upper, so g(x_q) <= 0
+    # BRISK and for ramps that reach A on both sides): g <= g_upper, so g(x_q) <= 0;
+    # with a knee the bound takes the reduced acceleration everywhere
     au, ju, ad, jd = acc_up[todo], jerk_up[todo], acc_dn[todo], jerk_dn[todo]
+    if has_knee:
+        r = np.where(np.isfinite(knee[todo]), ratio[todo], 1.0)
+        au, ad = au * r, ad * r
     w0, w1, Lt = v0[todo], v1[todo], L[todo]
     alpha = 0.5 / au + 0.5 / ad
     beta = 0.5 * au / ju + 0.5 * ad / jd
@@ -336,8 +427,8 @@ def _ramp_phases(dv, acc, jerk):
     return t1, t2, ap, acc_lim
 
 
-def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn
-                  ) -> UnitProfiles:
+def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn, knee=None,
+                  ratio=None) -> UnitProfiles:
     """Time-optimal profiles of all units (see the module docstring).
 
     Parameters
@@ -348,6 +439,9 @@ def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn
         Unit length (mm) and speed cap (mm/s).
     acc_up, jerk_up, acc_dn, jerk_dn : numpy.ndarray, shape (n,)
         Limits for the rise and for the fall (jerk ``inf`` for BRISK).
+    knee, ratio : numpy.ndarray, shape (n,), optional
+        DRIVE units (BRISK): the knee speed, mm/s (``inf``: none), and the share of the
+        acceleration above it.
 
     Returns
     -------
@@ -362,7 +456,8 @@ def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn
     args = [np.asarray(x, dtype=np.float64) for x in
             (v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn)]
     v0, v1, L, C, au, ju, ad, jd = args
-    vp = solve_peak(v0, v1, L, C, au, ju, ad, jd)
+    has_knee = knee is not None and bool(np.any(np.isfinite(knee)))
+    vp = solve_peak(v0, v1, L, C, au, ju, ad, jd, *((knee, ratio) if has_knee else ()))
     du, dd = vp - v0, vp - v1
     t1u, t2u, apu, accu = _ramp_phases(du, au, ju)
     t1d, t2d, apd, accd = _ramp_phases(dd, ad, jd)
@@ -379,6 +474,12 @@ def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn
     jerk = np.stack([juf, np.zeros_like(vp), -juf, np.zeros_like(vp),
                      -jdf, np.zeros_like(vp), jdf], axis=1)
     jerk = np.where(dur > 0, jerk, 0.0)
+    if has_knee:
+        i = np.flatnonzero(np.isfinite(knee))
+        dist_u[i], dist_d[i] = _knee_phases(i, np.asarray(knee, dtype=np.float64),
+                                            np.asarray(ratio, dtype=np.float64), v0, v1,
+                                            vp, L, au, ad, dur, a0, jerk)
+        rest = L - dist_u - dist_d
     case = ((du > 0) * CASE_RISE + (accu & (du > 0)) * CASE_RISE_ACC
             + (vp >= C * (1 - CAUSE_REL_TOL)) * CASE_CRUISE + (dd > 0) * CASE_FALL
             + (accd & (dd > 0)) * CASE_FALL_ACC).astype(np.int64)
@@ -387,6 +488,29 @@ def unit_profiles(v_in, v_out, length, cap, acc_up, jerk_up, acc_dn, jerk_dn
                          dist_fall=dist_d, case=case)
     verify_units(units, L, C, au, ju, ad, jd)
     return units
+
+
+def _knee_phases(i, knee, ratio, v0, v1, vp, L, au, ad, dur, a0, jerk):
+    """Overwrite the phases of the DRIVE units ``i`` in place: rise with ``A`` below the
+    knee (phase 0) and ``ratio * A`` above it (phase 1), cruise, fall with ``ratio * A``
+    above the knee (phase 4) and ``A`` below it (phase 5); no jerk phases. Returns the
+    rise and fall distances of those units (``E(vp) - E(v)``), mm."""
+    k, r = knee[i], ratio[i]
+    w0, w1, p, a_u, a_d = v0[i], v1[i], vp[i], au[i], ad[i]
+    t_lo_u = np.maximum(np.minimum(p, k) - w0, 0.0) / a_u
+    t_hi_u = np.maximum(p - np.maximum(w0, k), 0.0) / (r * a_u)
+    t_hi_d = np.maximum(p - np.maximum(w1, k), 0.0) / (r * a_d)
+    t_lo_d = np.maximum(np.minimum(p, k) - w1, 0.0) / a_d
+    d_u = knee_effort(p, a_u, k, r) - knee_effort(w0, a_u, k, r)
+    d_d = knee_effort(p, a_d, k, r) - knee_effort(w1, a_d, k, r)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t4 = np.where(p > 0, np.maximum(L[i] - d_u - d_d, 0.0) / np.where(p > 0, p, 1.0),
+                      0.0)
+    zero = np.zeros_like(p)
+    dur[i] = np.stack([t_lo_u, t_hi_u, zero, t4, t_hi_d, t_lo_d, zero], axis=1)
+    a0[i] = np.stack([a_u, r * a_u, zero, zero, -r * a_d, -a_d, zero], axis=1)
+    jerk[i] = 0.0
+    return d_u, d_d
 
 
 def verify_units(units: UnitProfiles, length, cap, acc_up, jerk_up, acc_dn, jerk_dn) -> None:

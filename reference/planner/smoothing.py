@@ -8,8 +8,14 @@ as AX2 moves). No contour error results: only the speed changes.
 
 Model [I]:
 
-* A bump is the stretch between two consecutive *valleys* of the planned speed (nodes
-  where the speed stops falling and starts rising; program start and end count).
+* A bump is the stretch between two consecutive *valleys* of the planned speed: nodes
+  where the descent from a peak ends or the ascent to one starts. A constant-speed
+  stretch (a cruise) ends a descent and starts an ascent like a dip does, so a node
+  counts when the speed just before it falls or stays level and just after it rises, or
+  just before it falls and just after it stays level or rises (program start and end
+  count). A short rise and fall between two stretches at constant speed is a bump of
+  its own (``G1 X50 F3000 / X51 F6000 / X101 F3000``); a plateau at the top of a bump
+  (level on both sides of a node) is no valley, so the bump keeps its plateau.
 * Candidate: cap the bump at ``v_flat = max(v_left_valley, v_right_valley)``; this keeps
   every pair of node speeds joinable (lower speeds never lengthen a ramp).
 * Accept the candidate when the bump is shorter than ``1/f`` and the time it costs is at
@@ -20,9 +26,13 @@ Model [I]:
 Each capped bump costs at most ``factor`` % of its own time, so the whole program slows
 down by at most ``factor`` %: 1 % is "practically off", as the manual's example says.
 
-The value 0: the manual's excerpt suggests that 0 makes the control use an internal
-100 %; this project's machine data (DESIGN section 3) defines 0 as "smoothing off", and
-the model follows the project. Set 100 for full smoothing.
+The value 0 (:func:`effective_factor`): the B1 excerpt on dynamic response adaptation
+(Function Manual 11/2006, example 1, note) says "A smoothing factor other than 0%
+prevents the default value of 100% from being used to smooth the path velocity", and
+sets 1.0 % to "practically deactivate" the smoothing. So 0 selects the control's internal
+100 % (model note 7.3: "treat 0 as 'use 100 %'"), and there is no exact "off": a small
+factor is the manual's way to switch smoothing practically off, and by the bound above
+it slows the program by at most that many percent.
 """
 
 from __future__ import annotations
@@ -34,8 +44,32 @@ import numpy as np
 
 from . import causes as C
 from .lookahead import NodeSpeeds, Units
-from .parameters import CAUSE_REL_TOL
+from .parameters import CAUSE_REL_TOL, DISTANCE_REL_TOL
 from .profiles import UnitProfiles
+
+
+#: The smoothing factor, %, the control uses when MD20460 LOOKAH_SMOOTH_FACTOR is 0 (the
+#: B1 note: "a smoothing factor other than 0% prevents the default value of 100% from
+#: being used").
+INTERNAL_DEFAULT_FACTOR_PCT = 100.0
+
+
+def effective_factor(md_value_pct: float) -> float:
+    """The smoothing factor in effect for a value of MD20460 LOOKAH_SMOOTH_FACTOR.
+
+    Parameters
+    ----------
+    md_value_pct : float
+        The machine-data value, % (>= 0).
+
+    Returns
+    -------
+    float
+        ``md_value_pct``, or :data:`INTERNAL_DEFAULT_FACTOR_PCT` (100 %) for 0: "a
+        smoothing factor other than 0% prevents the default value of 100% from being
+        used to smooth the path velocity" (B1 excerpt, note to example 1).
+    """
+    return INTERNAL_DEFAULT_FACTOR_PCT if md_value_pct <= 0.0 else float(md_value_pct)
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,8 +105,19 @@ def _moves(prof: UnitProfiles):
     return rise, fall
 
 
+#: Direction of the speed: falling, level, rising.
+_FALL, _LEVEL, _RISE = -1, 0, 1
+
+
 def find_valleys(prof: UnitProfiles) -> np.ndarray:
-    """Node indices where the speed stops falling and starts rising (ends included).
+    """Nodes where a descent ends or an ascent starts (the bump boundaries).
+
+    A unit's profile is rise, cruise, fall, so the speed just after its entry node
+    rises (a rise), stays level (a cruise) or falls, and just before its exit node falls,
+    stays level or rises. Node ``k`` is a valley when the speed just before it falls or
+    stays level and just after it rises or stays level, except level on both sides (a
+    plateau, e.g. the top of a bump spread over several units, is not cut). Program
+    start and end count as level outside.
 
     Parameters
     ----------
@@ -84,19 +129,18 @@ def find_valleys(prof: UnitProfiles) -> np.ndarray:
     numpy.ndarray of int
         Sorted node indices in ``[0, u]``.
     """
-    u = prof.v_peak.size
     rise, fall = _moves(prof)
-    last = np.where(fall, -1, np.where(rise, 1, 0))     # last move inside unit
-    first = np.where(rise, 1, np.where(fall, -1, 0))    # first move inside unit
-    # last move before node k (units < k), forward-filled over flat units
-    idx = np.where(last != 0, np.arange(u), -1)
-    ff = np.maximum.accumulate(idx) if u else idx
-    before = np.concatenate(([0], np.where(ff >= 0, last[np.maximum(ff, 0)], 0)))
-    # first move after node k (units >= k), backward-filled
-    idx2 = np.where(first != 0, np.arange(u), u)
-    bf = np.minimum.accumulate(idx2[::-1])[::-1] if u else idx2
-    after = np.concatenate((np.where(bf < u, first[np.minimum(bf, max(u - 1, 0))], 0), [0]))
-    return np.flatnonzero((before <= 0) & (after >= 0))
+    length = prof.dist_rise + prof.dist_cruise + prof.dist_fall
+    # a cruise shorter than the profiles' round-off is no constant-speed stretch
+    cruise = prof.dist_cruise > DISTANCE_REL_TOL * np.maximum(length, 1.0)
+    last = np.where(fall, _FALL, np.where(cruise | ~rise, _LEVEL, _RISE))   # into exit node
+    first = np.where(rise, _RISE, np.where(cruise | ~fall, _LEVEL, _FALL))  # out of entry
+    before = np.concatenate(([_LEVEL], last))
+    after = np.concatenate((first, [_LEVEL]))
+    valley = (before <= _LEVEL) & (after >= _LEVEL) & ~((before == _LEVEL)
+                                                        & (after == _LEVEL))
+    valley[[0, -1]] = True          # the program starts and ends at rest
+    return np.flatnonzero(valley)
 
 
 def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
@@ -111,9 +155,10 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     speeds : NodeSpeeds
     prof : UnitProfiles
     factor_pct : float
-        LOOKAH_SMOOTH_FACTOR, % (0 = off).
+        The factor in effect, % (:func:`effective_factor` of LOOKAH_SMOOTH_FACTOR;
+        a value <= 0 plans no smoothing, for callers that want the bare LookAhead).
     rounds : int
-        Rounds of bump removal.
+        Rounds of bump removal (0: none).
     replan : callable
         ``replan(units_subset_index -> ...)``: given ``(units, idx, v_nodes)`` returns the
         unit profiles of units ``idx`` with entry ``v_nodes[idx]`` and exit
@@ -125,10 +170,10 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     """
     t0 = float(prof.time.sum())
     n_bumps = 0
-    if factor_pct <= 0.0 or units.n_units == 0:
+    if factor_pct <= 0.0 or rounds <= 0 or units.n_units == 0:
         return SmoothingResult(units, speeds, prof, 0, t0, t0)
     v = speeds.v.copy()
-    for _ in range(max(rounds, 1)):
+    for _ in range(rounds):
         valleys = find_valleys(prof)
         if valleys.size < 2:
             break
@@ -143,13 +188,20 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
             short = t_bump < 1.0 / f_bump
         # a bump between two standstills cannot be flattened (v_flat = 0)
         v_flat_all = np.maximum(v[a], v[b])
-        cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0))
+        # capped, no speed in the bump exceeds v_flat: it takes at least L / v_flat, so a
+        # bump whose bound already costs more than the factor is rejected unplanned
+        s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_low = (s_node[b] - s_node[a]) / v_flat_all
+        affordable = t_low - t_bump <= factor_pct / 100.0 * t_bump * (1.0 + 1e-9)
+        cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0) & affordable)
         if cand.size == 0:
             break
         v_flat = np.maximum(v[a[cand]], v[b[cand]])
         # units of the candidate bumps and their flat speed
         counts = b[cand] - a[cand]
-        uidx = np.concatenate([np.arange(x, y) for x, y in zip(a[cand], b[cand])])
+        first = np.cumsum(counts) - counts
+        uidx = np.arange(int(counts.sum())) + np.repeat(a[cand] - first, counts)
         vf_u = np.repeat(v_flat, counts)
         new_cap = np.minimum(units.cap[uidx], vf_u)
         v_new = v.copy()

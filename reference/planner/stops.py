@@ -54,8 +54,10 @@ ACCEL_MODES: tuple[AccelMode, ...] = (
     AccelMode("BRISK", jerk_limited=False, bound_set="acc", uses_soft_accel_factor=False),
     AccelMode("SOFT", jerk_limited=True, bound_set="jerk", uses_soft_accel_factor=True),
     AccelMode("DRIVE", jerk_limited=False, bound_set="acc", uses_soft_accel_factor=False,
-              note="DRIVE planned as BRISK (the knee-shaped characteristic above "
-                   "ACCEL_REDUCTION_SPEED_POINT is not modelled; its a_max is the bound)"),
+              note="DRIVE: trapezoids with the knee-shaped characteristic above "
+                   "ACCEL_REDUCTION_SPEED_POINT (MD35220/35230/35240, "
+                   "reference.planner.drive); the oracle accelerates with MAX_AX_ACCEL, so "
+                   "the gap includes the reduction"),
 )
 MODE_CODE = {m.name: i for i, m in enumerate(ACCEL_MODES)}
 JERK_LIMITED = np.array([m.jerk_limited for m in ACCEL_MODES])

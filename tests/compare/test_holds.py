@@ -178,7 +178,10 @@ def test_oracle_and_heuristic_wait_the_same_at_the_same_breaks():
 
     s_r, h_r, b_r = holds_of(p.profile)
     s_o, h_o, b_o = holds_of(sol.profile)
-    assert np.array_equal(h_r, h_o) and np.array_equal(b_r, b_o)
+    # the same holds in the same blocks; as differences of absolute knot times (which
+    # differ between the two motions) the durations agree to the round-off of t
+    assert np.array_equal(b_r, b_o)
+    assert np.allclose(h_r, h_o, rtol=1e-12, atol=0.0)
     assert np.allclose(s_r, s_o, rtol=0, atol=1e-9) and s_r.tolist() == [100.0, 100.0,
                                                                             100.0, 150.0]
     assert h_r[1:3] == pytest.approx([0.3, 0.1], rel=1e-12)

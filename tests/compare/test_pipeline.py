@@ -146,11 +146,11 @@ def test_check_trajectory_refuses_a_bad_smoothing(small_program, tmp_path, smoot
 
 
 def test_load_inputs_passes_objects_through_and_lists_warnings(small_program):
-    program = parse_text("N10 G90 G64 F6000\nN20 G41 G1 X10\nN30 G40 G1 X20\nM30\n", "w.mpf")
+    program = parse_text("N10 G90 G64 F6000\nN20 G1 X10\nN30 CYCLE800()\nM30\n", "w.mpf")
     machine = load_machine("linuxcnc_xyz")
     inp = pipeline.load_inputs(program, machine)
     assert inp.program is program and inp.machine is machine
-    assert any("tool radius compensation" in str(w) for w in inp.warnings)
+    assert any("CYCLE800" in str(w) and w.line == 3 for w in inp.warnings)
     from_file = pipeline.load_inputs(small_program, "linuxcnc_xyz")
     assert from_file.machine.name == machine.name
     assert [b.line for b in from_file.program.blocks] == [b.line for b in

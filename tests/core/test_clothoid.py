@@ -119,14 +119,14 @@ def test_pair_shape_small_angle_limit():
 
 
 def test_derivative_norm_bounds_hold_up_to_the_fifth():
-    """The checker's pruning bounds (reference.core.constraints._clothoid_derivative_norms)
+    """The checker's pruning bounds (reference.core.geometry.clothoid_derivative_norms)
     against the derivatives: q' .. q''' exact, q'''' and q5 by central differences of
     the exact q'''."""
-    from reference.core.constraints import _clothoid_derivative_norms
+    from reference.core.geometry import clothoid_derivative_norms
     for theta, half in ((0.4, 0.2), (1.5, 1.0), (2.9, 0.05)):
         path, _, _, _ = corner_path(theta, half)
         c = theta / half ** 2
-        norms = _clothoid_derivative_norms(np.array([c]), np.array([half]))
+        norms = clothoid_derivative_norms(np.array([c]), np.array([half]))
         h = half * 1e-3
         for k in (1, 2):
             s = np.linspace(path.s_breaks[k] + 2 * h, path.s_breaks[k + 1] - 2 * h, 301)

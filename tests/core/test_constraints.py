@@ -617,7 +617,7 @@ def test_coarse_sampling_finds_the_highest_of_nearly_equal_peaks(monkeypatch, fa
 @pytest.mark.parametrize("factor", [8, 64])
 def test_sampling_on_clothoid_pairs_against_brute_force(monkeypatch, factor):
     """The checker's accuracy statement holds on clothoid roundings too (their coarse
-    steps are pruned by bounds from :func:`_clothoid_derivative_norms`): lines with
+    steps are pruned by bounds from :func:`reference.core.geometry.clothoid_derivative_norms`): lines with
     clothoid pairs of 30..170 deg between them, random BRISK-like and SOFT motions,
     against a brute-force grid per segment (1e5 points, both sides of every knot)."""
     from reference.core.geometry import KIND_CODES, clothoid_pair_shape, clothoid_pieces

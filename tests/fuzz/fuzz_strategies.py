@@ -79,6 +79,15 @@ HOSTILE_NGC = [
     "G92 X1e9", "G10 L2 P1 X1e9", "G20 G1 X1000000", "G2 X0 Y0 Z10 I5 J0 P1000000",
 ]
 
+#: Tool radius compensation and tangential control statements.
+TRC_SIN = ["$TC_DP6[1,1]=2\nT1 D1", "$TC_DP6[1,1]=-1.5\nT1 D1", "T1 D1", "G41", "G42",
+           "G40", "G450", "G451", "G450 DISC=30", "G41 G1 X5 Y5", "G40 G1 X0 Y0", "D0",
+           "$TC_DP6[2,1]=0.5\nT2", "G42 G0 X-10 Y-10"]
+TRC_NGC = ["G10 L1 P1 R2\nT1 M6", "G41", "G42", "G40", "G41.1 D4", "G42.1 D3",
+           "G40 G1 X0 Y0", "G41 D1 G1 X-10 Y-10", "G42.1 D0.5 G0 X5 Y-5"]
+TANG_SIN = ["TANG(C, X, Y, 1)\nTANGON(C, 0)", "TANG(C, X, Y, 2)\nTANGON(C, 45)\nTLIFT(C)",
+            "TLIFT(C)", "TANGOF(C)", "TANGON(C, 90)"]
+
 # -- programs ----------------------------------------------------------------------------
 
 _PLANES = {"G17": ("X", "Y", "I", "J", "Z", "K"), "G18": ("Z", "X", "K", "I", "Y", "J"),
@@ -196,7 +205,8 @@ def _statement(draw, dialect: str, state: dict, depth: int) -> list[str]:
     sin = dialect == "sin"
     kind = draw(st.sampled_from(
         ["line"] * 6 + ["arc"] * 4 + ["feed", "mode", "plane", "dwell", "comment", "assign",
-                                       "assign_move", "loop", "if", "hostile"]))
+                                       "assign_move", "loop", "if", "hostile", "trc",
+                                       "tang"]))
     if kind == "line":
         return [draw(_line(dialect, state))]
     if kind == "arc":
@@ -242,6 +252,16 @@ def _statement(draw, dialect: str, state: dict, depth: int) -> list[str]:
             lines.append(f"G1 {ax}={name}" if sin else f"G1 {ax}{name}")
             state["pos"] = None
         return lines
+    if kind == "trc":
+        # tool radius compensation: tool data, G41/G42/G40, corner modes; random
+        # contours often make the tool not fit (the collision alarm: exit 2 naming the
+        # line), which is what is under test besides the compensated path itself
+        word = draw(st.sampled_from(TRC_SIN if sin else TRC_NGC))
+        if " X" in word:
+            state["pos"] = None
+        return word.split("\n")
+    if kind == "tang" and sin:
+        return draw(st.sampled_from(TANG_SIN)).split("\n")
     if kind == "loop" and depth < 2:
         return draw(_loop(dialect, state, depth))
     if kind == "if" and depth < 2:

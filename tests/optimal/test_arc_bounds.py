@@ -19,7 +19,8 @@ from scipy.optimize import linprog
 
 import optimal
 from optimal.arc_bounds import tangential_slope_bound
-from optimal.bounds import _interval_data, verified_profile
+from optimal.bounds import _interval_data
+from optimal.upper import verified_profile
 from optimal.grid import grid_from_counts, initial_grid
 from reference.core import AxisLimits, MachineLimits
 from reference.machine import load_machine

@@ -82,7 +82,10 @@ def test_every_number_key_with_a_lower_bound_has_a_plausible_minimum():
     # exceptions are the keys whose lower end is a meaningful "off" (0 %, a feed-forward
     # weight of 0) or a count
     exempt = {"SMOOTHING_MODE", "LOOKAH_SMOOTH_FACTOR", "lookahead_blocks", "MAX_AX_VELO",
-              "MAX_ACCEL_OVL_FACTOR", "VELO_FFW_WEIGHT"}
+              "MAX_ACCEL_OVL_FACTOR", "VELO_FFW_WEIGHT", "ACCEL_REDUCTION_FACTOR",
+              # TRC corner switches: 0 turns each off (no intersection instead of a
+              # circle, no DISC, no 840C rule); nothing is divided by them
+              "CUTCOM_CURVE_INSERT_LIMIT", "CUTCOM_MAX_DISC", "CUTCOM_840C_MD6"}
     for table in (_CHANNEL_KEYS, _AXIS_KEYS):
         for key, spec in table.items():
             if spec.lo is not None and key not in exempt:

@@ -50,6 +50,12 @@ def run(text: str, m=DEFAULT, **kw) -> ReferencePlan:
     return plan(parse_text(text, "t.mpf"), m, **kw)
 
 
+#: The bare LookAhead, without velocity smoothing: the machine data have no "off" (MD20460
+#: = 0 selects the internal 100 %), so tests of the LookAhead stage alone switch the
+#: smoothing stage off by the model knob.
+BARE = PlannerParameters(smoothing_rounds=0)
+
+
 def local_maxima(p: ReferencePlan) -> int:
     """Strict local maxima of the path speed sampled at a quarter IPO cycle."""
     _, _, v, _, _ = p.profile.sample(T_IPO / 4)
@@ -224,8 +230,8 @@ def test_ipo_cycle_cap_on_tiny_blocks():
 def test_short_horizon_gives_a_saw_tooth_and_a_long_one_removes_it(mode):
     text = f"G90 G64 {mode} F6000\n" + "\n".join(
         f"G1 X{0.5 * (i + 1):.3f}" for i in range(200)) + "\nM30\n"
-    short = run(text, machine({"lookahead_blocks": 2}))
-    long = run(text, machine({"lookahead_blocks": 200}))
+    short = run(text, machine({"lookahead_blocks": 2}), parameters=BARE)
+    long = run(text, machine({"lookahead_blocks": 200}), parameters=BARE)
     assert local_maxima(short) >= 150          # one tooth per block
     assert local_maxima(long) <= 1
     assert short.blocks[100].cause == "look-ahead horizon"
@@ -254,7 +260,7 @@ def test_receding_horizon_matches_replanning_per_block():
     text = "G90 G64 BRISK\n" + "\n".join(
         f"G1 X{xi:.4f} F{f}" for xi, f in zip(x, feeds)) + "\nM30\n"
     N = 3
-    p = run(text, machine({"lookahead_blocks": N}))
+    p = run(text, machine({"lookahead_blocks": N}), parameters=BARE)
     A = 2000.0
     Lr = np.diff(np.concatenate(([0.0], np.round(x, 4))))
     cap = np.minimum(feeds / 60.0, Lr / T_IPO)
@@ -278,14 +284,14 @@ SMOOTH_PROGRAM = "G90 G64 BRISK\n" + "\n".join(
 
 
 def test_smoothing_one_percent_is_practically_off():
-    off = run(SMOOTH_PROGRAM)
+    off = run(SMOOTH_PROGRAM, parameters=BARE)
     one = run(SMOOTH_PROGRAM, machine({"LOOKAH_SMOOTH_FACTOR": 1.0}))
     assert off.time_s <= one.time_s <= 1.01 * off.time_s
     assert local_maxima(one) >= local_maxima(off) - 2
 
 
 def test_smoothing_100_percent_removes_short_bumps():
-    off = run(SMOOTH_PROGRAM)
+    off = run(SMOOTH_PROGRAM, parameters=BARE)
     full = run(SMOOTH_PROGRAM, machine({"LOOKAH_SMOOTH_FACTOR": 100.0}))
     assert local_maxima(off) >= 40
     assert local_maxima(full) <= 2
@@ -298,7 +304,7 @@ def test_smoothing_keeps_bumps_longer_than_one_over_f():
     # 20 Hz axes: bumps of more than 50 ms are low-frequency and stay
     text = "G90 G64 BRISK\n" + "\n".join(
         f"G1 X{30 * (i + 1)}.0 F{6000 if i % 2 else 3000}" for i in range(10)) + "\nM30\n"
-    off = run(text)
+    off = run(text, parameters=BARE)
     full = run(text, machine({"LOOKAH_SMOOTH_FACTOR": 100.0}))
     assert full.time_s == pytest.approx(off.time_s, rel=1e-12)
 

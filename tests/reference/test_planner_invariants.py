@@ -129,6 +129,20 @@ def test_random_programs_keep_the_declared_bounds(seed: int, name: str):
     _assert_keeps_its_bounds(p, f"seed {seed} machine {name}")
 
 
+#: DRIVE with a knee on every axis (hyperbolic and constant characteristics mixed), with
+#: adaptation: the BRISK blocks of the random programs run in DRIVE.
+DRIVE_MACHINE = _machine({"ADAPT_PATH_DYNAMIC": [1.5, 1.0]},
+                         {"ACCEL_REDUCTION_SPEED_POINT": 0.05, "ACCEL_REDUCTION_FACTOR": 0.6,
+                          "ACCEL_TYPE_DRIVE": 1})
+
+
+@pytest.mark.parametrize("seed", range(N_RANDOM))
+def test_random_drive_programs_keep_the_declared_bounds(seed: int):
+    text = random_program(seed).replace("BRISK", "DRIVE")
+    p = plan(parse_text(text, f"drive{seed}.mpf"), DRIVE_MACHINE)
+    _assert_keeps_its_bounds(p, f"seed {seed} DRIVE")
+
+
 def _corpus_files() -> list[FsPath]:
     if not CORPUS.is_dir():
         return []
