@@ -26,7 +26,7 @@ from reference.core.profile import Profile
 from reference.core.rules import (FEASIBLE, axis_acceleration, axis_jerk, is_tangential,
                                   junction_speed_cap)
 
-__all__ = ["CAUSES", "MIN_SHARE", "TIGHT_REL", "derive_causes"]
+__all__ = ["CAUSES", "MIN_SHARE", "TIGHT_REL", "derive_causes", "stretch_causes"]
 
 #: A limit is tight where value/limit >= 1 - TIGHT_REL. 2 % covers the oracle's
 #: discretisation (constant path acceleration between grid nodes on arcs) and the
@@ -91,19 +91,7 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
         b = np.repeat(blk[k], _TAU.size)
         s, v, a = s.ravel(), v.ravel(), a.ravel()
         j = np.repeat(prof.j[k], _TAU.size)
-        seg = path.segment_index(np.clip(s, 0.0, path.total_length))
-        _, dq, ddq, dddq = path.evaluate(np.clip(s, 0.0, path.total_length), segment=seg)
-        feed = path.feed[seg]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratios = {
-                "feed": np.where(np.isfinite(feed), v / feed, 0.0),
-                "axis velocity": np.max(np.abs(dq) * v[:, None] / lim.v_max, axis=1),
-                "axis acceleration": np.max(np.abs(axis_acceleration(dq, ddq, v, a))
-                                            / lim.a_max, axis=1),
-            }
-            if jerk:
-                jr = axis_jerk(dq, ddq, dddq, v, a, j)
-                ratios["jerk"] = np.max(np.abs(jr) / lim.j_max, axis=1)
+        ratios = _ratios(path, lim, s, v, a, j, jerk)
         for c in names:
             tight[c] += np.bincount(b, weights=w * (ratios[c] >= 1.0 - TIGHT_REL),
                                     minlength=n_blocks)
@@ -133,6 +121,59 @@ def derive_causes(path: Path, limits: MachineLimits, profile: Profile,
             out[i] = best
         else:
             out[i] = end or "none"
+    return out
+
+
+def _ratios(path: Path, lim, s: np.ndarray, v: np.ndarray, a: np.ndarray, j: np.ndarray,
+            jerk: bool) -> dict[str, np.ndarray]:
+    """value/limit of every shared limit at samples ``(s, v, a, j)``, shape (N,) each."""
+    seg = path.segment_index(np.clip(s, 0.0, path.total_length))
+    _, dq, ddq, dddq = path.evaluate(np.clip(s, 0.0, path.total_length), segment=seg)
+    feed = path.feed[seg]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = {
+            "feed": np.where(np.isfinite(feed), v / feed, 0.0),
+            "axis velocity": np.max(np.abs(dq) * v[:, None] / lim.v_max, axis=1),
+            "axis acceleration": np.max(np.abs(axis_acceleration(dq, ddq, v, a))
+                                        / lim.a_max, axis=1),
+        }
+        if jerk:
+            jr = axis_jerk(dq, ddq, dddq, v, a, j)
+            ratios["jerk"] = np.max(np.abs(jr) / lim.j_max, axis=1)
+    return ratios
+
+
+def stretch_causes(path: Path, limits: MachineLimits, profile: Profile, s0: np.ndarray,
+                   s1: np.ndarray, jerk: bool = True, samples: int = 64) -> list[str]:
+    """Limiting cause of the motion on path stretches (inserted blocks), by the rule of
+    :func:`derive_causes` (the limit tight for the largest share of the time, ``"none"``
+    below :data:`MIN_SHARE`), on ``samples`` equal time steps per stretch.
+
+    Parameters
+    ----------
+    s0, s1 : numpy.ndarray, shape (p,)
+        Stretch ends, mm (``s0 < s1``; no stop inside).
+
+    Returns
+    -------
+    list of str, length p
+    """
+    if len(s0) == 0:
+        return []
+    lim = limits.for_axes(path.axes)
+    names = _SHARED if jerk else _SHARED[:3]
+    t0 = profile.time_at(np.asarray(s0, dtype=np.float64), which="last")
+    t1 = profile.time_at(np.asarray(s1, dtype=np.float64), which="first")
+    frac = (np.arange(samples) + 0.5) / samples
+    t = (t0[:, None] + (t1 - t0)[:, None] * frac[None, :]).ravel()
+    s, v, a, j = profile.state(t)
+    ratios = _ratios(path, lim, s, np.maximum(v, 0.0), a, j, jerk)
+    out = []
+    for p in range(len(s0)):
+        shares = {c: float(np.mean(ratios[c][p * samples:(p + 1) * samples]
+                                   >= 1.0 - TIGHT_REL)) for c in names}
+        best = max(shares, key=shares.get)
+        out.append(best if shares[best] >= MIN_SHARE else "none")
     return out
 
 

@@ -11,6 +11,8 @@ import sys
 import traceback
 from typing import Sequence
 
+import numpy as np
+
 from reference.core.budget import DEFAULT_MAX_GRID_POINTS
 from reference.core.errors import FeedOracleError
 from reference.core.geometry import KIND_CODES
@@ -147,18 +149,34 @@ def _write_rounding(out, program, table) -> None:
         return
     lines = {b.index: b.line for b in program.blocks}
     out.write(f"rounding: {int(table.inserted.sum())} of {table.n} corners in G641..G645 "
-              "rounded (tangent arcs)\n")
+              "rounded (shape: arc = tangent arc, G2 = clothoid pair, curvature continuous; "
+              "radius_mm = smallest radius); d = distance of the rounding's ends from the corner, "
+              "dev = largest distance of the rounded path from the corner, F_G64 / F_round "
+              "= speed through the corner under G64 / through the rounding (model "
+              "estimate, mm/min) that decided it\n")
     out.write(f"{'corner':>13} {'mode':<5} {'d_mm':>9} {'length_mm':>10} {'dev_mm':>9} "
-              f"{'radius_mm':>10} result\n")
+              f"{'radius_mm':>10} {'F_G64':>9} {'F_round':>9} result\n")
     for i in range(table.n):
         corner = f"{lines[int(table.block[i])]}/{lines[int(table.next_block[i])]}"
         if table.inserted[i]:
-            what = "rounded" + (" (clamped to the block length)" if table.clamped[i] else "")
+            what = "rounded (" + ("G2" if table.g2[i] else "arc") + ")"
+            if table.blocks_spanned[i] > 2:
+                what += (f" across lines {lines[int(table.first_block[i])]}.."
+                         f"{lines[int(table.last_block[i])]} (short blocks)")
+            if table.clamped[i]:
+                what += " (clamped to half the block" + (
+                    "s" if table.blocks_spanned[i] > 2 else "") + ")"
         else:
             what = "none: " + table.reason_text(i)
+        f64, frd = (60.0 * table.v_g64[i], 60.0 * table.v_round[i])
         out.write(f"{corner:>13} {table.mode[i]:<5} {table.distance_mm[i]:>9.4f} "
                   f"{table.length_mm[i]:>10.4f} {table.deviation_mm[i]:>9.5f} "
-                  f"{table.radius_mm[i]:>10.4f} {what}\n")
+                  f"{table.radius_mm[i]:>10.4f} {_num(f64):>9} {_num(frd):>9} {what}\n")
+
+
+def _num(x: float) -> str:
+    """A speed for the rounding table: ``-`` where it was not evaluated."""
+    return "-" if not np.isfinite(x) else f"{x:.1f}"
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -48,14 +48,16 @@ import numpy as np
 
 from reference.core.causes import normalise_cause
 from reference.core.constraints import BOUND_SETS, ConstraintReport, check_profile
-from reference.core.geometry import BlockSpan, Path
+from reference.core.geometry import KIND_CODES, BlockSpan, Path
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import BlockMotion, BlockRow, block_motion
-from reference.core.errors import InternalError
+from reference.core.errors import FeedOracleError, InternalError
 from reference.core.tolerances import RATIO_TOL, ROUNDOFF_MARGIN_REL
+from reference.prepare import prepare, restrict_to_machine
 
-from .causes import derive_causes
+from .causes import derive_causes, stretch_causes
+from .inserted import inserted_pieces, stretch_motion
 from .result import (GAP_ABS_TOL_S, INSERTED_KINDS, ComparedBlock, Comparison, OracleResult,
                      Side, Verdict, block_span, describe_violation, format_interval)
 
@@ -66,7 +68,7 @@ if TYPE_CHECKING:                 # annotations only: the heuristic and oracle s
 
 __all__ = ["ComparedBlock", "Comparison", "OracleResult", "Side", "Verdict",
            "block_span", "compare", "compare_profiles", "describe_violation",
-           "format_interval", "oracle_result", "reference_side"]
+           "format_interval", "oracle_result", "programmed_contour", "reference_side"]
 
 
 # ---------------------------------------------------------------------- helpers
@@ -82,6 +84,99 @@ def _corners(path: Path) -> dict[int, tuple[int, int]]:
         after = next((spans[k] for k in range(i + 1, len(spans))
                       if spans[k].kind not in INSERTED_KINDS and spans[k].n_segments), None)
         out[i] = (before.line if before else sp.line, after.line if after else sp.line)
+    return out
+
+
+def _at(mot: BlockMotion, i: int) -> tuple[float, float, float, float]:
+    """(time, entry, exit, peak) of span ``i``."""
+    return (float(mot.time_s[i]), float(mot.v_entry[i]), float(mot.v_exit[i]),
+            float(mot.v_peak[i]))
+
+
+def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
+                    opt_prof: Profile | None, jerk_ref: bool, jerk_opt: bool) -> dict:
+    """Per span holding inserted segments (corner rounding): a function that turns the
+    span's one row piece into the block's own piece followed by one piece per inserted
+    block (a run of inserted segments: a clothoid pair is one rounding; see
+    :func:`compare_profiles` for the piece layout).
+
+    The inserted pieces are measured on each profile exactly
+    (:func:`compare.inserted.stretch_motion`); the block keeps the rest of its time, so
+    the rows still sum to each profile's duration; its limiting cause is derived from
+    each motion on the stretch (:func:`compare.causes.stretch_causes`: the planners
+    report causes per program block). An inserted segment at the end of
+    the span (a rounding always is) ends the block's own piece: its exit speed is the
+    inserted piece's entry speed and its peak is measured on the stretch before it.
+    """
+    found = inserted_pieces(path)
+    if not found:
+        return {}
+    spans = path.blocks
+    order = sorted(found)
+    runs = np.concatenate([found[i] for i in order])             # (R, 2) first, last
+    sb = path.s_breaks
+    # the block's own stretch before its first inserted block, then each inserted one
+    own0 = np.array([spans[i].s_start for i in order])
+    own1 = np.array([sb[found[i][0, 0]] for i in order])
+    ins0, ins1 = sb[runs[:, 0]], sb[runs[:, 1] + 1]
+
+    def measure(prof: Profile | None, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+        if prof is None or s0.size == 0:
+            return np.full((s0.size, 4), math.nan)
+        m = stretch_motion(prof, s0, s1)
+        return np.column_stack((m.time_s, m.v_entry, m.v_exit, m.v_peak))
+
+    has_own = own1 > own0
+    ins_r, ins_o = measure(ref_prof, ins0, ins1), measure(opt_prof, ins0, ins1)
+    own_r = np.full((len(order), 4), math.nan)
+    own_o = np.full((len(order), 4), math.nan)
+    own_r[has_own] = measure(ref_prof, own0[has_own], own1[has_own])
+    own_o[has_own] = measure(opt_prof, own0[has_own], own1[has_own])
+    cause_r = stretch_causes(path, limits, ref_prof, ins0, ins1, jerk_ref)
+    cause_o = (stretch_causes(path, limits, opt_prof, ins0, ins1, jerk_opt)
+               if opt_prof is not None else ["-"] * runs.shape[0])
+    table = path.rounding
+    lines = {sp.block: sp.line for sp in spans}
+    corner_of: dict[int, tuple[int, int]] = {}
+    if table is not None:
+        for k in np.flatnonzero(table.inserted):
+            corner_of[int(table.block[k])] = (lines.get(int(table.block[k]), 0),
+                                               lines.get(int(table.next_block[k]), 0))
+    kinds = KIND_CODES
+    out = {}
+    pos = 0
+    for n, i in enumerate(order):
+        ks = found[i]
+        nk = ks.shape[0]
+        rows_r, rows_o = ins_r[pos:pos + nk], ins_o[pos:pos + nk]
+        cr, co = cause_r[pos:pos + nk], cause_o[pos:pos + nk]
+        pos += nk
+        sp = spans[i]
+        tail = bool(ks[-1, 1] == sp.first_segment + sp.n_segments - 1 and nk == 1)
+
+        def make(base, ks=ks, rows_r=rows_r, rows_o=rows_o, n=n, sp=sp, tail=tail, cr=cr,
+                 co=co):
+            kind, corner, line, source, s_start, length, stop, hold, mr, mo, lr, lo = base
+            ins_len = float(sum(sb[b + 1] - sb[a] for a, b in ks.tolist()))
+            own = []
+            for whole, part, own_part in ((mr, rows_r, own_r[n]), (mo, rows_o, own_o[n])):
+                t = whole[0] - float(np.nansum(part[:, 0]))
+                exit_ = part[0, 1] if tail else whole[2]
+                peak = own_part[3] if tail and has_own[n] else whole[3]
+                own.append((t, whole[1], float(exit_), float(peak)))
+            corner_here = corner_of.get(sp.block, (sp.line, sp.line))
+            pieces = [(kind, corner, line, source, s_start, length - ins_len,
+                       "" if tail else stop, hold, own[0], own[1], lr, lo)]
+            for j, (k, k_end) in enumerate(ks.tolist()):
+                last = j == nk - 1
+                pieces.append((kinds[int(path.kind[k])], corner_here, corner_here[0], "",
+                               float(sb[k]), float(sb[k_end + 1] - sb[k]),
+                               stop if (tail and last) else "", 0.0,
+                               tuple(float(x) for x in rows_r[j]),
+                               tuple(float(x) for x in rows_o[j]), cr[j], co[j]))
+            return pieces
+
+        out[i] = make
     return out
 
 
@@ -122,8 +217,8 @@ def _gap_note(row_gap: float, t_opt: float, c_rel_band: float, oracle_bounds: st
 # ---------------------------------------------------------------------- entry points
 def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                      oracle: OracleResult, *, program: str = "", machine: str = "",
-                     program_lines: tuple[str, ...] = (), notes: Iterable[str] = ()
-                     ) -> Comparison:
+                     program_lines: tuple[str, ...] = (), notes: Iterable[str] = (),
+                     programmed: Path | None = None) -> Comparison:
     """Compare any planner's motion with the oracle on the same path.
 
     Parameters
@@ -142,6 +237,9 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         Program source lines (for the source column and the report).
     notes : iterable of str
         Extra program-level remarks.
+    programmed : Path, optional
+        The programmed contour before compensation and rounding (for the tool-path
+        plot; :func:`programmed_contour`).
 
     Returns
     -------
@@ -193,6 +291,7 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     rel_band = ((ub - H) / (lb - H) - 1.0) if (lb - H > 0 and math.isfinite(ub)) else math.inf
     corners = _corners(path)
     lines = program_lines
+    split = _split_inserted(path, limits, ref_prof, opt_prof, jerk_ref, jerk_opt)
     rows = []
     for i, sp in enumerate(spans):
         corner = corners.get(i)
@@ -200,26 +299,33 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
         source = "" if corner or not (0 < sp.line <= len(lines)) else lines[sp.line - 1]
         hold = float(hold_blk[i])
         hold_cause = oracle.holds.cause_of(sp.block) if hold > 0 else ""
-        gap = float((t_ref[i] - hold) - (t_opt[i] - hold))
-        note = "" if math.isnan(gap) else _gap_note(
-            gap, float(t_opt[i] - hold), rel_band, oracle.bounds, float(ve_r[i]),
-            float(vx_r[i]), float(ve_o[i]), float(vx_o[i]), breaks)
         lim_r, lim_o = c_ref.get(sp.block, "-"), c_opt.get(sp.block, "-")
         if hold_cause and sp.n_segments == 0:
             # a block that only waits: its time is the hold on every side
             lim_r = lim_o = hold_cause
-        ident = dict(block=sp.block, line=max(1, line), label=sp.label, kind=sp.kind,
-                     length_mm=sp.length, hold_s=hold)
-        rows.append(ComparedBlock(
-            reference=BlockRow(**ident, time_s=float(mot_r.time_s[i]),
-                               v_entry=float(mot_r.v_entry[i]), v_exit=float(mot_r.v_exit[i]),
-                               v_peak=float(mot_r.v_peak[i]), cause=lim_r),
-            oracle=BlockRow(**ident, time_s=float(mot_o.time_s[i]),
-                            v_entry=float(mot_o.v_entry[i]), v_exit=float(mot_o.v_exit[i]),
-                            v_peak=float(mot_o.v_peak[i]), cause=lim_o),
-            source=source.strip(), corner=corner, s_start=sp.s_start,
-            ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
-            stop_reason=sp.stop_reason, note=note, hold_cause=hold_cause))
+        # (kind, corner, line, source, s_start, length, stop, hold, reference motion,
+        # oracle motion, reference cause, oracle cause) per row: the block itself, then
+        # its inserted blocks on rows of their own
+        pieces = [(sp.kind, corner, line, source, sp.s_start, sp.length, sp.stop_reason,
+                   hold, _at(mot_r, i), _at(mot_o, i), lim_r, lim_o)]
+        if i in split:
+            pieces = split[i](pieces[0])
+        for kind, corn, ln, src, s_start, length, stop, hld, mr, mo, cr, co in pieces:
+            gap = float((mr[0] - hld) - (mo[0] - hld))
+            note = "" if math.isnan(gap) else _gap_note(
+                gap, float(mo[0] - hld), rel_band, oracle.bounds, mr[1], mr[2], mo[1], mo[2],
+                breaks)
+            ident = dict(block=sp.block, line=max(1, ln), label=sp.label if corn is None
+                         or corner is not None else "", kind=kind, length_mm=length,
+                         hold_s=hld)
+            rows.append(ComparedBlock(
+                reference=BlockRow(**ident, time_s=mr[0], v_entry=mr[1], v_exit=mr[2],
+                                   v_peak=mr[3], cause=cr),
+                oracle=BlockRow(**ident, time_s=mo[0], v_entry=mo[1], v_exit=mo[2],
+                                v_peak=mo[3], cause=co),
+                source=src.strip(), corner=corn, s_start=s_start,
+                ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
+                stop_reason=stop, note=note, hold_cause=hold_cause if hld > 0 else ""))
 
     all_notes = list(notes)
     if not set(BOUND_SETS[reference.bound_set]) <= set(BOUND_SETS.get(oracle.bounds, ())):
@@ -250,7 +356,7 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                       oracle=oracle, path=path, limits=limits, reference_profile=ref_prof,
                       rows=tuple(rows), reference_report=ref_report, oracle_report=opt_report,
                       notes=tuple(all_notes), program_lines=tuple(program_lines),
-                      reference_ratio_tol=reference.ratio_tol)
+                      reference_ratio_tol=reference.ratio_tol, programmed=programmed)
 
 
 def _check_certificate(path: Path, profile: Profile, report: ConstraintReport,
@@ -332,4 +438,19 @@ def compare(plan: ReferencePlan, solution: OptimalSolution, *,
     name = program.file if program is not None else ""
     return compare_profiles(plan.path, limits, reference_side(plan),
                             oracle_result(solution, solution.bounds),
-                            program=name, machine=machine, program_lines=lines)
+                            program=name, machine=machine, program_lines=lines,
+                            programmed=programmed_contour(program, limits))
+
+
+def programmed_contour(program: Program | None, limits: MachineLimits) -> Path | None:
+    """The program's contour as programmed -- positions, lines and arcs of its blocks over
+    the machine's axes, before tool radius compensation and corner rounding
+    (:func:`reference.prepare.prepare`, :func:`reference.prepare.restrict_to_machine`)
+    -- or ``None`` without a program or when it cannot be built (the planned path is
+    then drawn alone; the path stages already reported any error)."""
+    if program is None:
+        return None
+    try:
+        return restrict_to_machine(prepare(program), limits)
+    except FeedOracleError:
+        return None

@@ -205,7 +205,8 @@ class Comparison:
     reference_profile : Profile
         The planner's motion.
     rows : tuple[ComparedBlock, ...]
-        One per block span, in path order.
+        One per block span, in path order, each followed by the blocks inserted at its
+        end (corner rounding) on rows of their own.
     reference_report, oracle_report : ConstraintReport or None
         ``check_profile`` of each profile (``None`` for a missing oracle profile).
     notes : tuple[str, ...]
@@ -214,6 +215,10 @@ class Comparison:
         Source text of the program, one entry per line (for reports).
     reference_ratio_tol : float
         Violation threshold of the planner's profile (``Side.ratio_tol``).
+    programmed : Path or None
+        The programmed contour over the same axes, before tool radius compensation and
+        corner rounding (:func:`reference.prepare.prepare`), for the tool-path plot;
+        ``None`` when the program is not at hand (then ``path`` is drawn alone).
     """
 
     program: str
@@ -230,6 +235,7 @@ class Comparison:
     notes: tuple[str, ...] = ()
     program_lines: tuple[str, ...] = field(default=(), repr=False)
     reference_ratio_tol: float = RATIO_TOL
+    programmed: Path | None = None
 
     # ------------------------------------------------------------------ totals
     @property

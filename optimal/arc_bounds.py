@@ -41,7 +41,8 @@ No step uses ``b``; the bound holds for every feasible motion. It never exceeds 
 one-axis bound by more than the ratio ``sum_j |q'_j| / |q'|`` (at most ``sqrt n``) and is
 2.4-3.4 times smaller on a circle at its speed limit, where the one-axis bound also pays
 the centripetal term. Spirals (``dradius != 0``) have ``q' . q'' != 0`` and keep the
-one-axis bound only.
+one-axis bound only; so do clothoids (``sharpness != 0``), whose packed rows are not of
+the helical form above (the argument is only made for that form).
 
 The remainder of the interval-exact rows
 ========================================
@@ -102,7 +103,7 @@ def tangential_slope_bound(path: Path, lim: AxisArrays, segment: np.ndarray,
     """
     norm2 = np.sum(dq_mid * dq_mid, axis=1)
     acc = np.sum(dq_hi * lim.a_max[None, :], axis=1)
-    ok = (path.dradius[segment] == 0) & (norm2 > 0)
+    ok = (path.dradius[segment] == 0) & (path.sharpness[segment] == 0) & (norm2 > 0)
     out = np.full(segment.size, np.inf)
     out[ok] = 2.0 * acc[ok] / norm2[ok]
     return out

@@ -26,10 +26,12 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    ``|int q''_j e / 2| <= sup|q''_j| M D^2 / 8 =: E_jk``. Hence the end values satisfy the
    linear rows ``sigma ([q'_j b]/2 + w0 b_k + w1 b_{k+1}) <= A_j D + E_jk`` with
    ``w0, w1 = int q''_j (1 - t/D) / 2, int q''_j (t/D) / 2`` (closed form on helices).
-   On spiral arcs (curvature varying along the arc) ``sup|q''_j|`` and ``sup|q'''_j|``
-   are the segment's worst values (:func:`reference.core.geometry.plane_amplitudes`) and
-   the weights come by parts, ``w0 = (dq/D - q'_j(s_k)) / 2``,
-   ``w1 = (q'_j(s_{k+1}) - dq/D) / 2`` (``dq`` the exact chord), whose round-off bound
+   On spiral arcs and on clothoids (curvature varying along the segment; the kinds
+   without the helix closed forms, :func:`_varying_curvature`) ``sup|q''_j|`` and
+   ``sup|q'''_j|`` are the segment's worst values
+   (:func:`reference.core.geometry.plane_amplitudes`) and the weights come by parts,
+   ``w0 = (dq/D - q'_j(s_k)) / 2``, ``w1 = (q'_j(s_{k+1}) - dq/D) / 2`` (``dq`` the
+   exact chord; both identities hold for every smooth curve), whose round-off bound
    times ``Bbar_k`` is added to ``E_jk``.
    On lines ``q'' = 0``: the row is the exact ``|q'_j (b_{k+1} - b_k)| / (2D) <= A_j``.
    From the second round on (or with node bounds from a coarser grid) each curved row
@@ -199,7 +201,7 @@ def derivative_ranges(path: Path, grid: Grid, dq0: np.ndarray, ddq0: np.ndarray,
     ``q''_j = -r omega^2 |e_j| cos(phi - atan2(e2_j, e1_j))`` (``|e_j|`` the axis' share
     of the arc plane): their extremes on an interval are at its ends and at the interior
     extremes of the sinusoid (:func:`_sinusoid_range`). On lines both are constant.
-    Spirals are left to the caller (``exact`` is False there).
+    Spirals and clothoids are left to the caller (``exact`` is False there).
 
     Returns
     -------
@@ -214,7 +216,7 @@ def derivative_ranges(path: Path, grid: Grid, dq0: np.ndarray, ddq0: np.ndarray,
     seg = grid.segment
     t_lo, t_hi = np.minimum(dq0, dq1), np.maximum(dq0, dq1)
     k_lo, k_hi = np.minimum(ddq0, ddq1), np.maximum(ddq0, ddq1)
-    exact = path.dradius[seg] == 0
+    exact = ~_varying_curvature(path, seg)         # not on spirals and clothoids
     circ_all = np.flatnonzero(exact & (path.radius[seg] > 0))
     amp = np.zeros_like(dq0)
     # in chunks of intervals: a dozen (chunk, n) temporaries each
@@ -252,7 +254,7 @@ def _interval_data(path: Path, lim: AxisArrays, grid: Grid,
     plane = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)          # (N, n)
     k2 = np.abs(r * w * w)[:, None] * plane                          # sup |q''_j|
     k3 = np.abs(r * w ** 3)[:, None] * plane                         # sup |q^(3)_j|
-    spi = np.flatnonzero(path.dradius[seg])            # spirals: worst over the segment
+    spi = np.flatnonzero(_varying_curvature(path, seg))  # worst over the segment
     if spi.size:
         amp = plane_amplitudes(path)
         k2[spi] = amp.curvature[seg[spi], None] * plane[spi]
@@ -366,6 +368,25 @@ def _monotone_peak(geo: _IntervalData, b_node: np.ndarray) -> np.ndarray:
     return cand.min(axis=1) if cand.shape[1] else np.full(cand.shape[0], np.inf)
 
 
+def _varying_curvature(path: Path, seg: np.ndarray) -> np.ndarray:
+    """True for segments whose curvature varies along them (spirals, clothoids): no
+    helix closed forms there, the generic by-parts weights and worst-case suprema are
+    used instead. Shape (len(seg),)."""
+    return (path.dradius[seg] != 0) | (path.sharpness[seg] != 0)
+
+
+def _clothoid_position_scale(path: Path, seg: np.ndarray) -> np.ndarray:
+    """Magnitude bounding the round-off of clothoid positions, shape (K, n), mm.
+
+    A clothoid position is ``Z + X e1 + Y e2`` with ``|X|, |Y| <= L`` from the Fresnel
+    integrals, which scipy evaluates to a few units of round-off relative to
+    ``sqrt(pi/c)`` times values at most ``L / sqrt(pi/c)``; the sum then carries at most
+    a few ulps of ``|Z_j| + 2 L``. ``|Z_j| + 4 L`` (used with the same ``16 eps`` as the
+    spirals' bound) leaves a factor of two on top.
+    """
+    return np.abs(path.origin[seg]) + 4.0 * path.length[seg][:, None]
+
+
 def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
                     dq1: np.ndarray) -> tuple[np.ndarray, ...]:
     """``I0, I1`` on spiral intervals ``iv`` by parts, and their round-off bound.
@@ -385,6 +406,9 @@ def _spiral_weights(path: Path, grid: Grid, iv: np.ndarray, dq0: np.ndarray,
     r_max = np.maximum(path.radius[seg], path.radius[seg] + path.dradius[seg] * t_end)
     scale = (np.abs(path.origin[seg]) + (r_max * (1.0 + t_end))[:, None]
              + np.abs(path.d[seg]) * path.length[seg][:, None])
+    clo = np.flatnonzero(path.sharpness[seg])
+    if clo.size:
+        scale[clo] = _clothoid_position_scale(path, seg[clo])
     err = 2.0 * 16.0 * np.finfo(np.float64).eps * scale / D
     return 0.5 * (chord - dq0), 0.5 * (dq1 - chord), err
 

@@ -49,7 +49,7 @@ import numpy as np
 
 from reference.core.arrays import readonly
 from reference.core.errors import InfeasibleError, InternalError
-from reference.core.geometry import Path
+from reference.core.geometry import Path, clothoid_derivative_norms
 from reference.core.limits import AxisArrays
 from reference.core.rules import FEASIBLE, RELAXED, junction_speed_cap
 
@@ -557,7 +557,8 @@ def clip_slopes(path: Path, lim: AxisArrays, grid: Grid, dq0: np.ndarray, dq1: n
     # lines: the allowed acceleration is the same all along, the optimum's is piecewise
     # constant (a slope there only spreads a switch); spirals: no slope term in their
     # margin
-    return np.where((path.dradius[seg] != 0) | (path.radius[seg] == 0), 0.0, g)
+    return np.where((path.dradius[seg] != 0) | (path.sharpness[seg] != 0)
+                    | (path.radius[seg] == 0), 0.0, g)
 
 
 def acceleration_slopes(grid: Grid, b: np.ndarray) -> np.ndarray:
@@ -714,7 +715,8 @@ def _curved_margins(path, lim, grid, curved, dq0, ddq0, dq1, ddq1, cap, g, bg):
         a1 = (np.abs(d1) * A).sum(axis=1) / (d1 ** 2).sum(axis=1)
         abar = np.maximum(a0, a1)
     D = grid.s[curved + 1] - grid.s[curved]
-    spiral = path.dradius[sa] != 0
+    # spirals and clothoids: the generic margin (no helix closed forms)
+    spiral = (path.dradius[sa] != 0) | (path.sharpness[sa] != 0)
     # circles and helices: second order in the swept angle, free of b
     rho = (w * D) ** 2 / 8.0
     C = 4.0 * (r * w)[:, None] * plane + np.abs(path.d[sa])
@@ -732,6 +734,12 @@ def _curved_margins(path, lim, grid, curved, dq0, ddq0, dq1, ddq1, cap, g, bg):
     if np.any(spiral):
         k3 = (r * w ** 3)[:, None] * plane
         k4 = (r * w ** 4)[:, None] * plane
+        clo = np.flatnonzero(path.sharpness[sa] != 0)
+        if clo.size:        # clothoids: the suprema of their third and fourth derivative
+            norms = clothoid_derivative_norms(np.abs(path.sharpness[sa[clo]]),
+                                              path.length[sa[clo]])
+            k3[clo] = norms[2][:, None] * plane[clo]
+            k4[clo] = norms[3][:, None] * plane[clo]
         c = curved[spiral]
         mvc0 = pair_mvc(dq0[c], ddq0[c], lim.a_max)
         mvc1 = pair_mvc(dq1[c], ddq1[c], lim.a_max)

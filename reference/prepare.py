@@ -263,7 +263,7 @@ def _exact_path_stops(path: Path, program: Program) -> Path:
         reasons[k + 1] = reasons[k + 1] or "exact path G61 corner"
     fields = {f: getattr(path, f) for f in ("axes", "geometry", "rotary", "origin", "e1",
               "e2", "d", "radius", "omega", "theta0", "length", "block", "kind", "feed",
-              "rapid", "blocks", "source", "dradius")}
+              "rapid", "blocks", "source", "dradius", "sharpness")}
     return Path(stop=np.array([bool(r) for r in reasons]), stop_reason=tuple(reasons),
                 **fields)
 
@@ -339,7 +339,7 @@ def restrict_to_machine(path: Path, limits: MachineLimits) -> Path:
         return path
     f = {k: getattr(path, k) for k in ("radius", "omega", "theta0", "length", "block",
                                        "kind", "feed", "rapid", "stop", "stop_reason",
-                                       "blocks", "source", "dradius")}
+                                       "blocks", "source", "dradius", "sharpness")}
     return Path(axes=tuple(a for a, k in zip(path.axes, keep) if k),
                 geometry=path.geometry[keep], rotary=path.rotary[keep],
                 origin=path.origin[:, keep], e1=path.e1[:, keep], e2=path.e2[:, keep],

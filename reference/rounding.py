@@ -2,10 +2,15 @@
 
 sinumerik-model 5.1: "the neighbouring blocks are shortened and one or two intermediate
 blocks are inserted". :func:`round_corners` does this on the :class:`Path` that both
-planners share (DESIGN section 1): at every corner it rounds, it inserts one segment of
-kind ``"rounding"`` -- the circular arc tangent to both lines
-(:mod:`reference.core.rounding`) -- and shortens the two lines by the tangent distance
-``d``. The segment is attributed to the block whose end is the corner ("synchronisation
+planners share (DESIGN section 1): at every corner it rounds, it inserts segments of
+kind ``"rounding"`` and shortens the two lines by the tangent distance ``d``: under
+BRISK and for RND/RNDM one circular arc tangent to both lines
+(:mod:`reference.core.rounding`); under SOFT (G641..G645) a symmetric pair of clothoid
+pieces (:func:`reference.core.geometry.clothoid_pieces`) whose curvature rises linearly
+from zero to ``theta / L_s`` and falls back to zero, so the path stays curvature
+continuous and the axis motion in the rounding area can be jerk-limited (spec 5.9,
+MD20480 ten-thousands digit 0: "jerk-limited under SOFT"; 5.8 "curvature-continuous";
+6.3: a curvature jump would cap the speed). The segments are attributed to the block whose end is the corner ("synchronisation
 events are referred to the end of the shortened first block", 5.1), so every program
 block keeps exactly one :class:`BlockSpan`: that block's span now covers its shortened
 line and the rounding; the next block's span starts where the rounding ends.
@@ -32,31 +37,45 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      (CTOL ignored, 5.6); 2xxx/3xxx not modelled yet (named);
    * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
      radius ``R`` is what RND defines; no speed check: it is contour, not smoothing);
+   * a tolerance gives ``d = e / tan(theta/4)`` for the arc and ``d = e d_1(theta) /
+     e_1(theta)`` for the clothoid pair (both shapes deviate from the corner by ``e``
+     exactly; :func:`reference.core.geometry.clothoid_pair_shape`);
    * clamp: ``d <= c min(L1, L2)`` with ``c = rounding_length_clamp`` (0.5: "the
      rounding distance cannot exceed half the length of the original participating
      blocks", the G644 excerpt; 5.3); ``d`` at or below MIN_SEGMENT_LENGTH_MM: too small;
+     with G642/G645 the window may reach across short blocks that continue the same
+     straight line, ``L1``, ``L2`` then being those straight chains
+     (:func:`_across_blocks`; the blocks it covers whole are no longer interpolated);
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
    junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
    and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
    TRUE skips it, G643 and G644 never make it); every mode rounds only when the
    rounding is estimated to pass the corner in less time than G64
-   (:func:`corner_time_loss`), with ``v_round`` = min of the centripetal limit
-   ``sqrt(CENTRIPETAL_SHARE A_i R / rho_i)``, the one-IPO-cycle limit ``R theta / T_ipo`` (5.3: "about
-   ADIS/T_ipo"), under SOFT the curvature-jump limit of the shared rule (6.3) and the
-   in-arc jerk limit ``(J_i R^2 / rho_i)^(1/3)``, and the feed.
+   (:func:`corner_time_loss`, jerk-limited ramps under SOFT), with ``v_round``
+   (:func:`_rounding_speed`) = min of the centripetal limit at the largest curvature,
+   the one-IPO-cycle limit per inserted block (5.3: "about ADIS/T_ipo"), under SOFT the
+   in-rounding jerk limit and, on the arc only, the curvature-jump limit of the shared
+   rule (6.3), and the feed.
 
-Model limits, stated: the rounding is a tangent arc (G1 continuous, curvature jump
-``1/R`` at both ends), also for G642/G645 where the control inserts a smoother polynomial;
-G643/G644 insert the same segment (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions with curvature jumps and rounding across
-several short blocks are not modelled.
+Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
+curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
+clothoid pair (G2), where the control inserts a polynomial of its own;
+G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
+G645's rounding of tangential transitions with curvature jumps is not modelled; a window
+reaches across short blocks only along a straight chain (several corners closer than
+their windows are rounded one by one, each clamped), and tangential transitions between
+short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
+which would merge them, are not modelled), so each such block keeps its own IPO cycle.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from .core.geometry import KIND_CODES, BlockSpan, Path
+from .core.geometry import (KIND_CODES, BlockSpan, Path, clothoid_pair_shape,
+                            clothoid_pieces)
 from .core.limits import AxisArrays
 from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
                             deflection_angle, distance_for_deviation, fillet_pieces)
@@ -69,6 +88,25 @@ from .nc.program import Program
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
 #: Modes that round only where G64 would have to reduce the speed (4.3).
 _OVERLOAD_CHECKED = ("G641", "G642", "G645")
+
+#: Modes whose tolerance-based rounding window may reach across several short blocks
+#: (:func:`_across_blocks`). G641 and the ADIS digit (4) are limited by the block lengths
+#: (5.3: "the rounding area is also limited by the block lengths"); G643 rounds inside
+#: the original blocks (5.5); G644's distance "cannot exceed half the length of the
+#: original participating blocks" (excerpt) -- all three keep the one-block clamp.
+_ACROSS_BLOCKS = ("G642", "G645")
+
+#: A rounding window reaches across short blocks only where the lines it covers are so
+#: nearly parallel that the rounding's start ``C - d t1`` and the path point ``d`` before
+#: the corner differ by at most this, mm: a tenth of the 1e-9 mm to which consecutive
+#: segments meet, so the rounded path stays continuous to that.
+CHAIN_MEET_MM = 1e-10
+
+#: Share of the axis jerk the rounding-speed estimate grants the path jerk on the
+#: rounding (``v^3 |q'''_i|``): the heuristic's default
+#: ``PlannerParameters.arc_jerk_velocity_share`` (a test keeps the two equal), for the
+#: same reason as :data:`CENTRIPETAL_SHARE`.
+JERK_VELOCITY_SHARE = 0.5
 
 #: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
 _RADIUS_MODES = ("RND", "RNDM")
@@ -181,17 +219,27 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
     decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
 
-    # --- rounding distance by mode ----------------------------------------------------
+    # --- the rounding's shape (5.8, 5.9): under SOFT the axis motion in the rounding
+    # area is jerk-limited (MD20480 ten-thousands digit 0), which a curvature jump at its
+    # ends would break: a clothoid pair (G2); under BRISK and for RND/RNDM (a programmed
+    # radius) the tangent arc
     theta = deflection_angle(t1, t2)
-    d = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, decide)
-    lens = np.minimum(path.length[a], path.length[b])
-    cap = ch.rounding_length_clamp * lens
+    g2 = (attrs["accel"][ka] == "SOFT") & np.isin(mode_arr, ROUNDING_MODES)
+    d, multi = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, g2,
+                          decide)
+    # clamp (5.3, the G644 excerpt): c times the shorter participating block; where the
+    # mode rounds across short blocks, the participating "block" on each side is the
+    # straight chain of blocks the window may cover (:func:`_straight_chains`)
+    c = ch.rounding_length_clamp
+    cap = c * np.minimum(path.length[a], path.length[b])
+    first, last = a.copy(), b.copy()
+    if multi.any():
+        cap, first, last = _across_blocks(path, attrs, a, b, d, cap, c, multi & (reason < 0))
     clamped = d > cap
     d = np.minimum(d, cap)
     decide(~(d > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        radius = np.where(reason < 0, d / np.tan(theta / 2.0), 0.0)
-    decide(~(radius * theta > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
+    shape = _shape(theta, d, g2, reason < 0)
+    decide(~(shape.piece > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
 
     # --- speeds: G64 against rounding (4.3, 5.2 group 2, 5.8) -------------------------
     lim = machine.limits.for_axes(path.axes)
@@ -207,7 +255,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                             axis=1)
         v_prog = np.minimum(feed, v_axis)
         soft = attrs["accel"][ka[o]] == "SOFT"
-        v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], radius[o],
+        v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
         radius_mode = np.isin(mode_arr[o], _RADIUS_MODES)
@@ -218,29 +266,44 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         with np.errstate(divide="ignore"):
             a_path = np.min(lim.a_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
                             axis=1)
-        sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, radius[o] * theta[o], 2 * d[o])
-                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0)) & ~radius_mode
+            j_path = np.min(lim.j_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
+                            axis=1)
+        j_path = np.where(soft, j_path, np.inf)
+        # against passing at the programmed speed (the stretch form of the estimate,
+        # ``half`` = half of the shorter neighbouring block, rounded more corners whose
+        # rounding the heuristic then planned slower, on both bundled machines, BRISK
+        # and SOFT: measured on the bench polylines, so the classic form decides)
+        sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, shape.length[o], 2 * d[o],
+                                    j_path)
+                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0, j_path)
+                   ) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
     ins = reason == 0
     zero = np.where(ins, 1.0, 0.0)
     table = RoundingTable(
         block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
-        distance_mm=d * zero, length_mm=radius * theta * zero,
-        deviation_mm=d * np.tan(theta / 4.0) * zero, radius_mm=radius * zero,
-        clamped=clamped & ins, v_g64=v64, v_round=v_round)
+        distance_mm=d * zero, length_mm=shape.length * zero,
+        deviation_mm=shape.deviation * zero, radius_mm=shape.radius * zero,
+        clamped=clamped & ins, v_g64=v64, v_round=v_round, g2=g2 & ins,
+        first_block=np.where(ins, path.block[first], ka).astype(np.int64),
+        last_block=np.where(ins, path.block[last], kb).astype(np.int64))
     if not ins.any():                     # nothing to insert: same path, with the table
         keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
-                "blocks", "source", "dradius")
+                "blocks", "source", "dradius", "sharpness")
         return Path(rounding=table, **{f: getattr(path, f) for f in keep})
-    return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], table)
+    return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],
+                     table)
 
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
-               t2: np.ndarray, theta: np.ndarray, decide) -> np.ndarray:
-    """Tangent distance per corner by mode, before the block-length clamp, mm."""
+               t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, decide
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
+    and whether the corner's window may reach across short blocks (G642/G645 with a
+    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -284,25 +347,146 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
         dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
-        d = np.where(is_tol & (dev > 0), distance_for_deviation(theta, np.maximum(dev, 0.0)), d)
+        d_dev = np.where(g2, _clothoid_distance(theta, np.maximum(dev, 0.0)),
+                         distance_for_deviation(theta, np.maximum(dev, 0.0)))
+        d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
     decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
-    return np.where(np.isfinite(d), d, 0.0)
+    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == "tol")
+    return np.where(np.isfinite(d), d, 0.0), multi
+
+
+def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Maximal runs of line segments that one rounding window may cover, and their lengths.
+
+    Two consecutive segments are in one run when both are lines of consecutive program
+    blocks (no block between), the break between them is tangential (the shared rule,
+    :func:`reference.core.rules.is_tangential`) and carries no stop, and both blocks
+    agree in group-10 mode, acceleration mode, feed and G0: the blocks of a run are then
+    one straight stretch of the contour that the control can replace in part by a
+    rounding block without anything else changing along it.
+
+    Returns
+    -------
+    run : numpy.ndarray of int, shape (m,)
+        Run index of each segment (non-decreasing).
+    run_length : numpy.ndarray, shape (max(run) + 1,)
+        Length of each run, mm.
+    """
+    blk = path.block
+    line = path.kind == _LINE
+    ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
+    # fixed-width strings compare in C; the object arrays would compare per element
+    mode, accel = attrs["mode"].astype("U8"), attrs["accel"].astype("U8")
+    ok &= mode[blk[:-1]] == mode[blk[1:]]
+    ok &= accel[blk[:-1]] == accel[blk[1:]]
+    ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
+    sel = np.flatnonzero(ok)
+    ok[sel] = is_tangential(path.d[sel], path.d[sel + 1], FEASIBLE)
+    run = np.concatenate(([0], np.cumsum(~ok)))
+    return run, np.bincount(run, weights=path.length)
+
+
+def _across_blocks(path: Path, attrs: dict[str, np.ndarray], a: np.ndarray, b: np.ndarray,
+                   d: np.ndarray, cap: np.ndarray, c: float, sel: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clamp and window ends of corners whose rounding may span several short blocks.
+
+    Model [I] of rounding across short blocks (issue item: "where the documented modes
+    allow rounding across several short blocks"): with G642/G645 the tolerance, not the
+    block, fixes the rounding distance (5.4: ``d`` from MD33100 / SD42465 / CTOL), and
+    the rounding "replaces the area near the original angular transition" (FB1 excerpt,
+    5.1) -- so where the blocks beside the corner are shorter than ``d``, the window
+    runs on into the blocks before and after as long as they continue the same straight
+    line (:func:`_straight_chains`), and those blocks are covered by the rounding block
+    (what the control then interpolates is one rounding block instead of several short
+    ones, so the one-IPO-cycle-per-block cap applies to the rounding's length, 5.3).
+    The clamp "at most half of the participating blocks" (the G644 excerpt) then applies
+    to the straight chain on each side: two windows on one chain never overlap. A window
+    does not pass a non-tangential break: several corners closer together than their
+    windows are rounded one by one, each clamped (a blend over several corners is not
+    modelled).
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray of int, shape (k,)
+        Segments before and after each corner (lines).
+    d : numpy.ndarray, shape (k,)
+        Tangent distance by mode, before any clamp, mm.
+    cap : numpy.ndarray, shape (k,)
+        The one-block clamp ``c min(L_a, L_b)``, mm.
+    c : float
+        The clamp factor (``rounding_length_clamp``).
+    sel : numpy.ndarray of bool, shape (k,)
+        Corners that may reach across blocks.
+
+    Returns
+    -------
+    cap : numpy.ndarray, shape (k,)
+        The clamp, on ``sel`` ``c`` times the shorter straight chain, mm.
+    first, last : numpy.ndarray of int, shape (k,)
+        First and last segment the window ``[S - d', S + d']`` touches (``a`` and ``b``
+        unless it reaches further; ``d' = min(d, cap)``).
+    """
+    first, last = a.copy(), b.copy()
+    run, run_len = _straight_chains(path, attrs)
+    o = np.flatnonzero(sel)
+    wide = np.minimum(c * np.minimum(run_len[run[a[o]]], run_len[run[b[o]]]), d[o])
+    reach = wide > np.minimum(cap[o], d[o])
+    o, wide = o[reach], wide[reach]
+    if o.size == 0:
+        return cap, first, last
+    sb = path.s_breaks
+    corner = sb[a[o] + 1]
+    f = np.maximum(np.searchsorted(sb, corner - wide, side="right") - 1, 0)
+    g = np.minimum(np.searchsorted(sb, corner + wide, side="left") - 1, path.n_segments - 1)
+    # the lines of a chain are tangential (angle <= TANGENT_TOL_RAD), not bit-parallel:
+    # the rounding starts at C - d t1 on the corner's own line, the covered part of the
+    # chain ends at the path point S - d; they differ by at most d max_j |t_j - t_a|
+    # (sum of the covered lengths times their direction errors). Where that could exceed
+    # CHAIN_MEET_MM the window stays within the two blocks (the one-block clamp).
+    err = np.maximum(_max_dir_error(path, f, a[o], a[o]),
+                     _max_dir_error(path, b[o], g, b[o])) * wide
+    good = err <= CHAIN_MEET_MM
+    o, f, g, wide = o[good], f[good], g[good], wide[good]
+    cap = cap.copy()
+    cap[o] = wide
+    first[o], last[o] = f, g
+    return cap, first, last
+
+
+def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
+                   ) -> np.ndarray:
+    """``max_{lo <= j <= hi} |t_j - t_ref|`` per range (segment directions), shape (k,)."""
+    out = np.zeros(lo.size)
+    cnt = hi - lo + 1
+    owner = np.repeat(np.arange(lo.size), cnt)
+    flat = lo[owner] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    np.maximum.at(out, owner, np.linalg.norm(path.d[flat] - path.d[ref[owner]], axis=1))
+    return out
 
 
 def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarray,
-                     inserted: np.ndarray | float, replaced: np.ndarray | float) -> np.ndarray:
-    """Estimated time a corner costs against passing it at the programmed speed, s.
+                     inserted: np.ndarray | float, replaced: np.ndarray | float,
+                     j_path: np.ndarray | float = np.inf,
+                     half: np.ndarray | float = np.inf) -> np.ndarray:
+    """Estimated time to pass a corner and the stretch ``half`` before and after it, s.
 
-    Braking from ``v_p`` to ``v`` and accelerating back at the constant path
-    acceleration ``a`` costs ``(v_p - v)^2 / (a v_p)`` against covering the same
-    distance at ``v_p`` (both sides together); a rounding of length ``l`` that replaces
-    ``2 d`` of the contour and is traversed at ``v`` (a SOFT profile crosses its
-    curvature-jump ends at zero path acceleration, so it stays near ``v`` on it) adds
-    ``l / v - 2 d / v_p``. This is the model's reading of "rounding would slow the
-    program down" (5.2 group 2): an estimate for the decision only; the heuristic then
-    plans whichever contour results exactly. Jerk-limited ramps are not in the estimate.
+    Each side: the speed rises from the corner speed ``v`` over the ``x = half -
+    replaced / 2`` of straight line left beside the corner (or the rounding) to
+    ``v_pk = min(v_p, v + dv_max(x))`` and costs the ramp's duration ``T`` plus the rest
+    of ``x`` at ``v_pk``; a ramp that is symmetric in time covers ``(v_pk + v) T / 2``.
+    ``T = dv / a`` at the constant path acceleration ``a`` (BRISK); with the path jerk
+    ``j`` (SOFT) ``T = dv / a + a / j`` where the ramp reaches ``a`` (``dv >= a^2 / j``),
+    else ``2 sqrt(dv / j)``. ``dv_max(x)`` is the gain over ``x`` from ``v``:
+    ``sqrt(v^2 + a x) - v`` (BRISK over half of ``x``, the other half left for the next
+    corner's braking) and, with jerk, at most ``(x sqrt(j))^(2/3)`` (an S-ramp by ``dv``
+    covers at least ``dv T / 2 = dv^1.5 / sqrt(j)``). A rounding of length ``l`` adds
+    ``l / v`` (a SOFT profile crosses its ends at zero path acceleration, so it stays
+    near ``v`` on it). This is the model's reading of "rounding would slow the program
+    down" (5.2 group 2), also "between two very short blocks": an estimate for the
+    decision only; the heuristic then plans whichever contour results exactly.
 
     Parameters
     ----------
@@ -310,46 +494,186 @@ def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarra
         mm/s, mm/s, mm/s^2.
     inserted, replaced : numpy.ndarray or float
         Rounding length ``l`` and the replaced contour length ``2 d``, mm (0 for G64).
+    j_path : numpy.ndarray or float
+        Path jerk, mm/s^3 (``inf``: no jerk limit, BRISK).
+    half : numpy.ndarray or float
+        Length of the stretch on each side of the corner, mm (``inf``: the programmed
+        speed is reached; the function then returns the classic loss against passing at
+        ``v_p``: ``(v_p - v)^2 / (a v_p)`` for BRISK, plus ``l / v - 2 d / v_p``).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
     """
     v = np.minimum(v_corner, v_prog)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        x = np.maximum(np.asarray(half, dtype=np.float64) - np.asarray(replaced) / 2.0, 0.0)
+        gain = np.minimum(np.sqrt(v * v + a_path * x) - v, np.cbrt((x * x) * j_path))
+        v_pk = np.minimum(v_prog, v + gain)
+        dv = np.maximum(v_pk - v, 0.0)
+        reach = dv * j_path >= a_path * a_path
+        T = np.where(reach, dv / a_path + a_path / j_path, 2.0 * np.sqrt(dv / j_path))
+        T = np.where(dv > 0, T, 0.0)
+        path = np.where(np.asarray(inserted) > 0, np.asarray(inserted) / v, 0.0)
+        finite = np.isfinite(x)
+        # the time beyond covering the stretch at v_pk (for an infinite stretch, at v_p)
+        side = T * dv / (2.0 * np.where(v_pk > 0, v_pk, 1.0))
+        stretch = np.where(finite, 2.0 * (T + np.maximum(x - (v_pk + v) * T / 2.0, 0.0)
+                                          / np.where(v_pk > 0, v_pk, 1.0)),
+                           2.0 * side - np.where(np.isfinite(v_prog),
+                                                 np.asarray(replaced) / v_prog, 0.0))
+    return np.where(v > 0, stretch + path, np.inf)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Shape:
+    """Per corner, the rounding's size (0 where none): ``piece`` the length of each
+    inserted segment, ``length`` of the whole rounding, ``deviation`` from the corner,
+    ``radius`` the smallest radius of curvature, ``kappa`` the largest curvature and
+    ``sharp`` the clothoid's curvature rate (0 on arcs), all shape (k,), mm, 1/mm,
+    1/mm^2."""
+
+    piece: np.ndarray
+    length: np.ndarray
+    deviation: np.ndarray
+    radius: np.ndarray
+    kappa: np.ndarray
+    sharp: np.ndarray
+
+
+def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) -> _Shape:
+    """Size of the rounding of tangent distance ``d`` at each open corner.
+
+    Tangent arc (``reference.core.rounding``): ``R = d / tan(theta/2)``, length
+    ``R theta``, deviation ``d tan(theta/4)``. Clothoid pair
+    (:func:`reference.core.geometry.clothoid_pair_shape`, both pieces of length ``L_s``):
+    ``L_s = d / d_1(theta)``, length ``2 L_s``, deviation ``L_s e_1(theta)``, largest
+    curvature ``theta / L_s`` in the middle, curvature rate ``theta / L_s^2``.
+    """
+    z = np.zeros_like(d)
+    ok = open_ & (d > 0)
+    d_1, e_1 = clothoid_pair_shape(np.where(ok, theta, 1.0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        ramps = np.where(np.isfinite(v_prog), (v_prog - v) ** 2 / (a_path * v_prog), 0.0)
-        path = np.where(np.asarray(inserted) > 0, np.asarray(inserted) / v, 0.0) - np.where(
-            np.isfinite(v_prog), np.asarray(replaced) / v_prog, 0.0)
-    return np.where(v > 0, ramps + path, np.inf)
+        r_arc = d / np.tan(theta / 2.0)
+        piece_c = d / d_1
+        piece = np.where(ok, np.where(g2, piece_c, r_arc * theta), z)
+        length = np.where(g2, 2.0 * piece, piece)
+        deviation = np.where(ok, np.where(g2, piece_c * e_1, d * np.tan(theta / 4.0)), z)
+        kappa = np.where(ok, np.where(g2, theta / piece_c, 1.0 / r_arc), z)
+        radius = np.where(ok, 1.0 / kappa, z)
+        sharp = np.where(ok & g2, theta / (piece_c * piece_c), z)
+    return _Shape(piece, length, deviation, radius, kappa, sharp)
 
 
-def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, radius: np.ndarray,
-                    lim: AxisArrays, t_ipo: float, soft: np.ndarray) -> np.ndarray:
-    """Model speed through tangent-arc roundings (5.8, 6.3, 6.4), mm/s, shape (k,)."""
+def _clothoid_distance(theta: np.ndarray, deviation: np.ndarray) -> np.ndarray:
+    """Tangent distance whose clothoid pair deviates from the corner by ``deviation``:
+    ``d = deviation d_1(theta) / e_1(theta)`` (both scale with the piece length), mm."""
+    d_1, e_1 = clothoid_pair_shape(np.clip(theta, 1e-300, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return deviation * d_1 / e_1
+
+
+def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _Shape,
+                    o: np.ndarray, lim: AxisArrays, t_ipo: float,
+                    soft: np.ndarray) -> np.ndarray:
+    """Model speed through the roundings of corners ``o`` (5.8, 6.3, 6.4), mm/s,
+    shape (k,).
+
+    Centripetal ``sqrt(CENTRIPETAL_SHARE A_i / (rho_i kappa_max))``; one IPO cycle per
+    inserted block (5.3: a piece of length ``l`` is passed at most at ``l / T_ipo``);
+    under SOFT the in-rounding jerk ``rho_i |q3| v^3 <= J_i`` (``q3`` the third path derivative: ``|q3| = kappa^2`` on
+    the arc, at most ``hypot(kappa_max^2, c)`` on a clothoid) and, on the arc only, the
+    curvature-jump rule at both ends (6.3; a clothoid pair starts and ends with zero
+    curvature, as the lines do).
+    """
+    kappa, sharp, piece = shape.kappa[o], shape.sharp[o], shape.piece[o]
+    clo = sharp > 0
     normal = t2 - np.sum(t2 * t1, axis=1)[:, None] * t1
     normal /= np.linalg.norm(normal, axis=1)[:, None]
     rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
+    q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
     with np.errstate(divide="ignore", invalid="ignore"):
         a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
-        v_c = np.where(rho > 0, np.sqrt(a_c * radius[:, None] / np.where(rho > 0, rho, 1.0)),
-                       np.inf).min(axis=1)
-        v_j = np.where(rho > 0, np.cbrt(lim.j_max[None, :] * radius[:, None] ** 2
-                                        / np.where(rho > 0, rho, 1.0)), np.inf).min(axis=1)
-    v_ipo = radius * theta / t_ipo
-    # the curvature vector jumps from 0 to n/R at the start and from the rotated normal
-    # to 0 at the end (same magnitude per axis bounded by rho/R): the shared rule on both
-    k_end = (normal * np.cos(theta)[:, None] - t1 * np.sin(theta)[:, None]) / radius[:, None]
+        w = np.where(rho > 0, rho, 1.0)
+        v_c = np.where(rho > 0, np.sqrt(a_c / (w * kappa[:, None])), np.inf).min(axis=1)
+        v_j = np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
+                                        / (w * q3[:, None])), np.inf).min(axis=1)
+    v_ipo = piece / t_ipo
+    # the arc's curvature vector jumps from 0 to kappa n at the start and from the
+    # rotated normal to 0 at the end (same magnitude per axis bounded by rho kappa)
+    k_end = (normal * np.cos(theta)[:, None] - t1 * np.sin(theta)[:, None]) * kappa[:, None]
     zero = np.zeros_like(t1)
     v_k = np.minimum(
-        curvature_jump_speed_cap(zero, normal / radius[:, None], lim.path_trans_jerk, t_ipo),
+        curvature_jump_speed_cap(zero, normal * kappa[:, None], lim.path_trans_jerk, t_ipo),
         curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
+    v_k = np.where(clo, np.inf, v_k)
     out = np.minimum(v_c, v_ipo)
     return np.where(soft, np.minimum(out, np.minimum(v_j, v_k)), out)
 
 
+def _inserted_rows(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.ndarray,
+                   g2: np.ndarray, piece: np.ndarray, block: np.ndarray
+                   ) -> dict[str, np.ndarray]:
+    """Packed rows of the inserted roundings in corner order: one tangent arc
+    (:func:`reference.core.rounding.fillet_pieces`) or the two pieces of a clothoid
+    pair (:func:`reference.core.geometry.clothoid_pieces`) per corner."""
+    arcs = fillet_pieces(corner, t1, t2, d, block, _ROUNDING)
+    arcs["sharpness"] = np.zeros(d.size)
+    if not g2.any():
+        return arcs
+    c = np.flatnonzero(g2)
+    pairs = clothoid_pieces(corner[c] - d[c, None] * t1[c], t1[c], t2[c], piece[c],
+                            block[c], _ROUNDING)
+    # interleave: corner order, one row per arc, two per pair
+    n_rows = np.where(g2, 2, 1)
+    start = np.concatenate(([0], np.cumsum(n_rows)[:-1]))
+    arc_rows = start[~g2]
+    pair_rows = np.concatenate((start[c], start[c] + 1))
+    pair_src = np.concatenate((np.arange(0, 2 * c.size, 2), np.arange(1, 2 * c.size, 2)))
+    out = {}
+    total = int(n_rows.sum())
+    for key, val in arcs.items():
+        arr = np.zeros((total,) + val.shape[1:], dtype=val.dtype)
+        arr[arc_rows] = val[~g2]
+        arr[pair_rows] = pairs[key][pair_src]
+        out[key] = arr
+    return out
+
+
+def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Length cut from the start and from the end of every segment by the windows
+    ``[S_c - d, S_c + d]`` around the corners at the ends of segments ``a``, mm, shape (m,)
+    each (at most the segment's length each; a covered segment gets its whole length).
+
+    Windows are disjoint (each is at most half of the straight chain on either side) and
+    contain their corner, so a segment is cut at its start only by the window of the
+    corner before it and at its end only by the window of the corner after it. The cut is
+    ``d - (distance from the corner)``, which is exactly ``d`` at the corner's own two
+    segments (the one-block case keeps its exact trims).
+    """
+    sb = path.s_breaks
+    s0, s1 = sb[:-1], sb[1:]
+    corner = sb[a + 1]
+    trim_start = np.zeros(path.n_segments)
+    trim_end = np.zeros(path.n_segments)
+    # window whose corner is at or before the segment's start, and whose reach covers it
+    i = np.searchsorted(corner, s0, side="right") - 1
+    hit = i >= 0
+    reach = np.where(hit, d[np.maximum(i, 0)] - (s0 - corner[np.maximum(i, 0)]), 0.0)
+    trim_start = np.where(hit & (reach > 0), np.minimum(reach, path.length), 0.0)
+    # window whose corner is at or after the segment's end
+    i = np.searchsorted(corner, s1, side="left")
+    hit = i < corner.size
+    ic = np.minimum(i, corner.size - 1)
+    reach = np.where(hit, d[ic] - (corner[ic] - s1), 0.0)
+    trim_end = np.where(hit & (reach > 0), np.minimum(reach, path.length), 0.0)
+    return trim_start, trim_end
+
+
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
-              table: RoundingTable) -> Path:
-    """The rounded path: lines shortened, arcs inserted after segments ``a``, spans moved.
+              g2: np.ndarray, piece: np.ndarray, table: RoundingTable) -> Path:
+    """The rounded path: lines shortened, roundings inserted after segments ``a``
+    (a tangent arc, or the two pieces of a clothoid pair), spans moved.
 
     Parameters
     ----------
@@ -359,27 +683,33 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         Tangent distances, mm.
     t1, t2 : numpy.ndarray, shape (r, n)
         Unit directions of the lines before and after.
+    g2 : numpy.ndarray of bool, shape (r,)
+        Clothoid pair (else tangent arc).
+    piece : numpy.ndarray, shape (r,)
+        Length of each clothoid piece, mm (used where ``g2``).
     """
     m = path.n_segments
-    trim_start = np.zeros(m)
-    trim_end = np.zeros(m)
-    trim_end[a] = d
-    trim_start[a + 1] = d
+    trim_start, trim_end = _window_trims(path, a, d)
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
-    # meet tangentially and the line is dropped
+    # meet tangentially and the line is dropped; a line inside a window that reaches
+    # across short blocks (:func:`_across_blocks`) is covered whole and dropped too
     keep = length > MIN_SEGMENT_LENGTH_MM
     has_arc = np.zeros(m, bool)
     has_arc[a] = True
-    count = keep.astype(np.int64) + has_arc
+    n_ins = np.zeros(m, dtype=np.int64)
+    n_ins[a] = np.where(g2, 2, 1)
+    count = keep.astype(np.int64) + n_ins
     first = np.concatenate(([0], np.cumsum(count)))          # new index of old seg's pieces
     total = int(first[-1])
     n = path.n_axes
     corner = path.origin[a] + path.d[a] * path.length[a][:, None]
-    arcs = fillet_pieces(corner, t1, t2, d, path.block[a], _ROUNDING)
-
+    arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
+    # rows of the inserted segments: after the kept part of segment a, one or two each
+    base = first[:-1][a] + keep[a]
+    arc_pos = np.concatenate([base[i:i + 1] + np.arange(k) for i, k in
+                              enumerate(n_ins[a].tolist())]) if a.size else base
     line_pos = first[:-1][keep]
-    arc_pos = first[:-1][has_arc] + keep[has_arc]
     new = {}
     for key in ("origin", "e1", "e2", "d"):
         arr = np.zeros((total, n))
@@ -391,37 +721,46 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     new["origin"][line_pos] += path.d[keep] * trim_start[keep][:, None]
     for key, dtype in (("radius", np.float64), ("omega", np.float64),
                        ("theta0", np.float64), ("length", np.float64),
-                       ("block", np.int64), ("kind", np.int8), ("dradius", np.float64)):
+                       ("block", np.int64), ("kind", np.int8), ("dradius", np.float64),
+                       ("sharpness", np.float64)):
         arr = np.zeros(total, dtype=dtype)
         src = length if key == "length" else getattr(path, key)
         arr[line_pos] = src[keep]
         arr[arc_pos] = arcs[key]
         new[key] = arr
+    per = np.repeat(np.arange(a.size), np.where(g2, 2, 1))  # corner of each inserted row
     feed = np.zeros(total)
     feed[line_pos] = path.feed[keep]
-    feed[arc_pos] = np.minimum(path.feed[a], path.feed[a + 1])
+    feed[arc_pos] = np.minimum(path.feed[a], path.feed[a + 1])[per]
     rapid = np.zeros(total, bool)
     rapid[line_pos] = path.rapid[keep]
-    rapid[arc_pos] = path.rapid[a] & path.rapid[a + 1]
+    rapid[arc_pos] = (path.rapid[a] & path.rapid[a + 1])[per]
     # breaks: old break k (k = 0..m) is new break first[k]; the new interior breaks
     # (line -> rounding -> line) carry no stop (a corner with a stop is never rounded)
     reasons = [""] * (total + 1)
+    stop = np.zeros(total + 1, dtype=bool)
     for k in np.flatnonzero(path.stop):
         reasons[int(first[k])] = path.stop_reason[k]
+        stop[int(first[k])] = True
     sb = np.concatenate(([0.0], np.cumsum(new["length"])))
     # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
-    j0 = np.array([sp.first_segment for sp in path.blocks], dtype=np.int64)
-    j1 = j0 + np.array([sp.n_segments for sp in path.blocks], dtype=np.int64)
+    j0 = np.fromiter((sp.first_segment for sp in path.blocks), np.int64, len(path.blocks))
+    j1 = j0 + np.fromiter((sp.n_segments for sp in path.blocks), np.int64, len(path.blocks))
     f, e = first[j0], first[j1]
-    # positional arguments: 10^5 spans, and keywords cost a third more
-    spans = [BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi,
-                       sp.feed_mm_s, sp.stop_reason, sp.dwell_s)
-             for sp, s0, s1, fi, ei in zip(path.blocks, sb[f].tolist(), sb[e].tolist(),
-                                           f.tolist(), e.tolist())]
+    # spans that end before the first segment a window touches keep their segments,
+    # indices and positions (same objects); the others move (positional arguments:
+    # 10^5 spans, and keywords cost a third more)
+    touched = np.flatnonzero((trim_start > 0) | (trim_end > 0) | has_arc | ~keep)
+    n_same = int(np.searchsorted(j1, touched[0], side="right")) if touched.size else len(j0)
+    spans = list(path.blocks[:n_same]) + [
+        BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi, sp.feed_mm_s,
+                  sp.stop_reason, sp.dwell_s)
+        for sp, s0, s1, fi, ei in zip(path.blocks[n_same:], sb[f[n_same:]].tolist(),
+                                      sb[e[n_same:]].tolist(), f[n_same:].tolist(),
+                                      e[n_same:].tolist())]
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
-                rapid=rapid, stop=np.array([bool(r) for r in reasons]),
-                stop_reason=tuple(reasons), blocks=tuple(spans), source=path.source,
-                rounding=table, **new)
+                rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=tuple(spans),
+                source=path.source, rounding=table, **new)
 
 
 __all__ = ["ROUNDING_MODES", "corner_time_loss", "round_corners"]

@@ -41,7 +41,8 @@ from reference.nc.program import Program
 from reference.prepare import build_path, prepare, restrict_to_machine
 
 from .. import engines
-from ..comparison import Comparison, Side, block_span, compare_profiles, oracle_result
+from ..comparison import (Comparison, Side, block_span, compare_profiles, oracle_result,
+                          programmed_contour)
 from ..export import comparison_dict
 from ..text import print_comparison
 from .projection import Projection, project
@@ -272,7 +273,8 @@ def check_recorded(file: str | FsPath, program: Program, machine: Machine, *,
     c = compare_profiles(path, limits, Side("recorded", prof, bound_set,
                                             ratio_tol=tol, steps=STEPS_SPREAD),
                          oracle_result(sol), program=program.file, machine=machine.name,
-                         program_lines=tuple(program.lines), notes=notes)
+                         program_lines=tuple(program.lines), notes=notes,
+                         programmed=programmed_contour(program, limits))
     max_dev = max_deviation if max_deviation is not None else max(
         DEFAULT_MAX_DEVIATION_MM, 5 * sigma)
     return CheckResult(recording=rec, projection=proj, noise_mm=sigma,

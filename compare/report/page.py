@@ -413,9 +413,12 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
                    "axis) is the accumulated gap: its steep parts are where the total "
                    "time is lost.", "gaps")
     tool = _figure(plot_toolpath(c, worst), "tool path",
-                   "The path both planners run on, in its main plane: inserted blocks "
-                   "orange, the blocks with the largest gaps violet (with the time they "
-                   "lose), required stops as squares.", "path")
+                   "The path both planners run on (dark), in its main plane, over the "
+                   "programmed contour (light blue: the program's lines and arcs before "
+                   "tool radius compensation and corner rounding, visible where the "
+                   "planned path leaves it): inserted blocks orange, the blocks with the "
+                   "largest gaps violet (with the time they lose), required stops as "
+                   "squares.", "path")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">

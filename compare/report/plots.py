@@ -330,8 +330,9 @@ def plot_gaps(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -> st
             ax.set_xlabel("block (source line), in program order")
         else:
             ax.xaxis.set_major_locator(MaxNLocator(nbins=12, integer=True))
-            ax.set_xlabel(f"block in execution order (1 … {n}; loops repeat lines, so "
-                          "only the worst blocks are labelled with their source line)")
+            ax.set_xlabel(f"block in execution order (1 … {n}; loops and inserted blocks "
+                          "repeat lines, so only the worst blocks are labelled with their "
+                          "source line)")
             y0, y1 = ax.get_ylim()            # room for the labels above the spikes
             ax.set_ylim(y0, y1 + 0.12 * (y1 - y0))
             pos = {id(r): k for k, r in enumerate(rows)}
@@ -369,8 +370,22 @@ def _plane(c: Comparison, q: np.ndarray) -> tuple[int, int]:
     return tuple(sorted(best))  # type: ignore[return-value]
 
 
+def _path_points(path) -> tuple[np.ndarray, np.ndarray]:
+    """Points along every segment (2 per line, arcs every 0.05 mm, 8..400 per arc) and
+    the segment of each point: ``q`` shape (N, n), ``seg`` shape (N,)."""
+    n_pts = np.where(path.radius == 0, 2, np.clip(
+        np.ceil(np.abs(path.omega) * path.length / 0.05).astype(np.int64), 8, 400))
+    seg = np.repeat(np.arange(path.n_segments), n_pts)
+    first = np.concatenate(([0], np.cumsum(n_pts)[:-1]))
+    frac = (np.arange(seg.size) - first[seg]) / (n_pts[seg] - 1)
+    s = path.s_breaks[seg] + frac * path.length[seg]
+    return path.evaluate(s, segment=seg)[0], seg
+
+
 def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -> str:
-    """The tool path in its main plane with inserted and worst blocks marked (SVG URI)."""
+    """The tool path in its main plane (SVG URI): the programmed contour (before tool
+    radius compensation and rounding, ``c.programmed``) under the planned path both
+    planners run on, with inserted and worst blocks marked."""
     fig = Figure(figsize=(11, 6.0))
     ax = fig.add_subplot()
     path = c.path
@@ -380,22 +395,34 @@ def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -
     qs = path.evaluate(np.linspace(0, path.total_length, 500))[0]
     i, j = _plane(c, qs)
     worst_rows = c.worst_blocks(N_WORST) if worst is None else worst
-    worst = {r.block for r in worst_rows}
+    # the segments of each worst row, by its stretch of the path (an inserted block's row
+    # and its corner block's row share the block index)
+    mid_seg = 0.5 * (path.s_breaks[:-1] + path.s_breaks[1:])
+    in_worst = np.zeros(path.n_segments, bool)
+    row_segs = []
+    for r in worst_rows:
+        sel = np.flatnonzero((mid_seg > r.s_start) & (mid_seg < r.s_start + r.length_mm))
+        in_worst[sel] = True
+        row_segs.append(sel)
     # points of every segment (arcs finely), NaN-separated per drawing style
-    n_pts = np.where(path.radius == 0, 2, np.clip(
-        np.ceil(np.abs(path.omega) * path.length / 0.05).astype(np.int64), 8, 400))
-    raster = int(n_pts.sum()) > MAX_VECTOR_POINTS
-    seg = np.repeat(np.arange(path.n_segments), n_pts)
-    first = np.concatenate(([0], np.cumsum(n_pts)[:-1]))
-    frac = (np.arange(seg.size) - first[seg]) / (n_pts[seg] - 1)
-    s = path.s_breaks[seg] + frac * path.length[seg]
-    q = path.evaluate(s, segment=seg)[0]
+    q, seg = _path_points(path)
+    prog = c.programmed
+    if prog is not None and (prog.n_segments == 0 or prog.axes != path.axes):
+        prog = None
+    q_prog = _path_points(prog)[0] if prog is not None else None
+    raster = seg.size + (0 if q_prog is None else q_prog.shape[0]) > MAX_VECTOR_POINTS
     kinds = np.array([KIND_CODES[int(k)] for k in path.kind])
-    style_of = np.where(np.isin(path.block, list(worst)), "worst",
+    style_of = np.where(in_worst, "worst",
                         np.where(np.isin(kinds, INSERTED_KINDS), "inserted",
                                  np.where(path.rapid, "rapid", "program")))
+    if q_prog is not None:
+        # drawn first, under the planned path: where the two coincide only the planned
+        # path shows; at a rounded corner the programmed corner stands out beside it
+        ax.plot(q_prog[:, i], q_prog[:, j], color="#8fb3d9", lw=3.2 if not raster else 1.6,
+                zorder=1, solid_capstyle="round", rasterized=raster,
+                label="programmed contour (before compensation and rounding)")
     styles = {"program": dict(color="#2b3440", lw=1.1 if not raster else 0.6, zorder=2,
-                              label="programmed (G1/G2/G3)"),
+                              label="planned path (G1/G2/G3)"),
               "rapid": dict(color="#9aa0a8", lw=1.0, ls="--", zorder=2, label="rapid (G0)"),
               "inserted": dict(color=C_INS, lw=2.2 if not raster else 1.2, zorder=3,
                                label="inserted blocks (rounding, TRC)"),
@@ -411,8 +438,7 @@ def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -
         brk = np.flatnonzero(np.diff(seg[pts]) > 1) + 1
         x, y = np.insert(x, brk, np.nan), np.insert(y, brk, np.nan)
         ax.plot(x, y, rasterized=raster and name != "worst", **style)
-    for r in worst_rows:
-        segs = np.flatnonzero(path.block == r.block)
+    for r, segs in zip(worst_rows, row_segs):
         if segs.size == 0:
             continue
         mid = path.evaluate(path.s_breaks[segs[0]] + 0.5 * path.length[segs[0]])[0][0]
@@ -435,4 +461,73 @@ def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -
     ax.grid(alpha=0.3)
     # "best" scans every drawn point for a free spot: seconds at 10^6 points
     ax.legend(loc="upper right" if raster else "best", fontsize=8, framealpha=0.9)
+    if q_prog is not None:
+        _corner_inset(fig, ax, c, q, seg, q_prog, i, j, style_of, styles)
     return svg_uri(fig)
+
+
+def _corner_inset(fig, ax, c: Comparison, q: np.ndarray, seg: np.ndarray,
+                  q_prog: np.ndarray, i: int, j: int, style_of: np.ndarray,
+                  styles: dict) -> None:
+    """A zoom on the rounded corner whose rounding lies farthest from the programmed
+    corner (relative to the plot's size), so the rounding is visible beside the
+    programmed corner even where it is far below the plot's resolution."""
+    table = c.path.rounding
+    if table is None or not table.inserted.any():
+        return
+    k = int(np.flatnonzero(table.inserted)[np.argmax(table.deviation_mm[table.inserted])])
+    rnd = np.flatnonzero(c.path.kind == KIND_CODES.index("rounding"))
+    # the rounding segment of that corner: the one attributed to its block
+    own = rnd[c.path.block[rnd] == table.block[k]]
+    if own.size == 0:
+        return
+    r = int(own[0])
+    a, b = c.path.segment(r).start, c.path.segment(r).end
+    half = 1.6 * max(table.distance_mm[k], 1e-6)
+    centre = 0.5 * (a + b)
+    x0, x1 = centre[i] - half, centre[i] + half
+    y0, y1 = centre[j] - half, centre[j] + half
+    span = max(np.ptp(q[:, i]), np.ptp(q[:, j]), 1e-12)
+    if half / span > 0.05:             # visible in the main plot already
+        return
+    sub = fig.add_axes([0.70, 0.14, 0.2, 0.3])
+
+    def near(pts: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        """Points of the pieces whose bounding box meets the zoom window (a line has
+        only its two end points: the axes clip it)."""
+        cut = np.flatnonzero(np.diff(owner)) + 1
+        starts = np.concatenate(([0], cut))
+        lo_x, hi_x = (np.minimum.reduceat(pts[:, i], starts),
+                      np.maximum.reduceat(pts[:, i], starts))
+        lo_y, hi_y = (np.minimum.reduceat(pts[:, j], starts),
+                      np.maximum.reduceat(pts[:, j], starts))
+        hit = (hi_x >= x0) & (lo_x <= x1) & (hi_y >= y0) & (lo_y <= y1)
+        return np.repeat(hit, np.diff(np.concatenate((starts, [owner.size]))))
+
+    def draw(pts: np.ndarray, owner: np.ndarray, keep: np.ndarray, **style) -> None:
+        sel = np.flatnonzero(keep)
+        if sel.size == 0:
+            return
+        x, y = pts[sel, i], pts[sel, j]
+        brk = np.flatnonzero(np.diff(owner[sel]) != 0) + 1
+        sub.plot(np.insert(x, brk, np.nan), np.insert(y, brk, np.nan), **style)
+
+    prog_owner = _path_points(c.programmed)[1]
+    draw(q_prog, prog_owner, near(q_prog, prog_owner), color="#8fb3d9", lw=3.2, zorder=1)
+    close = near(q, seg)
+    for name in ("program", "rapid", "inserted", "worst"):
+        st = {key: v for key, v in styles[name].items() if key != "label"}
+        draw(q, seg, close & np.isin(seg, np.flatnonzero(style_of == name)), **st)
+    sub.set_xlim(x0, x1)
+    sub.set_ylim(y0, y1)
+    sub.set_aspect("equal", adjustable="box")
+    sub.tick_params(labelsize=6)
+    sub.set_title(f"corner {c_line(c, int(table.block[k]))}/"
+                  f"{c_line(c, int(table.next_block[k]))}: {table.mode[k]}, deviation "
+                  f"{table.deviation_mm[k]:.3g} mm", fontsize=7)
+    ax.indicate_inset_zoom(sub, edgecolor="#555")
+
+
+def c_line(c: Comparison, block: int) -> int:
+    """Source line of a program block (0 if unknown)."""
+    return next((sp.line for sp in c.path.blocks if sp.block == block), 0)

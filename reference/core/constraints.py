@@ -77,9 +77,10 @@ one segment (lines, arcs, helices).
 * **Lines** (``q' = d`` constant, ``q'' = q''' = 0``): axis velocity, acceleration and
   jerk are ``|d_i|`` times polynomials of degree 2, 1, 0 in ``tau``; their maxima are
   taken exactly at the interval ends and the stationary point of ``v`` (``s''= 0``).
-* **Arcs and helices**: dense samples, uniform in time, at an angular step of at most
+* **Arcs, helices and clothoids**: dense samples, uniform in time, at an angular step of
+  at most
   :data:`ARC_SAMPLE_STEP_RAD` (0.125 deg) *at the interval's peak speed* (so also where
-  the motion is fastest; on a spiral at its largest angular rate
+  the motion is fastest; on a spiral or clothoid at its largest angular rate
   :attr:`~reference.core.geometry.PlaneAmplitudes.omega_max`), at least
   :data:`MIN_ARC_SAMPLES` per sub-interval, plus the stationary point of ``v``. A maximum of a cos-type function sampled at step
   ``dphi`` is missed by at most ``1 - cos(dphi/2) <= dphi^2/8`` of its amplitude:
@@ -87,6 +88,14 @@ one segment (lines, arcs, helices).
   is at most ``sup|g''| dtau^2 / 8`` for a quantity ``g(tau)`` sampled at time step
   ``dtau``; on arcs ``g''`` is dominated by ``(omega v)^2 g``, which gives the bound
   above, plus terms from the time variation of ``s''`` and ``v`` inside the interval.
+  On circles and helices the samples at that step are taken only where they can
+  matter: a first pass samples at :data:`ARC_COARSE_FACTOR` times the step, and a
+  coarse step is sampled finely only where its end values plus ``B D^2/8`` could exceed
+  the largest value sampled on the interval (``D`` the coarse step, ``B`` a rigorous
+  bound on the quantity's second time derivative inside the interval, from the
+  circle's derivative amplitudes and the interval's largest speed, path acceleration
+  and path jerk: :func:`_arc_curvature_bounds`). A step left coarse cannot hold a
+  larger value, so the bound above holds unchanged.
   After sampling, the worst sample of each interval and quantity is refined once by
   the vertex of the parabola through it and its neighbours, evaluated exactly; this
   can only raise the maximum found and, for smooth maxima, brings the deficit to order
@@ -111,7 +120,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .errors import ProfileError
-from .geometry import Path, plane_amplitudes
+from .geometry import Path, clothoid_derivative_norms, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
 from .profile import Profile
 from .rules import (STEPS_AT_BREAKS, STEPS_SPREAD, axis_acceleration, axis_jerk,
@@ -143,6 +152,14 @@ UNITS: Mapping[str, str] = MappingProxyType({
 #: Largest angular step between samples on arcs and helices, rad. 0.125 deg misses a
 #: cos-type peak by at most (step)^2/8 = 5.9e-7 of its amplitude, below RATIO_TOL.
 ARC_SAMPLE_STEP_RAD = float(np.deg2rad(0.125))
+
+#: On circles and helices the first pass samples at this many times the fine step
+#: (:data:`ARC_SAMPLE_STEP_RAD`), and only the coarse steps that may hold a larger value,
+#: by a bound on the second derivative, are sampled at the fine step (:func:`_check_arcs`).
+#: 8 (1 deg): at a cos-like peak the chord bound exceeds the peak by a few (1 deg)^2/8,
+#: so one or two coarse steps per peak are refined; a larger factor refines more of each
+#: step it keeps, a smaller one samples more coarsely everywhere.
+ARC_COARSE_FACTOR = 8
 
 #: Fewest uniform samples per sub-interval on an arc: keeps the time polynomials of
 #: short, slow intervals resolved even when they sweep almost no angle.
@@ -595,10 +612,71 @@ def _axis_kinematics(ctx: _Ctx, k: np.ndarray, tau: np.ndarray):
     return vel, acc, jer, s, p.t[k] + tau
 
 
+def _arc_curvature_bounds(ctx: _Ctx, k: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Bounds on the second time derivative of the axis velocity, acceleration and jerk
+    inside intervals ``k`` on circles and helices, shape (len(k), n) each (mm/s^3,
+    mm/s^4, mm/s^5).
+
+    On a circle or helix of radius ``r`` and angular rate ``w`` (rad/mm) the in-plane
+    part of the m-th path derivative of axis ``i`` has the amplitude ``rho_i r |w|^m``
+    (``rho_i`` the axis' plane weight), and the helix adds the constant ``d_i`` to the
+    first derivative only; on a clothoid the in-plane norms are bounded by
+    :func:`reference.core.geometry.clothoid_derivative_norms` (an axis' share of a plane
+    vector is at most ``rho_i`` times its norm). With ``V``, ``A``, ``J`` the largest ``|v|``, path
+    acceleration ``|a|`` and path jerk ``|j|`` on the interval (``j`` is constant in an
+    interval, so its time derivative is 0), differentiating the axis velocity
+    ``q1 v``, acceleration ``q1 a + q2 v^2`` and jerk ``q1 j + 3 q2 v a + q3 v^3``
+    (``qm`` the m-th path derivative of the axis) twice in time gives::
+
+        vel''  = q3 v^3 + 3 q2 v a + q1 j
+        acc''  = q4 v^4 + 6 q3 v^2 a + 3 q2 a^2 + 4 q2 v j
+        jerk'' = q5 v^5 + 10 q4 v^3 a + 15 q3 v a^2 + 10 q3 v^2 j + 10 q2 a j
+
+    and the bounds are these with every factor replaced by its bound.
+    """
+    path, p = ctx.path, ctx.prof
+    seg = ctx.seg[k]
+    h = ctx.h[k]
+    V = _speed_peak(ctx, k)[0]
+    A = np.maximum(np.abs(p.a[k]), np.abs(p.a[k] + p.j[k] * h))
+    J = np.abs(p.j[k])
+    r, w = path.radius[seg], np.abs(path.omega[seg])
+    rho = np.sqrt(path.e1[seg] ** 2 + path.e2[seg] ** 2)           # (N, n)
+    # norms of the in-plane parts of q', ..., q^(5): r |w|^m on circles
+    norms = [r * w ** m for m in range(1, 6)]
+    cl = np.flatnonzero(path.sharpness[seg])
+    if cl.size:
+        for m, val in enumerate(clothoid_derivative_norms(
+                np.abs(path.sharpness[seg[cl]]), path.length[seg[cl]])):
+            norms[m][cl] = val
+    a1 = np.abs(path.d[seg]) + rho * norms[0][:, None]
+    a2, a3, a4, a5 = (rho * nm[:, None] for nm in norms[1:])
+    V, A, J = V[:, None], A[:, None], J[:, None]
+    b_vel = a3 * V ** 3 + 3 * a2 * V * A + a1 * J
+    b_acc = a4 * V ** 4 + 6 * a3 * V ** 2 * A + 3 * a2 * A ** 2 + 4 * a2 * V * J
+    b_jerk = (a5 * V ** 5 + 10 * a4 * V ** 3 * A + 15 * a3 * V * A ** 2
+              + 10 * a3 * V ** 2 * J + 10 * a2 * A * J)
+    return b_vel, b_acc, b_jerk
+
+
 def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
                 worst: dict[str, _Worst], frac0: np.ndarray | None = None,
                 frac1: np.ndarray | None = None) -> None:
     """Dense samples on arcs/helices, then one parabolic refinement per interval.
+
+    ``n_uni`` is the number of uniform samples that meets :data:`ARC_SAMPLE_STEP_RAD`
+    (the fine step). On circles and helices the fine step is taken only where it can
+    matter: the interval is first sampled at :data:`ARC_COARSE_FACTOR` times that step,
+    and a coarse step of width ``D`` between samples ``a`` and ``b`` is sampled at the
+    fine step only when, for some axis and quantity ``g``,
+    ``max(g(a), g(b)) + B D^2 / 8`` exceeds the largest ``g`` sampled on the interval
+    (``B`` bounds ``|g''|`` there, :func:`_arc_curvature_bounds`; a function with
+    ``|g''| <= B`` exceeds the chord between two of its points by at most
+    ``B D^2 / 8``). A step left coarse therefore holds no larger value than one already
+    found, and each interval's maxima are those of the fine sampling or larger (all
+    values exact): the documented deficit bound holds unchanged. Circles, helices and clothoids
+    are pruned so; spirals are sampled at
+    the fine step throughout.
 
     ``frac0, frac1`` (default 0 and 1) restrict each row to the time piece
     ``[frac0 h, frac1 h]`` of its interval (a long interval checked in pieces).
@@ -609,43 +687,85 @@ def _check_arcs(ctx: _Ctx, k: np.ndarray, n_uni: np.ndarray,
     t0 = np.zeros(ni) if frac0 is None else frac0 * h_full
     t1 = h_full if frac1 is None else frac1 * h_full
     h = t1 - t0
-    # uniform samples, contiguous per interval
-    first = np.concatenate(([0], np.cumsum(n_uni)[:-1]))
-    row_iv = np.repeat(np.arange(ni), n_uni)
-    pos = np.arange(row_iv.size) - first[row_iv]
-    dtau = h / (n_uni - 1)
-    tau_u = np.minimum(t0[row_iv] + pos * dtau[row_iv], t1[row_iv])
+    circ = path.dradius[ctx.seg[k]] == 0
+    n_c = np.where(circ, np.maximum(MIN_ARC_SAMPLES,
+                                    -(-(n_uni - 1) // ARC_COARSE_FACTOR) + 1), n_uni)
+    n_c = np.minimum(n_c, n_uni)
+    # coarse samples (the fine ones on spirals), contiguous per interval
+    first = np.concatenate(([0], np.cumsum(n_c)[:-1]))
+    row_c = np.repeat(np.arange(ni), n_c)
+    pos = np.arange(row_c.size) - first[row_c]
+    dtau_c = h / (n_c - 1)
+    tau_c = np.minimum(t0[row_c] + pos * dtau_c[row_c], t1[row_c])
     _, _, ts = _speed_peak(ctx, k)
-    iv = np.concatenate((row_iv, np.arange(ni)))
-    tau = np.concatenate((tau_u, ts))
-    kin = _axis_kinematics(ctx, k[iv], tau)
-    s, t = kin[3], kin[4]
-    blk = path.block[ctx.seg[k[iv]]]
     limits = (lim.v_max, lim.a_max, lim.j_max)
     names = ("velocity", "acceleration", "jerk")
-    ref_iv, ref_tau = [], []
-    nu = row_iv.size
-    for name, val, lim_i in zip(names, kin[:3], limits):
+    kin = _axis_kinematics(ctx, k[np.concatenate((row_c, np.arange(ni)))],
+                           np.concatenate((tau_c, ts)))
+    nc = row_c.size
+    # coarse steps that may hide a larger value: sampled at the fine step
+    need = np.zeros(nc, bool)               # the step from sample p to p + 1
+    step = np.flatnonzero(np.diff(row_c) == 0)
+    if circ.any() and step.size:
+        bounds = _arc_curvature_bounds(ctx, k)
+        rs = row_c[step]
+        for val, b, lim_i in zip(kin[:3], bounds, limits):
+            r = val / lim_i
+            top = r.max(axis=1)
+            thr = np.maximum(np.maximum.reduceat(top[:nc], first), top[nc:])
+            ub = (np.maximum(r[step], r[step + 1])
+                  + (b[rs] / lim_i) * (dtau_c[rs] ** 2 / 8.0)[:, None])
+            need[step] |= circ[rs] & np.any(ub > thr[rs][:, None], axis=1)
+    fine = np.flatnonzero(need)
+    rf = row_c[fine]
+    # as many parts as make each part no longer than the fine step
+    parts = np.maximum(np.ceil(dtau_c[rf] * (n_uni[rf] - 1) / h[rf]
+                               * (1.0 - 1e-12)).astype(np.int64), 1)
+    cnt = parts - 1
+    owner = np.repeat(np.arange(fine.size), cnt)
+    m = np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1
+    tau_f = tau_c[fine[owner]] + m * (dtau_c[rf[owner]] / parts[owner])
+    row_f = rf[owner]
+    kin_f = _axis_kinematics(ctx, k[row_f], tau_f)
+    # every sample of each interval in time order, then the stationary points
+    rows = np.concatenate((row_c, row_f))
+    taus = np.concatenate((tau_c, tau_f))
+    order = np.lexsort((taus, rows))
+    nu = order.size
+    rows, taus = rows[order], taus[order]
+    counts = np.bincount(rows, minlength=ni)
+    first_u = np.concatenate(([0], np.cumsum(counts)[:-1]))
+
+    def merged(i: int) -> np.ndarray:
+        return np.concatenate((np.concatenate((kin[i][:nc], kin_f[i]))[order], kin[i][nc:]))
+
+    s_all, t_all = merged(3), merged(4)
+    blk = path.block[ctx.seg[k[np.concatenate((rows, np.arange(ni)))]]]
+    ref_tau = []
+    for q, (name, lim_i) in enumerate(zip(names, limits)):
+        val = merged(q)
         ratio = val / lim_i
-        worst[name].update(ratio, val, lim_i, s, t, blk, axes)
-        # refinement: worst uniform sample of each interval, parabola through neighbours
+        worst[name].update(ratio, val, lim_i, s_all, t_all, blk, axes)
+        # refinement: worst sample of each interval, parabola through its neighbours
         r_u = ratio[:nu]
         flat = r_u.max(axis=1)
         col = r_u.argmax(axis=1)
-        mx = np.maximum.reduceat(flat, first)
-        hit = np.flatnonzero(flat == mx[row_iv])
-        _, firsthit = np.unique(row_iv[hit], return_index=True)
+        mx = np.maximum.reduceat(flat, first_u)
+        hit = np.flatnonzero(flat == mx[rows])
+        _, firsthit = np.unique(rows[hit], return_index=True)
         p = hit[firsthit]                                     # one row per interval
-        c = np.clip(p, first + 1, first + n_uni - 2)          # centre with two neighbours
+        c = np.clip(p, first_u + 1, first_u + counts - 2)     # centre with two neighbours
         cc = col[p]
+        xm, x0, xp = taus[c - 1], taus[c], taus[c + 1]
         ym, y0, yp = r_u[c - 1, cc], r_u[c, cc], r_u[c + 1, cc]
-        den = ym - 2 * y0 + yp
+        # vertex of the parabola through the three points (spacing may differ)
+        dm, dp = x0 - xm, xp - x0
+        den = dm * (y0 - yp) + dp * (y0 - ym)
         with np.errstate(divide="ignore", invalid="ignore"):
-            off = np.where(den < 0, 0.5 * (ym - yp) / den, 0.0)
-        off = np.clip(off, -1.0, 1.0)
-        ref_iv.append(np.arange(ni))
-        ref_tau.append(np.clip(tau_u[c] + off * dtau, t0, t1))
-    riv = np.concatenate(ref_iv)
+            off = np.where(den > 0, 0.5 * (dp * dp * (y0 - ym) - dm * dm * (y0 - yp)) / den,
+                           0.0)
+        ref_tau.append(np.clip(x0 + off, np.maximum(xm, t0), np.minimum(xp, t1)))
+    riv = np.tile(np.arange(ni), len(names))
     rk = _axis_kinematics(ctx, k[riv], np.concatenate(ref_tau))
     rblk = path.block[ctx.seg[k[riv]]]
     for name, val, lim_i in zip(names, rk[:3], limits):

@@ -26,6 +26,26 @@ as ``d s``. Its in-plane part has the constant speed ``g = |dp/ds|`` (``g^2 + |d
 ``|omega| length`` is still the swept angle. A circle is the case ``k = 0`` and is
 evaluated by the closed forms above.
 
+*Clothoids (Euler spirals).* A corner rounding that must be curvature continuous
+(:mod:`reference.rounding`) is built from clothoid pieces: plane curves whose curvature
+grows linearly with the arc length from zero, ``kappa(sigma) = c sigma`` (``c =
+sharpness``, 1/mm^2), where ``sigma`` is the distance from the piece's zero-curvature
+end ``Z``. With ``e1`` the unit tangent at ``Z`` (pointing to growing ``sigma``) and
+``e2`` the unit normal it turns towards, the angle is ``phi = c sigma^2 / 2`` and
+
+``p(sigma) = Z + X(sigma) e1 + Y(sigma) e2``, ``X = sqrt(pi/c) C(sigma sqrt(c/pi))``,
+``Y = sqrt(pi/c) S(sigma sqrt(c/pi))`` (``C``, ``S`` the Fresnel integrals),
+``p' = T = cos phi e1 + sin phi e2``, ``p'' = kappa N`` (``N = -sin phi e1 + cos phi
+e2``), ``p''' = c N - kappa^2 T``, exact and arc-length parametrised (``|p'| = 1``).
+
+A piece whose curvature grows along the path has ``Z`` at its start (``sigma = s``,
+``sharpness > 0``); one whose curvature falls to zero at its end has ``Z`` there
+(``sigma = L - s``, stored as ``sharpness < 0``), so its odd derivatives change sign.
+Its packed row: ``origin = Z``, ``e1``, ``e2`` as above, ``d = 0``, ``radius = 1 /
+kappa_max`` and ``omega = kappa_max`` (``kappa_max = |c| L``): every "curved" test
+(``radius > 0``) holds, ``radius * omega = 1`` is its in-plane speed and ``|omega|``
+bounds its angular rate (``|omega| L`` is twice its swept angle ``|c| L^2 / 2``).
+
 A :class:`Path` stores all pieces as packed arrays (one row per segment) so that
 evaluation at 10^5 points is one vectorised numpy expression.
 
@@ -77,6 +97,9 @@ class HelicalSegment:
         ``"line"``, ``"arc"``, or the kind of an inserted block.
     dradius : float
         Spiral rate ``dr/dt``, mm per rad of swept angle; 0 for lines and circles.
+    sharpness : float
+        Clothoid curvature rate ``dkappa/dsigma``, 1/mm^2 (negative: the curvature falls
+        to zero at the end; module docstring); 0 for every other segment.
     """
 
     origin: np.ndarray
@@ -90,6 +113,7 @@ class HelicalSegment:
     source_block: int
     kind: str = "line"
     dradius: float = 0.0
+    sharpness: float = 0.0
 
     def evaluate(self, s: np.ndarray | float) -> tuple[np.ndarray, ...]:
         """Position and its first three derivatives with respect to ``s``.
@@ -109,7 +133,7 @@ class HelicalSegment:
             self.origin[None], self.e1[None], self.e2[None], self.d[None],
             np.array([self.radius]), np.array([self.omega]), np.array([self.theta0]),
             np.zeros(len(s), dtype=np.intp), s, np.array([self.dradius]),
-            np.array([self.length]))
+            np.array([self.length]), np.array([self.sharpness]))
 
     @property
     def start_tangent(self) -> np.ndarray:
@@ -143,12 +167,22 @@ class HelicalSegment:
 
 
 def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None,
-                  length=None):
+                  length=None, sharpness=None):
     """Vectorised kernel: rows ``idx`` of the packed arrays at local positions ``s``.
 
     ``dradius`` and ``length`` (shape ``(m,)``) are needed only when some row is a
-    spiral; without spirals the circle/line closed forms run alone, as fast as before.
+    spiral, ``sharpness`` and ``length`` when some row is a clothoid; without them the
+    circle/line closed forms run alone, as fast as before.
     """
+    cl = np.flatnonzero(sharpness[idx]) if sharpness is not None else np.zeros(0, np.intp)
+    if cl.size:
+        out = _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius,
+                            length)
+        rows = idx[cl]
+        for arr, part in zip(out, _eval_clothoid(origin[rows], e1[rows], e2[rows],
+                                                 sharpness[rows], length[rows], s[cl])):
+            arr[cl] = part
+        return out
     r = radius[idx]
     w = omega[idx]
     sp = np.flatnonzero(dradius[idx]) if dradius is not None else np.zeros(0, np.intp)
@@ -183,6 +217,135 @@ def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None
     ddq = D[:, None] * radial + E[:, None] * along
     dddq = F[:, None] * along + G[:, None] * radial
     return q, dq, ddq, dddq
+
+
+def _fresnel(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(S(z), C(z))``, the Fresnel integrals (scipy, loaded on first use: ``import
+    reference`` stays light, and paths without clothoids never load it)."""
+    from scipy.special import fresnel
+    return fresnel(z)
+
+
+def _eval_clothoid(origin, e1, e2, sharpness, length, s):
+    """Clothoid rows at local positions ``s`` (module docstring), shapes (N, n) / (N,).
+
+    Position from the Fresnel integrals (``scipy.special.fresnel``, accurate to a few
+    units of float64 round-off); derivatives in closed form. For ``sharpness < 0`` the
+    zero-curvature end is at ``s = L`` and ``sigma = L - s``, so ``q' = -p'``,
+    ``q'' = p''`` and ``q''' = -p'''``.
+    """
+    c = np.abs(sharpness)
+    back = sharpness < 0
+    sigma = np.where(back, length - s, s)
+    sigma = np.clip(sigma, 0.0, length)
+    scale = np.sqrt(np.pi / c)
+    fs, fc = _fresnel(sigma / scale)
+    phi = 0.5 * c * sigma * sigma
+    kappa = c * sigma
+    cos, sin = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    tan = cos * e1 + sin * e2
+    nor = cos * e2 - sin * e1
+    q = origin + (scale * fc)[:, None] * e1 + (scale * fs)[:, None] * e2
+    sign = np.where(back, -1.0, 1.0)[:, None]
+    dq = sign * tan
+    ddq = kappa[:, None] * nor
+    dddq = sign * (c[:, None] * nor - (kappa * kappa)[:, None] * tan)
+    return q, dq, ddq, dddq
+
+
+def clothoid_derivative_norms(c: np.ndarray, length: np.ndarray) -> list[np.ndarray]:
+    """Bounds of ``|q^(m)|``, ``m = 1..5``, on clothoid pieces of curvature rate ``c``
+    and length ``L`` (``kappa = c sigma <= K = c L``), shape (N,) each.
+
+    With ``T``, ``N`` the unit tangent and normal (``T' = kappa N``, ``N' = -kappa T``,
+    ``kappa' = c``): ``q' = T``, ``q'' = kappa N``, ``q''' = c N - kappa^2 T``,
+    ``q'''' = -3 c kappa T - kappa^3 N``, ``q5 = (kappa^4 - 3 c^2) T - 6 c kappa^2 N``;
+    ``T``, ``N`` orthonormal, so the norms are at most ``1``, ``K``, ``hypot(c, K^2)``,
+    ``hypot(3 c K, K^3)`` and ``hypot(max(K^4, 3 c^2), 6 c K^2)``.
+    """
+    K = c * length
+    return [np.ones_like(c), K, np.hypot(c, K * K), np.hypot(3 * c * K, K ** 3),
+            np.hypot(np.maximum(K ** 4, 3 * c * c), 6 * c * K * K)]
+
+
+def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
+                    half_length: np.ndarray, block: np.ndarray, kind_code: int
+                    ) -> dict[str, np.ndarray]:
+    """Packed rows of symmetric clothoid pairs turning from ``t_in`` to ``t_out``.
+
+    Pair ``k`` starts at ``start[k]`` tangent to ``t_in[k]`` with zero curvature; its
+    first piece (curvature rising, ``sharpness > 0``) turns by ``theta/2`` over
+    ``half_length`` (``theta`` the angle between the directions), the second (curvature
+    falling to zero, ``sharpness < 0``) turns by the other ``theta/2`` and ends tangent to
+    ``t_out`` with zero curvature. The pieces are interleaved (first, second, first,
+    ...): ``2k`` rows.
+
+    Parameters
+    ----------
+    start, t_in, t_out : numpy.ndarray, shape (k, n)
+        Start points and unit directions (in a plane; ``0 < theta < pi``).
+    half_length : numpy.ndarray, shape (k,)
+        Length of each piece ``L_s``, mm (``c = theta / L_s^2``, ``kappa_max = theta /
+        L_s``).
+    block : numpy.ndarray of int, shape (k,)
+        Block each pair is attributed to.
+    kind_code : int
+        Segment kind code.
+
+    Returns
+    -------
+    dict
+        Packed rows (keys of :class:`Path`, plus ``sharpness``).
+    """
+    k = half_length.size
+    n = start.shape[1]
+    theta = 2.0 * np.arctan2(np.linalg.norm(t_out - t_in, axis=1),
+                             np.linalg.norm(t_out + t_in, axis=1))
+    c = theta / half_length ** 2
+    kmax = theta / half_length
+    nor = t_out - np.sum(t_out * t_in, axis=1)[:, None] * t_in
+    nor /= np.linalg.norm(nor, axis=1)[:, None]
+    # the end: by symmetry about the bisector, the chord from start to end is
+    # 2 L_s (Fx cos(theta/2) + Fy sin(theta/2)) along the mean direction
+    scale = np.sqrt(np.pi / c)
+    fs, fc = _fresnel(half_length / scale)
+    X, Y = scale * fc, scale * fs
+    d = X + Y * np.tan(theta / 2.0)                    # tangent distance to the corner
+    corner = start + d[:, None] * t_in
+    end = corner + d[:, None] * t_out
+    back_n = -t_in + np.sum(t_in * t_out, axis=1)[:, None] * t_out
+    back_n /= np.linalg.norm(back_n, axis=1)[:, None]
+    origin = np.empty((2 * k, n))
+    e1 = np.empty((2 * k, n))
+    e2 = np.empty((2 * k, n))
+    origin[0::2], e1[0::2], e2[0::2] = start, t_in, nor
+    origin[1::2], e1[1::2], e2[1::2] = end, -t_out, back_n
+    rep = np.repeat
+    return {
+        "origin": origin, "e1": e1, "e2": e2, "d": np.zeros((2 * k, n)),
+        "radius": rep(1.0 / kmax, 2), "omega": rep(kmax, 2), "theta0": np.zeros(2 * k),
+        "length": rep(half_length, 2), "block": rep(np.asarray(block, np.int64), 2),
+        "kind": np.full(2 * k, kind_code, dtype=np.int8), "dradius": np.zeros(2 * k),
+        "sharpness": np.column_stack((c, -c)).ravel(),
+    }
+
+
+def clothoid_pair_shape(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tangent distance and contour deviation of a symmetric clothoid pair of unit
+    piece length turning by ``theta``, shape (k,) each (both scale with the piece
+    length ``L_s``).
+
+    The first piece ends at ``(X, Y) = (sqrt(pi/c) C(z), sqrt(pi/c) S(z))``,
+    ``z = sqrt(c/pi)`` (``L_s = 1``, ``c = theta``) with tangent angle ``theta/2``;
+    that point lies on the corner's bisector, so the tangent distance from the corner
+    is ``d = X + Y tan(theta/2)`` and the largest distance of the pair from the corner
+    (at that middle point, the nearest) is ``e = Y / cos(theta/2)``.
+    """
+    c = np.asarray(theta, dtype=np.float64)
+    scale = np.sqrt(np.pi / c)
+    fs, fc = _fresnel(1.0 / scale)
+    X, Y = scale * fc, scale * fs
+    return X + Y * np.tan(c / 2.0), Y / np.cos(c / 2.0)
 
 
 def spiral_plane_length(r0: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -323,7 +486,9 @@ class PlaneAmplitudes:
     (r^2 + k^2)^{3/2}`` falls as ``r`` grows): ``speed = g``, ``curvature =
     g^2 kappa(r_min)``, ``jerk_t = g^3 kappa(r_min)^2``, ``jerk_n = g^3 |k| r_max
     (r_max^2 + 4k^2) / (r_min^2 + k^2)^3 >= g^3 |dkappa/dsigma|`` and ``omega_max =
-    g / sqrt(r_min^2 + k^2) >= |dphi/ds|``. Lines have zeros.
+    g / sqrt(r_min^2 + k^2) >= |dphi/ds|``. On clothoids (``kappa = |c| sigma`` up
+    to ``kappa_max = |c| L``): ``speed = 1``, ``curvature = kappa_max``, ``jerk_t =
+    kappa_max^2``, ``jerk_n = |c|`` and ``omega_max = kappa_max``. Lines have zeros.
 
     Attributes
     ----------
@@ -371,6 +536,18 @@ def plane_amplitudes(path: "Path") -> PlaneAmplitudes:
         jerk_t[sp] = g ** 3 * kappa * kappa
         jerk_n[sp] = g ** 3 * np.abs(k) * rmax * (rmax * rmax + 4.0 * kk) / smin2 ** 3
         omega_max[sp] = g / np.sqrt(smin2)
+    cl = np.flatnonzero(path.sharpness)
+    if cl.size:
+        # clothoids: unit in-plane speed, kappa <= kappa_max = |c| L, the tangential part
+        # of q''' is -kappa^2 T (<= kappa_max^2), the normal part c N, and the angular
+        # rate dphi/ds = kappa <= kappa_max
+        c = np.abs(path.sharpness[cl])
+        kmax = c * path.length[cl]
+        speed[cl] = 1.0
+        curvature[cl] = kmax
+        jerk_t[cl] = kmax * kmax
+        jerk_n[cl] = c
+        omega_max[cl] = kmax
     return PlaneAmplitudes(speed, curvature, jerk_t, jerk_n, omega_max)
 
 
@@ -640,6 +817,9 @@ class Path:
         What the corner-rounding stage decided per corner
         (:class:`reference.core.rounding.RoundingTable`); ``None`` when the stage did
         not run or no block is in a rounding mode.
+    sharpness : numpy.ndarray, shape (m,)
+        Clothoid curvature rate, 1/mm^2 (module docstring; 0 on every other segment; the
+        default ``None`` means all zero).
     """
 
     axes: tuple[str, ...]
@@ -663,13 +843,16 @@ class Path:
     source: str = ""
     dradius: np.ndarray | None = None
     rounding: RoundingTable | None = None
+    sharpness: np.ndarray | None = None
     s_breaks: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         if self.dradius is None:
             object.__setattr__(self, "dradius", np.zeros(np.shape(self.length)))
+        if self.sharpness is None:
+            object.__setattr__(self, "sharpness", np.zeros(np.shape(self.length)))
         for name in ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length",
-                     "feed", "dradius"):
+                     "feed", "dradius", "sharpness"):
             object.__setattr__(self, name, _readonly(getattr(self, name)))
         for name in ("geometry", "rotary", "rapid", "stop"):
             a = np.ascontiguousarray(getattr(self, name), dtype=bool)
@@ -714,7 +897,7 @@ class Path:
             radius=float(self.radius[i]), omega=float(self.omega[i]),
             theta0=float(self.theta0[i]), length=float(self.length[i]),
             source_block=int(self.block[i]), kind=KIND_CODES[int(self.kind[i])],
-            dradius=float(self.dradius[i]))
+            dradius=float(self.dradius[i]), sharpness=float(self.sharpness[i]))
 
     @property
     def segments(self) -> tuple[HelicalSegment, ...]:
@@ -764,7 +947,8 @@ class Path:
         idx = self.segment_index(s, side) if segment is None else np.asarray(segment)
         local = s - self.s_breaks[idx]
         return _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                             self.omega, self.theta0, idx, local, self.dradius, self.length)
+                             self.omega, self.theta0, idx, local, self.dradius, self.length,
+                             self.sharpness)
 
     def moving_axes(self) -> np.ndarray:
         """Indices of the axes that move somewhere on the path (a non-zero in-plane or
@@ -798,7 +982,8 @@ class Path:
                     omega=self.omega, theta0=self.theta0, length=self.length,
                     block=self.block, kind=self.kind, feed=self.feed, rapid=self.rapid,
                     stop=self.stop, stop_reason=self.stop_reason, blocks=self.blocks,
-                    source=self.source, dradius=self.dradius, rounding=self.rounding)
+                    source=self.source, dradius=self.dradius, rounding=self.rounding,
+                    sharpness=self.sharpness)
 
     def junction_tangents(self, lo: int = 0, hi: int | None = None
                           ) -> tuple[np.ndarray, np.ndarray]:
@@ -826,10 +1011,10 @@ class Path:
         idx_out = idx_in + 1
         _, t_in, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                                       self.omega, self.theta0, idx_in, self.length[lo:hi],
-                                      self.dradius, self.length)
+                                      self.dradius, self.length, self.sharpness)
         _, t_out, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                                        self.omega, self.theta0, idx_out, np.zeros(hi - lo),
-                                       self.dradius, self.length)
+                                       self.dradius, self.length, self.sharpness)
         return t_in, t_out
 
     def junction_curvatures(self) -> tuple[np.ndarray, np.ndarray]:
@@ -841,10 +1026,10 @@ class Path:
         idx_in = np.arange(m - 1)
         _, _, k_in, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                                       self.omega, self.theta0, idx_in, self.length[:-1],
-                                      self.dradius, self.length)
+                                      self.dradius, self.length, self.sharpness)
         _, _, k_out, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                                        self.omega, self.theta0, idx_in + 1, np.zeros(m - 1),
-                                       self.dradius, self.length)
+                                       self.dradius, self.length, self.sharpness)
         return k_in, k_out
 
     def block_of(self, s: np.ndarray | float) -> np.ndarray:
@@ -886,7 +1071,7 @@ def path_from_pieces(axes: tuple[str, ...], pieces: list[dict[str, np.ndarray]],
     Path
     """
     keys = ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length", "block", "kind",
-            "dradius")
+            "dradius", "sharpness")
     n = len(axes)
     if pieces:
         packed = {k: np.concatenate([p[k] if k in p else np.zeros(p["length"].shape)

@@ -1,13 +1,14 @@
 """Corner rounding geometry: the tangent-arc fillet of a corner between two lines, and
 the table that records, per corner, what the rounding stage decided.
 
-First-version model (sinumerik-model 5.8 leaves the shape open: "the user must not
-assume a particular shape inside the rounding area", 5.1): the rounding block is the
-circular arc tangent to both lines. It is exactly representable by the path's helical
-pieces (a circle with ``d = 0``), so the checker, the heuristic and the oracle's bounds
-need nothing new: its ``q'``, ``q''``, ``q'''`` are the arc's closed forms. It is G1
-continuous (tangent at both ends) with a curvature jump ``1/R`` at both ends; the
-G2-continuous blend the manuals suggest for G642/G645 is not modelled yet.
+Model (sinumerik-model 5.8 leaves the shape open: "the user must not assume a
+particular shape inside the rounding area", 5.1): under BRISK the rounding block is the
+circular arc tangent to both lines, exactly representable by the path's helical pieces
+(a circle with ``d = 0``; its ``q'``, ``q''``, ``q'''`` are the arc's closed forms). It
+is G1 continuous with a curvature jump ``1/R`` at both ends. Under SOFT the stage
+inserts a curvature-continuous clothoid pair instead
+(:func:`reference.core.geometry.clothoid_pieces`); this module's arc formulas below
+describe the arc only.
 
 For a corner ``C`` between unit directions ``t1`` (in) and ``t2`` (out) with deflection
 angle ``theta`` (the angle between ``t1`` and ``t2``) and tangent distance ``d`` (how far
@@ -79,6 +80,14 @@ class RoundingTable:
     v_g64, v_round : numpy.ndarray, shape (k,)
         The G64 corner speed and the model's rounding speed (centripetal, curvature
         jump, one IPO cycle), mm/s (``nan`` where not evaluated).
+    g2 : numpy.ndarray of bool, shape (k,)
+        The rounding is a clothoid pair (curvature continuous; ``radius_mm`` is then its
+        smallest radius of curvature, in the middle), else a tangent arc.
+    first_block, last_block : numpy.ndarray of int, shape (k,)
+        First and last program block the rounding window touches: ``block`` and
+        ``next_block`` unless the window reaches across short blocks (G642/G645), in
+        which case the blocks strictly between ``first_block`` and ``block`` (and
+        between ``next_block`` and ``last_block``) are covered by the rounding whole.
     """
 
     block: np.ndarray
@@ -92,6 +101,9 @@ class RoundingTable:
     clamped: np.ndarray
     v_g64: np.ndarray
     v_round: np.ndarray
+    g2: np.ndarray
+    first_block: np.ndarray
+    last_block: np.ndarray
 
     @property
     def n(self) -> int:
@@ -102,6 +114,12 @@ class RoundingTable:
     def inserted(self) -> np.ndarray:
         """True per corner where a rounding segment was inserted, shape (k,)."""
         return self.reason == 0
+
+    @property
+    def blocks_spanned(self) -> np.ndarray:
+        """Program blocks the rounding window touches (2 for a rounding between two
+        blocks, more across short blocks; 0 where none was inserted), shape (k,)."""
+        return np.where(self.inserted, self.last_block - self.first_block + 1, 0)
 
     def reason_text(self, i: int) -> str:
         """The reason of corner ``i`` as words."""

@@ -29,6 +29,7 @@ from ..core.constraints import BOUND_SETS, check_profile
 from ..core.geometry import Path
 from ..core.holds import SETTLE_CAUSE, Holds, with_holds
 from ..core.profile import Profile
+from ..core.rounding import ROUNDING_REASONS
 from ..holds import imposed_holds
 from ..machine import Machine
 from ..nc.program import Program
@@ -57,15 +58,20 @@ def rounding_note(path: Path) -> str:
     if table is None or table.n == 0:
         return "no corner in G641..G645"
     ins = table.inserted
-    modes = sorted(set(table.mode))
-    per_mode = ", ".join(f"{md} {sum(1 for i in np.flatnonzero(ins) if table.mode[i] == md)}"
-                         f"/{sum(1 for x in table.mode if x == md)}" for md in modes)
-    left = {}
-    for i in np.flatnonzero(~ins):
-        left[table.reason_text(i)] = left.get(table.reason_text(i), 0) + 1
-    why = "; ".join(f"{n} {r}" for r, n in sorted(left.items(), key=lambda x: -x[1]))
-    return (f"{int(ins.sum())} of {table.n} corners in G641..G645 rounded by tangent arcs "
-            f"({per_mode}; {float(table.length_mm.sum()):.6g} mm of rounding)"
+    modes, code = np.unique(np.asarray(table.mode, dtype=object).astype(str),
+                            return_inverse=True)
+    n_in = np.bincount(code[ins], minlength=modes.size)
+    n_all = np.bincount(code, minlength=modes.size)
+    per_mode = ", ".join(f"{md} {a}/{b}" for md, a, b in zip(modes, n_in, n_all))
+    left = np.bincount(table.reason[~ins], minlength=len(ROUNDING_REASONS))
+    order = sorted(np.flatnonzero(left), key=lambda r: (-left[r], ROUNDING_REASONS[r]))
+    why = "; ".join(f"{left[r]} {ROUNDING_REASONS[r]}" for r in order)
+    across = int(np.sum(table.blocks_spanned > 2))
+    n_g2 = int(np.sum(table.g2))
+    return (f"{int(ins.sum())} of {table.n} corners in G641..G645 rounded ({n_g2} by "
+            f"clothoid pairs, {int(ins.sum()) - n_g2} by tangent arcs; "
+            f"{per_mode}; {float(table.length_mm.sum()):.6g} mm of rounding"
+            + (f"; {across} across short blocks" if across else "") + ")"
             + (f"; no rounding block: {why}" if why else ""))
 
 

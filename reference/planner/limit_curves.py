@@ -96,9 +96,9 @@ def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
 
     ``P``, ``Q``: in-plane tangent and curvature; ``R``, ``Rn``: tangential and normal
     parts of the third derivative. On circles they are constant (``Rn = 0``); on spirals
-    the curvature varies along the arc and these are its worst values over the segment
-    (:func:`~reference.core.geometry.plane_amplitudes`), so every cap derived from them
-    holds on the whole spiral.
+    and clothoids the curvature varies along the segment and these are its worst values
+    over the segment (:func:`~reference.core.geometry.plane_amplitudes`), so every cap
+    derived from them holds on the whole segment.
     """
     rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
     rw = np.abs(path.radius * path.omega)[:, None]
@@ -108,7 +108,7 @@ def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
     Q = P * w
     R = Q * w
     Rn = np.zeros_like(R)
-    sp = np.flatnonzero(path.dradius)
+    sp = np.flatnonzero((path.dradius != 0) | (path.sharpness != 0))
     if sp.size:
         amp = plane_amplitudes(path)
         P[sp] = rho[sp] * amp.speed[sp, None]

@@ -9,7 +9,12 @@ from pathlib import Path
 
 import pytest
 
+import numpy as np
+
 from compare import cli
+from reference.machine import load_machine
+from reference.nc import parse_file
+from reference.prepare import build_path
 from test_corpus_machines import MACHINES, _machine_file
 
 PROGRAMS = {
@@ -17,7 +22,15 @@ PROGRAMS = {
     "g641_adis": "G90 G641 ADIS=0.5 ADISPOS=1 BRISK F3000\nG0 X0 Y0\nG0 X20\nG1 Y20\nX0\nY0\nM30\n",
     "g642_soft": "G90 G642 SOFT F6000\nG1 X0 Y0\nX30\nY30 Z-2\nX0\nM30\n",
     "rnd": "G90 G64 F3000\nG1 X0 Y0\nX30 RND=3\nY30 RND=1\nX0 Y10\nM30\n",
+    # SOFT: clothoid pairs (curvature continuous), on every bundled machine
+    "g642_soft_shallow": "G90 G642 CTOL=0.1 SOFT F6000\nG1 X0 Y0\nX30\nX60 Y10\nX90 Y30\n"
+                         "X110 Y60\nM30\n",
+    "g645_soft_zigzag": "G90 G645 CTOL=0.05 SOFT F4000\nG1 X0 Y0\nX20 Y4\nX40 Y0\nX60 Y4\n"
+                        "X80 Y0\nM30\n",
+    "g641_soft_adis": "G90 G641 ADIS=1 SOFT F5000\nG1 X0 Y0\nX25\nX50 Y8\nX75 Y8 Z-3\nM30\n",
 }
+#: Programs whose roundings are clothoid pairs on every bundled machine (checked below).
+G2 = ("g642_soft_shallow", "g645_soft_zigzag", "g641_soft_adis")
 
 
 @pytest.mark.parametrize("machine", sorted(MACHINES))
@@ -39,6 +52,10 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
     assert lb <= ub <= lb * (1 + 2e-3) + 1e-12
     assert not ref["violations"], ref["violations"]
     assert t_ref >= lb
+    if name in G2:
+        path = build_path(parse_file(prog), load_machine(str(mfile)))
+        assert path.rounding.g2[path.rounding.inserted].all()
+        assert np.count_nonzero(path.sharpness) == 2 * int(path.rounding.inserted.sum()) > 0
 
 
 def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, capsys) -> None:
@@ -52,5 +69,46 @@ def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, caps
     rows = [r.split() for r in out.splitlines() if r.strip().startswith(("3/4", "4/5", "5/6"))]
     # 90 degree corners, ADIS 0.5: d = R = 0.5, length pi/4, deviation 0.5 (sqrt 2 - 1)
     assert rows[0][:6] == ["3/4", "G641", "0.5000", "0.7854", "0.20711", "0.5000"]
-    assert rows[0][6] == "rounded"
-    assert " ".join(rows[1][6:]) == "none: stop between the blocks"
+    # G64 corner speed by hand (spec 4.2): each axis may jump by A (ovl - 1) T_ipo =
+    # 2000 * 0.2 * 0.004 = 1.6 mm/s; at 90 degrees an axis jumps by v, so 96 mm/min
+    assert rows[0][6] == "96.0"
+    assert rows[0][8:10] == ["rounded", "(arc)"]
+    assert rows[1][6:8] == ["-", "-"]               # not evaluated: the stop decides
+    assert " ".join(rows[1][8:]) == "none: stop between the blocks"
+
+
+def test_inspect_names_a_rounding_across_short_blocks(tmp_path: Path, capsys) -> None:
+    """Issue 13 items 4 and 5: a G642 window that covers short blocks is listed with the
+    lines it spans. 90 degree corner, CTOL 0.2: d = 0.2 / tan(22.5 deg) = 0.4828 mm,
+    beyond the 0.2 mm blocks X20.8 -> X21 and X20.6 -> X20.8 into X20.4 -> X20.6
+    (line 5); after the corner it stays in the block Y10 (line 8)."""
+    prog = tmp_path / "steps.mpf"
+    prog.write_text("G90 G642 CTOL=0.2 BRISK F4000\nG1 X0 Y0\nX20\nX20.4\nX20.6\nX20.8\n"
+                    "X21\nY10\n")
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    row = next(r for r in out.splitlines() if r.strip().startswith("7/8"))
+    assert "0.4828" in row and row.endswith("rounded (arc) across lines 5..8 (short blocks)")
+
+
+@pytest.mark.parametrize("machine", sorted(MACHINES))
+@pytest.mark.parametrize("name", G2)
+def test_clothoid_roundings_keep_the_jerk_certificate(name: str, machine: str,
+                                                      tmp_path: Path, capsys) -> None:
+    """The jerk oracle on the same clothoid-rounded paths (its lower bound takes the
+    worst-case suprema of the clothoid, optimal/jerk/lower.py): the heuristic, which
+    keeps the jerk bounds, is never below the certified lower bound."""
+    prog = tmp_path / f"{name}.mpf"
+    prog.write_text(PROGRAMS[name])
+    mfile = _machine_file(tmp_path, machine, prog.name)
+    out = tmp_path / "r.json"
+    rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report", "--quiet",
+                   "--bounds", "jerk", "--json", str(out)])
+    err = capsys.readouterr().err
+    assert rc in (0, 1), err
+    doc = json.loads(out.read_text())
+    ora, ref = doc["oracle"], doc["reference"]
+    assert ora["status"] in ("optimal", "gap_not_met"), ora
+    assert not ref["violations"], ref["violations"]
+    assert ora["lower_bound_s"] <= ora["upper_bound_s"]
+    assert ref["time_s"] >= ora["lower_bound_s"]

@@ -542,3 +542,173 @@ def test_zero_length_path_only_judges_rest():
                    j=np.zeros(1), block=np.zeros(1, int))
     rep = check_profile(p, limits(), prof)
     assert rep.max_ratio() == 0.0
+
+
+@pytest.mark.parametrize("factor", [8, 64])
+def test_coarse_to_fine_arc_sampling_against_brute_force(monkeypatch, factor):
+    """Module docstring: on arcs the maxima are within dphi^2/8 of the true ones. The
+    circles are sampled coarsely first and finely only where a bound on the second
+    derivative says a larger value may hide (``ARC_COARSE_FACTOR``); with the factor
+    raised to 64 (8 deg coarse steps) almost everything rests on that bound, so a wrong
+    bound shows here as a missed peak. Reference: a brute-force time grid (1e5 points per
+    arc, both sides of every knot)
+    with the kinematics written out (q' v, q' a + q'' v^2, q' j + 3 q'' v a + q''' v^3),
+    per constraint and per block. Small rounding-like arcs (R 0.05..2 mm, 20..170 deg)
+    traversed by random BRISK and SOFT motions, in planes tilted to all axes."""
+    monkeypatch.setattr(cmod, "ARC_COARSE_FACTOR", factor)
+    rng = np.random.default_rng(5)
+    ax = ("X", "Y", "Z")
+    geo = np.array([True, True, True])
+    lim = MachineLimits(tuple(AxisLimits(n, 1e3, 1e4, 1e6, 1.2, 1.0) for n in ax), T_IPO)
+    la = lim.for_axes(ax)
+    for case in range(8):
+        pieces, pos = [], np.zeros(3)
+        for b in range(4):
+            r = rng.uniform(0.05, 2.0)
+            sweep = np.radians(rng.uniform(20.0, 170.0))
+            e1 = rng.normal(size=3)
+            e1 /= np.linalg.norm(e1)
+            e2 = rng.normal(size=3)
+            e2 -= e1 * (e2 @ e1)
+            e2 /= np.linalg.norm(e2)
+            c = pos - r * e1
+            end = c + r * (np.cos(sweep) * e1 + np.sin(sweep) * e2)
+            pieces.append(arc_segment(pos, end, c, (e1, e2), False, 0, geo, b, 1e-9))
+            pos = end
+        p = path_from_pieces(ax, pieces)
+        L = p.total_length
+        vmax = rng.uniform(5.0, 40.0)
+        if case % 2:          # BRISK-like: constant path acceleration per interval
+            s = np.linspace(0, L, 40)
+            v = vmax * np.sin(np.pi * s / L) ** 0.5 * (1 + 0.2 * np.sin(7 * s / L))
+            v[[0, -1]] = 0.0
+            prof = Profile.from_path_velocity(s, v)
+        else:                 # SOFT: jerk-limited ramps
+            prof = motion(L, [("ramp", vmax, 2000.0, 40000.0), ("cruise", None),
+                              ("ramp", 0.3 * vmax, 2000.0, 40000.0), ("cruise", 0.2 * L),
+                              ("ramp", 0.0, 2000.0, 40000.0)])
+        rep = check_profile(p, lim, prof)
+        # per arc (its own end points included: a corner follows each arc): its time
+        # span and the knots in it, positions clipped onto the arc
+        tb = prof.time_at(p.s_breaks)
+        # the path acceleration steps at knots: both one-sided values (next floats)
+        kn = np.concatenate((np.nextafter(prof.t, -np.inf), prof.t,
+                             np.nextafter(prof.t, np.inf)))
+        ts = [np.union1d(np.linspace(t0, t1, 100_001), kn[(kn > t0) & (kn < t1)])
+              for t0, t1 in zip(tb[:-1], tb[1:])]
+        seg = np.concatenate([np.full(x.size, i) for i, x in enumerate(ts)])
+        s, v, a, j = prof.state(np.concatenate(ts))
+        s = np.clip(s, p.s_breaks[seg], p.s_breaks[seg + 1])
+        _, dq, ddq, dddq = p.evaluate(s, segment=seg)
+        vals = {
+            "velocity": np.abs(dq * v[:, None]) / la.v_max,
+            "acceleration": np.abs(dq * a[:, None] + ddq * (v * v)[:, None]) / la.a_max,
+            "jerk": np.abs(dq * j[:, None] + 3 * ddq * (v * a)[:, None]
+                           + dddq * (v ** 3)[:, None]) / la.j_max}
+        blk = p.block[seg]
+        for name, val in vals.items():
+            b = val.max()
+            r = rep.components["jerk_interval"].ratio if name == "jerk" else \
+                rep.worst(name).ratio
+            assert b * (1 - 6e-7) <= r <= b * (1 + 1e-7), (case, name)
+            if name == "jerk":
+                continue       # block jerk ratios also hold the acceleration steps
+            per = np.zeros(4)
+            np.maximum.at(per, blk, val.max(axis=1))
+            got = rep.block_ratios[name][:4]
+            assert np.all(got >= per * (1 - 6e-7)), (case, name, got, per)
+            assert np.all(got <= per * (1 + 1e-7) + 1e-12), (case, name)
+
+
+@pytest.mark.parametrize("factor", [8, 64])
+def test_coarse_sampling_finds_the_highest_of_nearly_equal_peaks(monkeypatch, factor):
+    """The case the second-derivative bound exists for: ten turns of a circle in one
+    interval of slowly rising speed, so every half turn the X and Y accelerations peak,
+    each peak about 1e-5 higher than the one before (the last ones inside the interval,
+    not at its end). The coarse samples (1 or 8 deg apart) catch
+    some earlier peak better than the last one; only the bound sends the fine sampling
+    to the last, highest peak. Reference: 2e6 uniform samples (0.0018 deg apart)."""
+    monkeypatch.setattr(cmod, "ARC_COARSE_FACTOR", factor)
+    R, v0, v1 = 5.0, 20.0, 20.002
+    start = np.array([R, 0.0, 0.0])
+    end = R * np.array([np.cos(1.3), np.sin(1.3), 0.0])      # 10 turns and 1.3 rad
+    p = path_from_pieces(AX, [arc_segment(start, end, np.zeros(3), (0, 1), False, 10, GEO,
+                                          0, 1e-9)])
+    L = p.total_length
+    assert L == pytest.approx(R * (20 * np.pi + 1.3))
+    h = 2 * L / (v0 + v1)
+    a = (v1 - v0) / h
+    prof = Profile(t=np.array([0.0, h]), s=np.array([0.0, L]), v=np.array([v0, v1]),
+                   a=np.array([a]), j=np.zeros(1), block=np.zeros(1, dtype=np.int64))
+    lim = MachineLimits(tuple(AxisLimits(n, 1e3, 1e4, 1e6, 1.2, 1.0) for n in AX), T_IPO)
+    rep = check_profile(p, lim, prof)
+    t = np.linspace(0.0, h, 2_000_001)
+    s, v, acc, _ = prof.state(t)
+    _, dq, ddq, _ = p.evaluate(np.clip(s, 0, L))
+    brute = np.max(np.abs(dq * acc[:, None] + ddq * (v * v)[:, None])) / 1e4
+    got = rep.worst("acceleration").ratio
+    assert brute * (1 - 6e-7) <= got <= brute * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("factor", [8, 64])
+def test_sampling_on_clothoid_pairs_against_brute_force(monkeypatch, factor):
+    """The checker's accuracy statement holds on clothoid roundings too (their coarse
+    steps are pruned by bounds from :func:`reference.core.geometry.clothoid_derivative_norms`): lines with
+    clothoid pairs of 30..170 deg between them, random BRISK-like and SOFT motions,
+    against a brute-force grid per segment (1e5 points, both sides of every knot)."""
+    from reference.core.geometry import KIND_CODES, clothoid_pair_shape, clothoid_pieces
+    monkeypatch.setattr(cmod, "ARC_COARSE_FACTOR", factor)
+    rng = np.random.default_rng(21)
+    lim = MachineLimits(tuple(AxisLimits(n, 1e3, 1e4, 1e6, 1.2, 1.0) for n in AX), T_IPO)
+    la = lim.for_axes(AX)
+    for case in range(6):
+        pos, t_in = np.zeros(3), np.array([1.0, 0.0, 0.0])
+        pieces, blk = [], 0
+        for _ in range(3):
+            end = pos + rng.uniform(0.5, 3.0) * t_in
+            pieces.append(line_segments(pos[None], end[None], GEO, np.array([blk])))
+            ang = np.radians(rng.uniform(30.0, 170.0)) * rng.choice((-1.0, 1.0))
+            axis = rng.normal(size=3)
+            axis -= t_in * (axis @ t_in)
+            axis /= np.linalg.norm(axis)
+            t_out = np.cos(ang) * t_in + np.sin(ang) * axis
+            half = rng.uniform(0.05, 1.0)
+            pieces.append(clothoid_pieces(end[None], t_in[None], t_out[None],
+                                          np.array([half]), np.array([blk]),
+                                          KIND_CODES.index("rounding")))
+            d1, _ = clothoid_pair_shape(np.array([abs(ang)]))
+            pos = end + half * d1[0] * (t_in + t_out)
+            t_in, blk = t_out, blk + 1
+        end = pos + 2.0 * t_in
+        pieces.append(line_segments(pos[None], end[None], GEO, np.array([blk])))
+        p = path_from_pieces(AX, pieces)
+        L = p.total_length
+        vmax = rng.uniform(5.0, 40.0)
+        if case % 2:
+            s = np.linspace(0, L, 60)
+            v = vmax * np.sin(np.pi * s / L) ** 0.5 * (1 + 0.2 * np.sin(5 * s / L))
+            v[[0, -1]] = 0.0
+            prof = Profile.from_path_velocity(s, v)
+        else:
+            prof = motion(L, [("ramp", vmax, 2000.0, 40000.0), ("cruise", None),
+                              ("ramp", 0.0, 2000.0, 40000.0)])
+        rep = check_profile(p, lim, prof)
+        tb = prof.time_at(p.s_breaks)
+        kn = np.concatenate((np.nextafter(prof.t, -np.inf), prof.t,
+                             np.nextafter(prof.t, np.inf)))
+        ts = [np.union1d(np.linspace(t0, t1, 100_001), kn[(kn > t0) & (kn < t1)])
+              for t0, t1 in zip(tb[:-1], tb[1:])]
+        seg = np.concatenate([np.full(x.size, i) for i, x in enumerate(ts)])
+        s, v, a, j = prof.state(np.concatenate(ts))
+        s = np.clip(s, p.s_breaks[seg], p.s_breaks[seg + 1])
+        _, dq, ddq, dddq = p.evaluate(s, segment=seg)
+        vals = {
+            "velocity": np.abs(dq * v[:, None]) / la.v_max,
+            "acceleration": np.abs(dq * a[:, None] + ddq * (v * v)[:, None]) / la.a_max,
+            "jerk": np.abs(dq * j[:, None] + 3 * ddq * (v * a)[:, None]
+                           + dddq * (v ** 3)[:, None]) / la.j_max}
+        for name, val in vals.items():
+            b = val.max()
+            r = rep.components["jerk_interval"].ratio if name == "jerk" else \
+                rep.worst(name).ratio
+            assert b * (1 - 6e-7) <= r <= b * (1 + 1e-7), (case, name)

@@ -379,8 +379,9 @@ def test_g0_tolerance_factor_widens_the_g642_tolerance():
 
 def test_the_rounding_speed_estimate_uses_the_planner_default_centripetal_share():
     from reference.planner.parameters import DEFAULT_PARAMETERS
-    from reference.rounding import CENTRIPETAL_SHARE
+    from reference.rounding import CENTRIPETAL_SHARE, JERK_VELOCITY_SHARE
     assert CENTRIPETAL_SHARE == DEFAULT_PARAMETERS.arc_centripetal_share
+    assert JERK_VELOCITY_SHARE == DEFAULT_PARAMETERS.arc_jerk_velocity_share
 
 
 def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
