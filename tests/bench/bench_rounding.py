@@ -3,7 +3,7 @@
 A seeded CAM-like polyline of 10^4 lines (0.5..5 mm, turns of 5..120 degrees, F6000)
 is planned by the heuristic under G64 and under each rounding mode, on the default
 machine with BRISK and SOFT; then the short-segment program (tests/data/
-short_segments_g642.mpf, 3000 blocks of 0.0254 mm under G642) against itself under G64
+lcnc_short_segments_0.001.ngc converted to G642 by tests/corpus_sinumerik.py, 3000 blocks of 0.0254 mm under G642) against itself under G64
 on both bundled machines. Every row is a ratio against the same program under G64,
 measured in the same run, of the wall time per block (the smallest of 5 runs: on a
 machine shared with other work the smallest is the least disturbed; medians of 3 moved
@@ -42,7 +42,8 @@ from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
 
 TARGET = 1.30
-SHORT = HERE.parents[1] / "tests" / "data" / "short_segments_g642.mpf"
+sys.path.insert(0, str(HERE.parent.parent / "reference"))
+from corpus_sinumerik import short_segments_g642  # noqa: E402
 
 
 def polyline(n: int, seed: int = 13) -> str:
@@ -107,7 +108,7 @@ def main(argv=None) -> None:
             r, r_pl = row(f"{accel} {mode}, {n} blocks", n, base,
                           timed(head.replace("G90", f"G90 {mode}") + body, machine))
             worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    text = SHORT.read_text()
+    text = short_segments_g642()
     for name in (None, "linuxcnc_xyz"):
         mach = load_machine(name) if name else load_machine()
         base = timed(text.replace("G642 G17", "G64 G17"), mach)

@@ -22,12 +22,13 @@ import pytest
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
 from reference.machine import load_machine, machine_from_dict
+from corpus_sinumerik import short_segments_g642
 from reference.nc import parse_file, parse_text
 from reference.planner import plan
 from reference.prepare import build_path
 
 ROOT = FsPath(__file__).resolve().parents[2]
-SHORT = ROOT / "tests" / "data" / "short_segments_g642.mpf"
+SHORT = short_segments_g642     # the corpus program converted at test time
 ROUNDING = KIND_CODES.index("rounding")
 MEET_MM = 1e-9           # consecutive segments meet to this (test_path_continuity)
 
@@ -174,14 +175,14 @@ def test_one_interpolation_cycle_per_rounding_block_not_per_covered_block():
 @pytest.mark.parametrize("name", [None, "linuxcnc_xyz"])
 def test_short_segments_program_under_g642(name):
     """The corpus program lcnc_short_segments_0.001.ngc converted to SINUMERIK syntax
-    with G642 (tests/data/short_segments_g642.mpf): 3000 collinear 0.001 in blocks with
+    with G642 (converted by tests/reference/corpus_sinumerik.py): 3000 collinear 0.001 in blocks with
     two 90 degree corners. The tangential transitions are not rounded (spec 5.2 lists
     rounding only at angular transitions; G645's tangential rounding needs a curvature
     jump, 5.7), so every 0.0254 mm block stays one interpolated block; where a corner is
     rounded its window covers the short blocks within d, the path stays continuous, the
     plan keeps every limit, and it is no slower than G64."""
     mach = load_machine(name) if name else load_machine()
-    prog = parse_file(SHORT)
+    prog = parse_text(SHORT(), "short_segments_g642.mpf")
     path = build_path(prog, mach)
     t = path.rounding
     tangential = [t.reason_text(i) == "tangential transition" for i in range(t.n)]
@@ -190,7 +191,7 @@ def test_short_segments_program_under_g642(name):
     assert [s.block for s in path.blocks] == [b.index for b in prog.blocks]
     res = plan(prog, mach, path=path)
     assert res.report.ok(BOUND_SETS[res.bound_set])
-    prog64 = parse_text(SHORT.read_text().replace("G642 G17", "G64 G17"))
+    prog64 = parse_text(SHORT().replace("G642 G17", "G64 G17"))
     assert build_path(prog64, mach).rounding is None
     assert res.time_s <= plan(prog64, mach).time_s * (1 + 1e-9)
     for i in np.flatnonzero(t.inserted):

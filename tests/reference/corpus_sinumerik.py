@@ -1,0 +1,43 @@
+"""Corpus programs converted to SINUMERIK syntax at test time.
+
+``../shared/corpus/SOURCES.md`` asks that its programs are used from there and not copied
+into this repository (the ``lcnc_*`` files are GPL-2.0 data). Tests and benchmarks that
+need a LinuxCNC program in the other dialect convert it here, from the corpus file, on
+every run.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
+
+
+def short_segments_g642() -> str:
+    """``lcnc_short_segments_0.001.ngc`` (3000 collinear 0.001 in blocks along X, Y, Z at
+    F999 in/min) as a SINUMERIK program under G642.
+
+    Changes: ``G20`` -> ``G700`` (inch lengths and inch/min feeds, as G20), ``G64`` ->
+    ``G642`` (rounding with tolerances), ``( )`` comments -> ``;`` comments, tabs ->
+    spaces, axis words upper case, ``M2`` kept. The motion is unchanged.
+
+    Raises
+    ------
+    FileNotFoundError
+        The corpus is not beside the project.
+    """
+    src = (CORPUS / "lcnc_short_segments_0.001.ngc").read_text()
+    out = []
+    for line in src.splitlines():
+        line = line.replace("\t", " ").strip()
+        m = re.fullmatch(r"\((.*)\)", line)
+        if m:
+            out.append(f"; {m.group(1)}")
+            continue
+        line = re.sub(r"\bG20\b", "G700", line)
+        line = re.sub(r"\bG64\b", "G642", line)
+        line = re.sub(r"([xyz])(?=[-\d.])", lambda k: k.group(1).upper(), line)
+        line = re.sub(r"([A-Z]) +(?=[-\d.])", r"\1", line)
+        out.append(line)
+    return "\n".join(out) + "\n"
