@@ -41,10 +41,9 @@ def prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
 BOUND_CHOICES = ("auto", "acc", "jerk", "jerk+freq")
 
 
-#: Bound sets ``--bounds auto`` may pick. ``jerk`` is solved (``--bounds jerk``) but its
-#: lower bound is still the ``acc`` relaxation on curved runs and at corners crossed
-#: at speed, so its bracket is often wider than the gate's tolerance: auto stays ``acc``.
-AUTO_BOUND_SETS = ("acc",)
+#: Bound sets ``--bounds auto`` may pick: the planner's own (``acc`` for BRISK, ``jerk``
+#: for SOFT), so the gap compares like with like and both of its ends mean something.
+AUTO_BOUND_SETS = ("acc", "jerk")
 
 
 class BoundsNotAvailable(FeedOracleError, ValueError):

@@ -259,7 +259,7 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
           tol: float | None = None, backend: str = DEFAULT_BACKEND,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-          initial_intervals: int = DEFAULT_INITIAL_INTERVALS,
+          initial_intervals: int | None = None,
           progress: ProgressFn | None = None, holds: Holds | None = None) -> OptimalSolution:
     """Minimum-time motion along ``path`` with a certified lower and a verified upper bound.
 
@@ -297,8 +297,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         Largest number of grid intervals before giving up with ``"gap_not_met"``.
     max_iterations : int
         Largest number of refinement rounds.
-    initial_intervals : int
-        Target size of the initial grid.
+    initial_intervals : int, optional
+        Target size of the initial grid (default
+        :data:`~optimal.tolerances.DEFAULT_INITIAL_INTERVALS` for ``acc``,
+        :data:`~optimal.jerk.tolerances.DEFAULT_JERK_INITIAL_INTERVALS` for ``jerk``).
     progress : callable, optional
         Called as ``progress(stage_message, fraction_done)`` during refinement.
     holds : Holds, optional
@@ -336,6 +338,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         raise ValueError(f"max_grid = {max_grid!r}: must be an int >= 2")
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise ValueError(f"max_iterations = {max_iterations!r}: must be an int >= 1")
+    if initial_intervals is not None and not (isinstance(initial_intervals, int)
+                                              and initial_intervals >= 1):
+        raise ValueError(f"initial_intervals = {initial_intervals!r}: must be an int >= 1")
     if bounds == "jerk":
         # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
         from .jerk import solve_jerk
@@ -343,7 +348,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         acc_solve = partial(solve, backend=backend, backend_options=backend_options,
                             max_grid=max_grid, max_iterations=max_iterations)
         return solve_jerk(path, limits, acc_solve=acc_solve, tol=tol, progress=progress,
-                          holds=holds, initial_intervals=initial_intervals)
+                          holds=holds, **({} if initial_intervals is None
+                                          else {"initial_intervals": initial_intervals}))
     solve_fn = get_backend(backend)
     if holds is None:
         holds = dwell_holds(path)
@@ -360,6 +366,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
     lim = limits.for_axes(work.axes)
 
+    if initial_intervals is None:
+        initial_intervals = DEFAULT_INITIAL_INTERVALS
     grid = initial_grid(path, min(initial_intervals, max_grid))
     t_build = t_solve = t_check = t_bound = 0.0
     history: list[IterationRecord] = []

@@ -41,12 +41,43 @@ Why the bound holds
    back to zero acceleration (a virtual start at speed ``-a_s^2 / (2J)``). When the
    move is too short for that ramp (peak speed below ``a_s^2 / (2J)``, a few um on real
    machines) it returns the jerk-free time, a weaker bound.
-4. *Envelope on every segment* (:func:`envelope_times`): with ``v^2`` at most ``bhat``
-   at both breaks, ``|s''|`` at most the step rule's allowance there
-   (:func:`break_accelerations`), and path bounds ``V, A, J`` valid on the whole
-   segment (exact on lines; on curves from :func:`_curve_limits`), the speed cannot
-   grow faster than the fastest jerk-limited ramp from either end, which bounds the
-   distance covered in a given time from above and so the time from below.
+4. *Peak speed on every segment* (:func:`peak_times`). On a segment of length ``L``
+   take ``v <= vb0, |s''| <= as0`` at its start and ``v <= vb1, |s''| <= as1`` at its
+   end (``bhat`` at the breaks and the step rule's allowance there,
+   :func:`break_accelerations`), and path bounds ``v <= V``, ``|s''| <= A``,
+   ``|s'''| <= J`` valid on the whole segment (exact on lines; on curves from
+   :func:`_curve_limits`). First with a continuous path acceleration:
+
+   a. *End peak.* If the speed peaks at an end, ``v <= p <= max(vb0, vb1)``
+      throughout, and the speed can grow no faster than the fastest ramp
+      ``F0(t) = vb0 + int_0^t min(A, as0 + J tau)`` from the start, nor (backwards)
+      ``F1`` from the end: :func:`envelope_times` with the speed cap ``p``.
+   b. *Inside peak.* If it peaks at ``t*`` inside, at ``p`` with ``s''(t*) = 0``: at
+      every ``t < t*`` with ``s''(t) > 0`` the acceleration needs at least
+      ``s''(t) / J`` to fall to zero (it is zero at ``t*``), during which the speed
+      gains ``s''(t)^2 / (2 J)``, so ``v(t) <= p - s''(t)^2 / (2 J)``. With ``v <= F0``
+      this gives ``v(t) <= v*(t)``, the fastest rise to ``p`` with zero acceleration
+      (:func:`rise`: jerk ``+J``, a plateau at ``A``, jerk ``-J``, reaching ``p`` at
+      ``tau0(p)`` after ``d0(p)``): before its landing phase ``v* = F0``; in it
+      ``v*(t) = p - a*(t)^2 / (2J)`` with ``a*`` falling at rate ``J``, and a motion
+      with ``s''(t) >= a*(t)`` is below ``v*`` by the inequality, one with
+      ``s''(t) < a*(t)`` had ``s'' < a*`` all through the landing phase (its jerk is
+      at least ``-J``) and started it no faster. So ``t* >= tau0(p)``, the distance to
+      ``t*`` is at most ``d0(p) + p (t* - tau0(p))``, likewise from the end, and
+      ``T >= g(p) = tau0 + tau1 + max(0, L - d0 - d1) / p``. ``tau`` and ``d`` grow with
+      ``p`` and ``d' >= p tau'`` (``v*`` grows pointwise with ``p``, by the same
+      comparison), so ``g`` falls while ``d0 + d1 <= L`` and rises after: its least
+      value is at ``V`` or where ``d0 + d1 = L``.
+
+   The bound is the smaller of a and b. *Steps inside the segment*: the rulebook lets
+   the path acceleration step by ``eps`` in total inside a segment (``sqrt(n)`` times
+   the largest axis budget ``ACCEL_CONTINUITY_TOL_REL J_i T_ipo``: some axis has
+   ``|q'_i| >= 1/sqrt(n)``). Removing the steps leaves a continuous acceleration within
+   ``eps`` of ``s''`` whose speed is within ``eps t`` of ``v`` and whose distance is
+   within ``eps t^2 / 2`` of ``L``; so every motion faster than ``t_cap`` (twice the
+   step-free bound) meets the bound with ``V + eps t_cap``, ``A + eps``,
+   ``as + eps`` and ``L - eps t_cap^2 / 2``, and the bound is the smaller of that and
+   ``t_cap``. On a straight run between two stops this is the exact minimum (step 3).
 5. *Curvature-jump caps* (:func:`curvature_break_caps`): at a tangential break where the
    curvature vector jumps, the centripetal step ``dk v^2`` must fit the one-cycle
    allowance up to what a path-acceleration step can cancel; that bounds ``v^2`` there
@@ -57,10 +88,10 @@ Why the bound holds
    relaxation.
 
 Where it is loose: on arcs the path acceleration and jerk bounds of step 4 are norms
-over the axes (up to ``sqrt(n)`` above the pointwise values), and across corners crossed
-at speed and tangential joints nothing couples neighbouring segments beyond the node
-bounds; a convex relaxation of the jerk constraint itself (Consolini et al.) is not
-implemented, so the bracket on curved programs is often wider than 1 %.
+over the axes (up to ``sqrt(n)`` above the pointwise values), and neighbouring segments
+are coupled only through the node bounds and the step allowances at their common break.
+The convex relaxation of :mod:`optimal.jerk.relaxation` takes these bounds as per-segment
+floors and adds the coupling and the axis-wise jerk.
 
 Units: mm, s.
 """
@@ -75,11 +106,12 @@ from scipy.optimize import brentq
 from reference.core.geometry import Path, plane_amplitudes
 from reference.core.limits import AxisArrays
 from reference.core.rules import RELAXED, curvature_jumps, is_tangential, step_jerk_limit
-from reference.core.tolerances import VEL_TOL_MM_S
+from reference.core.tolerances import ACCEL_CONTINUITY_TOL_REL, VEL_TOL_MM_S
 
 from ..bounds import lower_bound
 from ..grid import Grid
 from .tolerances import JERK_LB_ROUNDOFF_REL
+
 
 
 def rest_to_rest_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) -> float:
@@ -233,51 +265,179 @@ def _max_fixed_rows(f, g, gamma, z_max, w_nonneg):
     return _max_fixed(f, g, gamma, z_max, w_nonneg) if out.size else out
 
 
-def envelope_times(L: np.ndarray, vb: np.ndarray, a_s: np.ndarray, V: np.ndarray,
-                   A: np.ndarray, J: np.ndarray) -> np.ndarray:
-    """Lower bound of the time to travel ``L`` on a line between two breaks (step 4 of
-    the module docstring), vectorised over segments.
+def _ramp(p: np.ndarray, vb: np.ndarray, a_s: np.ndarray, A: np.ndarray, J: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Time and distance for the fastest ramp ``F(t) = vb + int_0^t min(A, a_s + J tau)``
+    to reach the speed ``p`` (both 0 where ``p <= vb``: that end does not bind)."""
+    t1 = (A - a_s) / J
+    F1 = vb + a_s * t1 + J * t1 * t1 / 2
+    Q1 = vb * t1 + a_s * t1 * t1 / 2 + J * t1 ** 3 / 6
+    dp = np.maximum(p - vb, 0.0)
+    t_q = (-a_s + np.sqrt(a_s * a_s + 2 * J * dp)) / J
+    d = (p - F1) / A
+    t = np.where(p <= F1, t_q, t1 + d)
+    dist = np.where(p <= F1, vb * t_q + a_s * t_q * t_q / 2 + J * t_q ** 3 / 6,
+                    Q1 + F1 * d + A * d * d / 2)
+    return t, dist
 
-    Every motion with ``v <= vb`` and ``|s''| <= a_s`` at both ends, ``v <= V``,
-    ``|s''| <= A`` and ``|s'''| <= J`` has ``v(t) <= min(V, F(t), F(T - t))`` with
-    ``F(t) = vb + int_0^t min(A, a_s + J tau) dtau`` (the speed can grow no faster from
-    either end), hence ``L <= I(T) = 2 int_0^{T/2} min(V, F)``. ``I`` is increasing in
-    ``T``; bisection returns the lower end of its final bracket, where ``I < L``.
+
+def rise(p: np.ndarray, vb: np.ndarray, a0: np.ndarray, A: np.ndarray, J: np.ndarray
+         ) -> tuple[np.ndarray, np.ndarray]:
+    """Time and distance of the fastest rise to the speed ``p`` with zero acceleration
+    (step 4 of the module docstring), vectorised.
+
+    From speed ``vb`` with acceleration at most ``a0`` (``0 <= a0 <= A``), under
+    ``s'' <= A`` and ``|s'''| <= J``: jerk ``+J`` up to ``min(A, apk)``, a plateau at
+    ``A`` when needed, then jerk ``-J`` down to zero acceleration at ``p``. When even the
+    landing from ``a0`` would overshoot ``p`` it lands at once from the acceleration
+    ``sqrt(2 J (p - vb))``. Zero time and distance where ``p <= vb``.
 
     Parameters
     ----------
-    L, vb, a_s, V, A, J : numpy.ndarray, shape (k,)
-        Length (mm), boundary speed bound and speed limit (mm/s), boundary and path
-        acceleration limits (mm/s^2), jerk limit (mm/s^3).
+    p, vb, a0, A, J : numpy.ndarray, shape (k,)
+        Target and start speed (mm/s), start and largest acceleration (mm/s^2), jerk
+        (mm/s^3).
+
+    Returns
+    -------
+    tau, dist : numpy.ndarray, shape (k,)
+        Seconds and mm.
+    """
+    gain = np.maximum(p - vb, 0.0)
+    a0 = np.clip(a0, 0.0, A)
+    direct = vb + a0 * a0 / (2.0 * J) >= p
+    # landing at once: -J from a_l = sqrt(2 J gain) <= a0
+    a_l = np.sqrt(2.0 * J * gain)
+    t_l = a_l / J
+    d_l = vb * t_l + a_l * t_l * t_l / 2 - J * t_l ** 3 / 6
+    # ramp up to apk (plateau at A when apk > A), then land
+    apk = np.minimum(np.sqrt(J * gain + a0 * a0 / 2), A)
+    t1 = np.maximum(apk - a0, 0.0) / J
+    v1 = vb + a0 * t1 + J * t1 * t1 / 2
+    d1 = vb * t1 + a0 * t1 * t1 / 2 + J * t1 ** 3 / 6
+    t3 = apk / J
+    gain3 = apk * apk / (2.0 * J)
+    t2 = np.maximum(p - gain3 - v1, 0.0) / A
+    v2 = v1 + A * t2
+    d2 = v1 * t2 + A * t2 * t2 / 2
+    d3 = v2 * t3 + apk * t3 * t3 / 2 - J * t3 ** 3 / 6
+    tau = np.where(gain <= 0, 0.0, np.where(direct, t_l, t1 + t2 + t3))
+    dist = np.where(gain <= 0, 0.0, np.where(direct, d_l, d1 + d2 + d3))
+    return tau, dist
+
+
+def peak_times(L: np.ndarray, vb0: np.ndarray, vb1: np.ndarray, as0: np.ndarray,
+               as1: np.ndarray, V: np.ndarray, A: np.ndarray, J: np.ndarray,
+               eps: float | np.ndarray = 0.0) -> np.ndarray:
+    """Lower bound of the time on a segment from its peak speed (step 4 of the module
+    docstring), vectorised over segments.
+
+    Every motion whose speed peaks inside the segment, at ``p`` with zero acceleration,
+    takes ``T >= g(p) = tau0(p) + tau1(p) + max(0, L - d0(p) - d1(p)) / p`` (:func:`rise`
+    from each end); ``g`` falls while ``d0 + d1 <= L`` and rises after, so its least value
+    on ``0 < p <= V`` is at ``V`` or where ``d0 + d1 = L`` (bisection; the lower end of
+    the final bracket gives a time never above the bound). Every motion whose speed
+    peaks at an end has ``p <= max(vb0, vb1)`` (:func:`envelope_times` with that speed
+    cap). The bound is the smaller of the two. ``eps`` (mm/s^2, the segment's budget of
+    acceleration steps) enters through loosened parameters, module docstring.
+
+    Parameters
+    ----------
+    L, vb0, vb1, as0, as1, V, A, J : numpy.ndarray, shape (k,)
+        As :func:`envelope_times`.
+    eps : float or numpy.ndarray, shape (k,)
+        Acceleration steps allowed inside the segment in total, mm/s^2.
 
     Returns
     -------
     numpy.ndarray, shape (k,)
         Seconds.
     """
-    vb = np.minimum(vb, V)
-    a_s = np.clip(a_s, 0.0, A)
-    t1 = (A - a_s) / J
-    F1 = vb + a_s * t1 + J * t1 * t1 / 2
-    t_quad = (-a_s + np.sqrt(a_s * a_s + 2 * J * np.maximum(V - vb, 0.0))) / J
-    t_V = np.where(V <= F1, t_quad, t1 + (V - F1) / A)
-    Q1 = vb * t1 + a_s * t1 * t1 / 2 + J * t1 ** 3 / 6
+    eps = np.broadcast_to(np.asarray(eps, dtype=np.float64), L.shape)
 
-    def integral(T: np.ndarray) -> np.ndarray:
-        tau = np.minimum(T / 2, t_V)
-        d = tau - t1
-        q = np.where(tau <= t1, vb * tau + a_s * tau * tau / 2 + J * tau ** 3 / 6,
-                     Q1 + F1 * d + A * d * d / 2)
-        return 2.0 * (q + V * np.maximum(T / 2 - t_V, 0.0))
+    def bound(Lx, Vx, Ax, a0x, a1x):
+        vb0x, vb1x = np.minimum(vb0, Vx), np.minimum(vb1, Vx)
+        a0x, a1x = np.clip(a0x, 0.0, Ax), np.clip(a1x, 0.0, Ax)
+        # peak at an end: the speed never exceeds the larger end speed
+        Vb = np.minimum(Vx, np.maximum(vb0x, vb1x))
+        end_peak = np.where(Vb > 0, envelope_times(Lx, vb0x, vb1x, a0x, a1x,
+                                                   np.where(Vb > 0, Vb, 1.0), Ax, J),
+                            np.inf)
 
-    lo = np.zeros(L.size)
-    hi = 2.0 * t_V + L / V
+        def both(p):
+            t0, d0 = rise(p, vb0x, a0x, Ax, J)
+            t1, d1 = rise(p, vb1x, a1x, Ax, J)
+            return t0 + t1, d0 + d1
+
+        tV, dV = both(Vx)
+        lo, hi = np.zeros(Lx.size), Vx.copy()
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            short = both(mid)[1] < Lx
+            lo = np.where(short, mid, lo)
+            hi = np.where(short, hi, mid)
+        inside = np.where(dV <= Lx, tV + (Lx - dV) / Vx, both(lo)[0])
+        return np.minimum(inside, end_peak)
+
+    free = bound(L, V, A, as0, as1)
+    # steps inside the segment (module docstring): parameters loosened for every motion
+    # that takes less than t_cap, so the bound is min(t_cap, that)
+    t_cap = 2.0 * free
+    Lx = np.maximum(L - eps * t_cap ** 2 / 2, 0.0)
+    with_eps = bound(Lx, V + eps * t_cap, A + eps, as0 + eps, as1 + eps)
+    return np.where(eps > 0, np.minimum(t_cap, with_eps), free)
+
+
+def envelope_times(L: np.ndarray, vb0: np.ndarray, vb1: np.ndarray, as0: np.ndarray,
+                   as1: np.ndarray, V: np.ndarray, A: np.ndarray, J: np.ndarray
+                   ) -> np.ndarray:
+    """Lower bound of the time to travel ``L`` on a segment between two breaks (step 4
+    of the module docstring), vectorised over segments.
+
+    Every motion with ``v <= vb0``, ``|s''| <= as0`` at its start, ``v <= vb1``,
+    ``|s''| <= as1`` at its end, ``v <= V``, ``|s''| <= A`` and ``|s'''| <= J``
+    throughout has ``v(t) <= min(V, F0(t), F1(T - t))`` with ``Fe(t) = vbe +
+    int_0^t min(A, ase + J tau) dtau`` (the speed can grow no faster from either end).
+    ``F0`` rises and ``F1(T - t)`` falls in ``t``, so their minimum peaks where both
+    equal some ``p`` and the distance ``L <= I(T) = int_0^T min(V, F0, F1(T - .))`` is
+    that of the two ramps to ``p`` (plus a cruise at ``V``): with ``te(p), de(p)`` the
+    time and distance of ramp ``e`` to ``p`` (zero when ``p <= vbe``), ``T >=
+    t0(V) + t1(V) + (L - d0(V) - d1(V)) / V`` when both ramps reach ``V`` within ``L``,
+    else ``T >= t0(p) + t1(p)`` with ``d0(p) + d1(p) = L``. Both sums grow with ``p``;
+    bisection on ``p`` returns the lower end of its final bracket (distance short of
+    ``L``), so the time returned is never above the bound.
+
+    Parameters
+    ----------
+    L, vb0, vb1, as0, as1, V, A, J : numpy.ndarray, shape (k,)
+        Length (mm); speed bounds at the start, at the end and throughout (mm/s);
+        acceleration bounds at the start and at the end and throughout (mm/s^2); jerk
+        bound (mm/s^3).
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+        Seconds.
+    """
+    vb0, vb1 = np.minimum(vb0, V), np.minimum(vb1, V)
+    as0, as1 = np.clip(as0, 0.0, A), np.clip(as1, 0.0, A)
+
+    def ramps(p):
+        t0, d0 = _ramp(p, vb0, as0, A, J)
+        t1, d1 = _ramp(p, vb1, as1, A, J)
+        return t0 + t1, d0 + d1
+
+    tV, dV = ramps(V)
+    cruise = dV <= L
+    lo = np.minimum(vb0, vb1)
+    hi = V.astype(np.float64).copy()
     for _ in range(100):
         mid = 0.5 * (lo + hi)
-        short = integral(mid) < L
+        short = ramps(mid)[1] < L
         lo = np.where(short, mid, lo)
         hi = np.where(short, hi, mid)
-    return lo
+    t_peak = ramps(lo)[0]
+    return np.where(cruise, tV + np.maximum(L - dV, 0.0) / V, t_peak)
 
 
 def _line_limits(path: Path, lim: AxisArrays, seg: np.ndarray):
@@ -361,9 +521,12 @@ def segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray
     if seg.size == 0:
         return env, runs
     a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A[seg])), b_break)
-    a_s = np.maximum(a_out[seg], a_in[seg + 1])
-    vb = np.sqrt(np.maximum(np.maximum(b_break[seg], b_break[seg + 1]), 0.0))
-    env[seg] = envelope_times(path.length[seg], vb, a_s, V[seg], A[seg], J[seg])
+    vb = np.sqrt(np.maximum(b_break, 0.0))
+    # the path acceleration's steps inside a segment: axis steps are q'_i times it and
+    # some axis has |q'_i| >= 1/sqrt(n), so it steps by at most sqrt(n) max_i eps_i
+    eps = math.sqrt(len(path.axes)) * float(np.max(ACCEL_CONTINUITY_TOL_REL * lim.j_max)) * t_ipo
+    env[seg] = peak_times(path.length[seg], vb[seg], vb[seg + 1], a_out[seg],
+                          a_in[seg + 1], V[seg], A[seg], J[seg], eps)
     for r in np.flatnonzero(np.diff(stops) == 1):
         k = int(stops[r])
         if line[k] and V[k] > 0:

@@ -75,14 +75,31 @@ class UpperResult:
     message: str = ""
 
 
-def warm_start(path: Path, lim, grid: Grid, problem: JerkProblem
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Dimensionless ``(c, a, dt)`` from the ``acc`` grid optimum on ``grid``."""
+def warm_start(path: Path, lim, grid: Grid, problem: JerkProblem,
+               start: Profile | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Dimensionless ``(c, a, dt)`` to start the NLP from.
+
+    From ``start`` (a verified jerk profile on a coarser grid: its speed and acceleration
+    where it passes the new nodes, and the times between them) when given, else from the
+    ``acc`` grid optimum on ``grid``, slowed down until the node rows hold.
+    """
+    u = problem.units
+    if start is not None:
+        tn = profile_times_at(start, grid.s)
+        k = np.clip(np.searchsorted(start.t, tn, side="right") - 1, 0, start.n_intervals - 1)
+        tau = tn - start.t[k]
+        v = start.v[k] + tau * (start.a[k] + tau * start.j[k] / 2)
+        acc_n = start.a[k] + start.j[k] * tau
+        dt = np.diff(tn) / u.time_s
+        if np.all(dt > 0) and np.all(np.isfinite(dt)):
+            c = np.clip(v / u.speed, 0.0, problem.c_max)
+            a = acc_n / u.accel
+            lam = max(1.0, _row_excess(problem, c, a, dt))
+            return c / lam, a / lam ** 2, dt * lam
     acc = get_backend("fast")(build_grid_problem(path, lim, grid), None)
     if acc.b is None or acc.status not in (SolveStatus.OPTIMAL,
                                            SolveStatus.OPTIMAL_INACCURATE):
         raise RuntimeError(f"acc warm start failed: {acc.status} ({acc.message})")
-    u = problem.units
     f = WARM_START_SPEED_FRACTION
     c = f * np.sqrt(np.maximum(acc.b, 0.0)) / u.speed
     ds = problem.ds
@@ -171,7 +188,28 @@ def exact_profile(problem: JerkProblem, c: np.ndarray, a: np.ndarray, a_end: np.
     return Profile(t=t, s=problem.grid.s, v=v, a=a0, j=j, block=block)
 
 
-def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperResult:
+def profile_times_at(prof: Profile, s: np.ndarray) -> np.ndarray:
+    """Time at which a profile passes path positions ``s`` (non-decreasing), s.
+
+    Within a knot interval the position is a cubic in time, increasing where ``v > 0``:
+    a few Newton steps from the linear guess, clipped to the interval.
+    """
+    s = np.asarray(s, dtype=np.float64)
+    k = np.clip(np.searchsorted(prof.s, s, side="right") - 1, 0, prof.n_intervals - 1)
+    h = np.diff(prof.t)[k]
+    s0, v0, a0, j = prof.s[k], prof.v[k], prof.a[k], prof.j[k]
+    ds = prof.s[k + 1] - s0
+    tau = np.where(ds > 0, h * np.clip((s - s0) / np.where(ds > 0, ds, 1.0), 0.0, 1.0), 0.0)
+    for _ in range(8):
+        f = s0 + tau * (v0 + tau * (a0 / 2 + tau * j / 6)) - s
+        fp = v0 + tau * (a0 + tau * j / 2)
+        step = np.where(fp > 0, f / np.where(fp > 0, fp, 1.0), 0.0)
+        tau = np.clip(tau - step, 0.0, h)
+    return prof.t[k] + tau
+
+
+def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
+                      start: Profile | None = None) -> UpperResult:
     """Solve the jerk NLP on ``grid`` and verify its profile (see the module docstring).
 
     Parameters
@@ -182,6 +220,8 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperRes
         Machine limits.
     grid : Grid
         NLP grid.
+    start : Profile, optional
+        A verified profile from a coarser grid to start from (see :func:`warm_start`).
 
     Returns
     -------
@@ -189,7 +229,7 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid) -> UpperRes
     """
     lim = limits.for_axes(path.axes)
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
-    c0, a0, dt0 = warm_start(path, lim, grid, problem)
+    c0, a0, dt0 = warm_start(path, lim, grid, problem, start)
     nlp = solve_nlp(problem, c0, a0, dt0)
     empty = np.zeros(grid.n_intervals)
     if not nlp.success:
