@@ -42,7 +42,7 @@ from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
 
 TARGET = 1.30
-sys.path.insert(0, str(HERE.parent.parent / "reference"))
+sys.path.insert(0, str(HERE.parent / "reference"))
 from corpus_sinumerik import short_segments_g642  # noqa: E402
 
 
