@@ -37,7 +37,7 @@ it slows the program by at most that many percent.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import Callable
 
 import numpy as np
@@ -162,7 +162,10 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     replan : callable
         ``replan(units_subset_index -> ...)``: given ``(units, idx, v_nodes)`` returns the
         unit profiles of units ``idx`` with entry ``v_nodes[idx]`` and exit
-        ``v_nodes[idx + 1]``.
+        ``v_nodes[idx + 1]``; each unit's profile must depend on that unit's inputs
+        only (as :func:`reference.planner.profiles.unit_profiles` does, element by
+        element), so that the profiles of accepted bumps are spliced in without
+        planning the other units again.
 
     Returns
     -------
@@ -235,9 +238,26 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         units = replace(units, node_cap=node_cap, node_cause=node_cause)
         v[nodes] = np.minimum(v[nodes], vf_sel)
         n_bumps += int(ok.sum())
-        prof = replan(units, np.arange(units.n_units), v)
+        # a unit's profile depends on its own cap, limits and end speeds only, and the
+        # accepted units are exactly those whose cap or end speeds changed (the nodes
+        # changed are interior to accepted bumps; the bumps' end nodes are unchanged),
+        # planned above with these very caps and speeds: their rows replace the old ones
+        # (what a replan of every unit would give, element by element)
+        prof = _splice(prof, sel, p_new, np.flatnonzero(keep_u))
     speeds = replace(speeds, v=v)
     return SmoothingResult(units, speeds, prof, n_bumps, t0, float(prof.time.sum()))
+
+
+def _splice(prof: UnitProfiles, idx: np.ndarray, new: UnitProfiles, rows: np.ndarray
+            ) -> UnitProfiles:
+    """``prof`` with the profiles of units ``idx`` replaced by rows ``rows`` of ``new``
+    (shapes (k,) each)."""
+    out = {}
+    for f in fields(UnitProfiles):
+        arr = getattr(prof, f.name).copy()
+        arr[idx] = getattr(new, f.name)[rows]
+        out[f.name] = arr
+    return UnitProfiles(**out)
 
 
 def _scatter(base: np.ndarray, idx: np.ndarray, values: np.ndarray) -> np.ndarray:
