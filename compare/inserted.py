@@ -41,14 +41,13 @@ def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
     segs = np.flatnonzero(np.isin(path.kind, _INSERTED_CODES))
     if segs.size == 0:
         return {}
-    first = np.array([sp.first_segment for sp in path.blocks], dtype=np.int64)
-    nseg = np.array([sp.n_segments for sp in path.blocks], dtype=np.int64)
+    first, nseg = path.blocks.first_segment, path.blocks.n_segments
     # the span holding each segment: the last span starting at or before it with segments
     has = np.flatnonzero(nseg > 0)
     owner = has[np.searchsorted(first[has], segs, side="right") - 1]
     out: dict[int, list[int]] = {}
     for i, k in zip(owner.tolist(), segs.tolist()):
-        if path.blocks[i].kind not in INSERTED_KINDS:
+        if path.blocks.kind[i] not in INSERTED_KINDS:
             out.setdefault(i, []).append(k)
     runs = {}
     for i, v in out.items():

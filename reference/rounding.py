@@ -74,8 +74,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.geometry import (KIND_CODES, BlockSpan, Path, clothoid_pair_shape,
-                            clothoid_pieces)
+from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_pieces
 from .core.limits import AxisArrays
 from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
                             deflection_angle, distance_for_deviation, fillet_pieces)
@@ -695,8 +694,6 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     # meet tangentially and the line is dropped; a line inside a window that reaches
     # across short blocks (:func:`_across_blocks`) is covered whole and dropped too
     keep = length > MIN_SEGMENT_LENGTH_MM
-    has_arc = np.zeros(m, bool)
-    has_arc[a] = True
     n_ins = np.zeros(m, dtype=np.int64)
     n_ins[a] = np.where(g2, 2, 1)
     count = keep.astype(np.int64) + n_ins
@@ -707,8 +704,9 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
     # rows of the inserted segments: after the kept part of segment a, one or two each
     base = first[:-1][a] + keep[a]
-    arc_pos = np.concatenate([base[i:i + 1] + np.arange(k) for i, k in
-                              enumerate(n_ins[a].tolist())]) if a.size else base
+    k_ins = n_ins[a]
+    arc_pos = np.repeat(base, k_ins) + (np.arange(int(k_ins.sum()))
+                                        - np.repeat(np.cumsum(k_ins) - k_ins, k_ins))
     line_pos = first[:-1][keep]
     new = {}
     for key in ("origin", "e1", "e2", "d"):
@@ -744,22 +742,12 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         stop[int(first[k])] = True
     sb = np.concatenate(([0.0], np.cumsum(new["length"])))
     # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
-    j0 = np.fromiter((sp.first_segment for sp in path.blocks), np.int64, len(path.blocks))
-    j1 = j0 + np.fromiter((sp.n_segments for sp in path.blocks), np.int64, len(path.blocks))
-    f, e = first[j0], first[j1]
-    # spans that end before the first segment a window touches keep their segments,
-    # indices and positions (same objects); the others move (positional arguments:
-    # 10^5 spans, and keywords cost a third more)
-    touched = np.flatnonzero((trim_start > 0) | (trim_end > 0) | has_arc | ~keep)
-    n_same = int(np.searchsorted(j1, touched[0], side="right")) if touched.size else len(j0)
-    spans = list(path.blocks[:n_same]) + [
-        BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi, sp.feed_mm_s,
-                  sp.stop_reason, sp.dwell_s)
-        for sp, s0, s1, fi, ei in zip(path.blocks[n_same:], sb[f[n_same:]].tolist(),
-                                      sb[e[n_same:]].tolist(), f[n_same:].tolist(),
-                                      e[n_same:].tolist())]
+    spans = path.blocks
+    j0 = spans.first_segment
+    f, e = first[j0], first[j0 + spans.n_segments]
+    spans = spans.moved(sb[f], sb[e], f, e - f)
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
-                rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=tuple(spans),
+                rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=spans,
                 source=path.source, rounding=table, **new)
 
 

@@ -378,8 +378,9 @@ class Profile:
         numpy.ndarray, shape (n_blocks,)
             Indexed by block index (``path.blocks[i].block``), s.
         """
-        n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
-        cuts = [b.s_end for b in path.blocks if b.s_end > b.s_start]
+        spans = path.blocks
+        n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
+        cuts = spans.s_end[spans.s_end > spans.s_start]
         cut = self._cuts(cuts)
         if cut is None:
             t, s, blk = self.t, self.s, self.block
@@ -412,9 +413,9 @@ def _interval_blocks(s: np.ndarray, block: np.ndarray, path) -> np.ndarray:
     blk = np.array(block, dtype=np.int64)
     if not np.any(blk < 0) or not path.blocks:
         return blk
-    ends = np.array([b.s_end for b in path.blocks])
-    ids = np.array([b.block for b in path.blocks])
-    last = path.blocks[-1].block
+    ends = path.blocks.s_end
+    ids = path.blocks.block
+    last = int(ids[-1])
     for lo in range(0, blk.size, _LABEL_CHUNK):
         hi = min(blk.size, lo + _LABEL_CHUNK)
         part = blk[lo:hi]                       # a view: written in place

@@ -97,12 +97,10 @@ def block_motion(path: Path, profile: Profile) -> BlockMotion:
     if not spans:
         z = np.zeros(0)
         return BlockMotion(z, z, z, z)
-    idx = np.array([b.block for b in spans], dtype=np.int64)
+    idx = spans.block
     time_s = profile.block_times(path)[idx]
-    cuts = [b.s_end for b in spans if b.s_end > b.s_start]
-    prof = profile.split_at(cuts)
-    s0 = np.array([b.s_start for b in spans])
-    s1 = np.array([b.s_end for b in spans])
+    s0, s1 = spans.s_start, spans.s_end
+    prof = profile.split_at(s1[s1 > s0])
     K = prof.n_intervals
     k_dep = np.clip(np.searchsorted(prof.s, s0, side="right") - 1, 0, prof.s.size - 1)
     k_arr = np.clip(np.searchsorted(prof.s, s1, side="left"), 0, prof.s.size - 1)

@@ -433,9 +433,7 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     times = profile.block_times(path) if path.blocks else np.zeros(0)
     spans = path.blocks
     nb = len(spans)
-    first = np.array([sp.first_segment for sp in spans], dtype=np.int64)
-    nseg = np.array([sp.n_segments for sp in spans], dtype=np.int64)
-    ids = np.array([sp.block for sp in spans], dtype=np.int64)
+    first, nseg, ids = spans.first_segment, spans.n_segments, spans.block
     moving = nseg > 0
     # per block: the segment where it spends most time decides cause, mode and case
     main = first.copy()
@@ -456,14 +454,13 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
     cause_code = np.where(moving | stop_here, cause_code, -1)
     # a dwell block's whole time is its hold: the hold's own cause, not "forced stop"
-    is_dwell = np.array([sp.dwell_s > 0 and sp.n_segments == 0 for sp in spans], dtype=bool)
+    is_dwell = (spans.dwell_s > 0) & (nseg == 0)
     cause_code = np.where(is_dwell & (t_blk > 0), C.DWELL, cause_code)
     mode_code = np.where(moving, modes.mode[mainc] if m else 0, -1)
     case_code = np.where(moving, case_seg[mainc] if m else 0, -1)
     return BlockTable(
-        block=ids, line=np.array([sp.line for sp in spans], dtype=np.int64),
-        label=tuple(sp.label for sp in spans), kind=tuple(sp.kind for sp in spans),
-        length_mm=np.array([sp.s_end - sp.s_start for sp in spans], dtype=np.float64),
+        block=ids, line=spans.line, label=spans.label, kind=spans.kind,
+        length_mm=spans.s_end - spans.s_start,
         v_entry=v_entry, v_exit=v_exit, v_peak=v_pk, time_s=t_blk, cause_code=cause_code,
         mode_code=mode_code, case_code=case_code,
         hold_s=holds.per_block(int(ids.max()) + 1)[ids] if nb else np.zeros(0))
