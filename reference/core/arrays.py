@@ -54,6 +54,38 @@ def row_norms(x: np.ndarray) -> np.ndarray:
     return np.sqrt(acc, out=acc)
 
 
+def row_sums(x: np.ndarray) -> np.ndarray:
+    """``x.sum(axis=1)`` of a 2-D float array, shape (k, n) -> (k,).
+
+    The same numbers (bit for bit): columns summed in order, as numpy does for fewer
+    than 8 columns; 8 or more columns are handed to numpy.
+    """
+    x = np.asarray(x)
+    if x.ndim != 2 or x.shape[1] >= _SEQUENTIAL_SUM_COLUMNS or x.shape[1] == 0 \
+            or x.dtype != np.float64:
+        return x.sum(axis=1)
+    acc = x[:, 0].copy()
+    for j in range(1, x.shape[1]):
+        acc += x[:, j]
+    return acc
+
+
+def row_dots(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``numpy.sum(x * y, axis=1)`` of two 2-D arrays of one shape, (k, n) -> (k,).
+
+    The same numbers (bit for bit): products summed in column order, as numpy does for
+    fewer than 8 columns; 8 or more columns are handed to numpy.
+    """
+    x, y = np.asarray(x), np.asarray(y)
+    if x.ndim != 2 or x.shape != y.shape or x.shape[1] >= _SEQUENTIAL_SUM_COLUMNS \
+            or x.shape[1] == 0 or x.dtype != np.float64 or y.dtype != np.float64:
+        return np.sum(x * y, axis=1)
+    acc = x[:, 0] * y[:, 0]
+    for j in range(1, x.shape[1]):
+        acc += x[:, j] * y[:, j]
+    return acc
+
+
 def row_min(x: np.ndarray) -> np.ndarray:
     """``x.min(axis=1)`` of a 2-D array with at least one column, shape (k, n) -> (k,)."""
     x = np.asarray(x)

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.arrays import row_sums
 from ..core.errors import InfeasibleError
 from .parameters import CAUSE_REL_TOL, DISTANCE_REL_TOL, PEAK_SOLVE_ITERATIONS
 
@@ -400,17 +401,17 @@ class UnitProfiles:
     @property
     def time(self) -> np.ndarray:
         """Total time of each unit, s, shape (n,)."""
-        return self.duration.sum(axis=1)
+        return row_sums(self.duration)
 
     @property
     def rise_time(self) -> np.ndarray:
         """Duration of the rise process of each unit, s."""
-        return self.duration[:, :3].sum(axis=1)
+        return row_sums(self.duration[:, :3])
 
     @property
     def fall_time(self) -> np.ndarray:
         """Duration of the fall process of each unit, s."""
-        return self.duration[:, 4:].sum(axis=1)
+        return row_sums(self.duration[:, 4:])
 
 
 def _ramp_phases(dv, acc, jerk):

@@ -171,11 +171,20 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     -------
     SmoothingResult
     """
-    t0 = float(prof.time.sum())
+    time_u = prof.time                  # per unit, s (kept up to date below)
+    t0 = float(time_u.sum())
     n_bumps = 0
     if factor_pct <= 0.0 or rounds <= 0 or units.n_units == 0:
         return SmoothingResult(units, speeds, prof, 0, t0, t0)
     v = speeds.v.copy()
+    u = units.n_units
+    s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
+    # bumps rejected in an earlier round, as keys a (u + 1) + b: a bump whose units have
+    # not changed since is the same question with the same answer (same caps, speeds,
+    # profiles and frequency), so it is not planned again; a change to any of its units
+    # forgets it
+    rejected = np.zeros(0, dtype=np.int64)
+    owned = False                       # prof's arrays are copies this stage may write
     for _ in range(rounds):
         valleys = find_valleys(prof)
         if valleys.size < 2:
@@ -184,7 +193,7 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         rise, _ = _moves(prof)
         n_rise = np.concatenate(([0], np.cumsum(rise)))
         has_rise = (n_rise[b] - n_rise[a]) > 0
-        t_cum = np.concatenate(([0.0], np.cumsum(prof.time)))
+        t_cum = np.concatenate(([0.0], np.cumsum(time_u)))
         t_bump = t_cum[b] - t_cum[a]
         f_bump = np.minimum.reduceat(units.frequency[: b[-1]], a)
         with np.errstate(divide="ignore"):
@@ -193,11 +202,12 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         v_flat_all = np.maximum(v[a], v[b])
         # capped, no speed in the bump exceeds v_flat: it takes at least L / v_flat, so a
         # bump whose bound already costs more than the factor is rejected unplanned
-        s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
         with np.errstate(divide="ignore", invalid="ignore"):
             t_low = (s_node[b] - s_node[a]) / v_flat_all
         affordable = t_low - t_bump <= factor_pct / 100.0 * t_bump * (1.0 + 1e-9)
         cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0) & affordable)
+        if rejected.size and cand.size:
+            cand = cand[~np.isin(a[cand] * (u + 1) + b[cand], rejected)]
         if cand.size == 0:
             break
         v_flat = np.maximum(v[a[cand]], v[b[cand]])
@@ -209,12 +219,15 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         new_cap = np.minimum(units.cap[uidx], vf_u)
         v_new = v.copy()
         nidx = uidx[uidx > 0]
-        v_new[nidx] = np.minimum(v_new[nidx], np.repeat(v_flat, counts)[uidx > 0])
-        trial = units.with_caps(_scatter(units.cap, uidx, new_cap), units.cap_cause)
+        v_new[nidx] = np.minimum(v_new[nidx], vf_u[uidx > 0])
+        # the trial plans units ``uidx`` only, from their caps (node caps unused)
+        trial = replace(units, cap=_scatter(units.cap, uidx, new_cap))
         p_new = replan(trial, uidx, v_new)
         starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
-        t_new = np.add.reduceat(p_new.time, starts)
+        t_new_u = p_new.time
+        t_new = np.add.reduceat(t_new_u, starts)
         ok = t_new - t_bump[cand] <= factor_pct / 100.0 * t_bump[cand]
+        rejected = np.concatenate((rejected, a[cand[~ok]] * (u + 1) + b[cand[~ok]]))
         if not ok.any():
             break
         keep_u = np.repeat(ok, counts)
@@ -243,21 +256,24 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         # changed are interior to accepted bumps; the bumps' end nodes are unchanged),
         # planned above with these very caps and speeds: their rows replace the old ones
         # (what a replan of every unit would give, element by element)
-        prof = _splice(prof, sel, p_new, np.flatnonzero(keep_u))
+        rows = np.flatnonzero(keep_u)
+        if not owned:
+            prof = UnitProfiles(**{f.name: getattr(prof, f.name).copy()
+                                   for f in fields(UnitProfiles)})
+            time_u = time_u.copy()
+            owned = True
+        for f in fields(UnitProfiles):
+            getattr(prof, f.name)[sel] = getattr(p_new, f.name)[rows]
+        time_u[sel] = t_new_u[rows]
+        # rejected bumps that share a unit with an accepted one are open again
+        if rejected.size:
+            touched = np.zeros(u + 1, dtype=np.int64)
+            touched[sel + 1] = 1
+            np.cumsum(touched, out=touched)
+            ra, rb = rejected // (u + 1), rejected % (u + 1)
+            rejected = rejected[touched[rb] == touched[ra]]
     speeds = replace(speeds, v=v)
-    return SmoothingResult(units, speeds, prof, n_bumps, t0, float(prof.time.sum()))
-
-
-def _splice(prof: UnitProfiles, idx: np.ndarray, new: UnitProfiles, rows: np.ndarray
-            ) -> UnitProfiles:
-    """``prof`` with the profiles of units ``idx`` replaced by rows ``rows`` of ``new``
-    (shapes (k,) each)."""
-    out = {}
-    for f in fields(UnitProfiles):
-        arr = getattr(prof, f.name).copy()
-        arr[idx] = getattr(new, f.name)[rows]
-        out[f.name] = arr
-    return UnitProfiles(**out)
+    return SmoothingResult(units, speeds, prof, n_bumps, t0, float(time_u.sum()))
 
 
 def _scatter(base: np.ndarray, idx: np.ndarray, values: np.ndarray) -> np.ndarray:

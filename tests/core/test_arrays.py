@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reference.core.arrays import row_any, row_argmin, row_max, row_min, row_norms
+from reference.core.arrays import (row_any, row_argmin, row_dots, row_max, row_min,
+                                   row_norms, row_sums)
 
 COLUMNS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 12)
 
@@ -37,6 +38,23 @@ def test_row_norms_equal_numpy_bit_for_bit(n, seed):
     np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=-1))
     y = x[:, ::-1]                               # not contiguous
     np.testing.assert_array_equal(row_norms(y), np.linalg.norm(y, axis=-1))
+
+
+@pytest.mark.parametrize("n", COLUMNS)
+@pytest.mark.parametrize("seed", range(3))
+def test_row_sums_equal_numpy_bit_for_bit(n, seed):
+    x = data(n, seed)
+    with np.errstate(invalid="ignore"):                   # inf - inf
+        np.testing.assert_array_equal(row_sums(x), x.sum(axis=1))
+        np.testing.assert_array_equal(row_sums(x[:, ::-1]), x[:, ::-1].sum(axis=1))
+
+
+@pytest.mark.parametrize("n", COLUMNS)
+@pytest.mark.parametrize("seed", range(3))
+def test_row_dots_equal_numpy_bit_for_bit(n, seed):
+    x, y = data(n, seed), data(n, seed + 10)[::-1]
+    with np.errstate(invalid="ignore", over="ignore"):     # inf * 0, huge * huge
+        np.testing.assert_array_equal(row_dots(x, y), np.sum(x * y, axis=1))
 
 
 @pytest.mark.parametrize("n", COLUMNS)
