@@ -74,6 +74,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .core.arrays import row_dots, row_max, row_min, row_norms
 from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_pieces
 from .core.limits import AxisArrays
 from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
@@ -117,6 +118,9 @@ _ALL_MODES = ROUNDING_MODES + _RADIUS_MODES
 #: the decision uses the default, not the parameter of a particular plan.
 CENTRIPETAL_SHARE = 0.75
 
+#: Group-10 and acceleration modes as fixed-width strings (the longest is 5 characters).
+_MODE_DTYPE = "U8"
+
 _LINE = KIND_CODES.index("line")
 _ROUNDING = KIND_CODES.index("rounding")
 
@@ -147,12 +151,14 @@ def _block_attributes(program: Program, default_accel: str) -> dict[str, np.ndar
             uniq.append(md)
         code[i] = j
     rnd = np.array([blk.extra.rnd_mm for blk in blocks], dtype=np.float64)
-    mode = np.array([md.continuous_mode for md in uniq], dtype=object)[code]
+    # fixed-width strings: numpy compares them in C (object arrays per element)
+    mode = np.array([md.continuous_mode for md in uniq], dtype=_MODE_DTYPE)[code]
     rndm = np.array([md.rndm_mm for md in uniq], dtype=np.float64)[code]
-    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode))
+    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode)).astype(_MODE_DTYPE)
     return {
         "mode": mode,
-        "accel": np.array([md.accel_mode or default_accel for md in uniq], dtype=object)[code],
+        "accel": np.array([md.accel_mode or default_accel for md in uniq],
+                          dtype=_MODE_DTYPE)[code],
         "adis": np.array([md.adis_mm for md in uniq], dtype=np.float64)[code],
         "adispos": np.array([md.adispos_mm for md in uniq], dtype=np.float64)[code],
         "ctol": np.array([np.nan if md.contour_tol_mm is None else md.contour_tol_mm
@@ -192,7 +198,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     brk = cand + 1                        # break index of each corner
     ka, kb = path.block[a], path.block[b]
     mode_arr = attrs["mode"][ka]
-    mode = tuple(mode_arr)
+    mode = tuple(mode_arr.tolist())
     reason = np.full(a.size, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
@@ -205,15 +211,15 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
     is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
     da, db = path.d[a], path.d[b]
-    geo_a = np.where(path.kind[a] == _LINE, np.linalg.norm(da[:, geo], axis=1) > MOVING_AXIS_TOL,
-                     True)
-    geo_b = np.where(path.kind[b] == _LINE, np.linalg.norm(db[:, geo], axis=1) > MOVING_AXIS_TOL,
-                     True)
+    geo_a = np.where(path.kind[a] == _LINE, row_norms(da[:, geo]) > MOVING_AXIS_TOL, True)
+    geo_b = np.where(path.kind[b] == _LINE, row_norms(db[:, geo]) > MOVING_AXIS_TOL, True)
     decide(geo_a != geo_b, "geometry axes move in one block only")
     # --- model limits of this version ------------------------------------------------
     decide(~is_line, "arc transition: rounding not modelled yet")
-    other = (np.abs(da[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL) | (
-        np.abs(db[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL)
+    other = np.zeros(a.size, bool)
+    if not geo.all():
+        other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
+            row_max(np.abs(db[:, ~geo])) > MOVING_AXIS_TOL)
     decide(other, "non-geometry axes move: rounding not modelled yet")
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
     decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
@@ -249,9 +255,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         o = np.flatnonzero(open_)
         v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
         feed = np.minimum(path.feed[a[o]], path.feed[b[o]])
+        t_abs = np.maximum(np.abs(t1[o]), np.abs(t2[o]))
         with np.errstate(divide="ignore"):
-            v_axis = np.min(lim.v_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
+            v_axis = row_min(lim.v_max[None, :] / t_abs)
         v_prog = np.minimum(feed, v_axis)
         soft = attrs["accel"][ka[o]] == "SOFT"
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
@@ -263,10 +269,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         sub[:] = False
         with np.errstate(divide="ignore"):
-            a_path = np.min(lim.a_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
-            j_path = np.min(lim.j_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
+            a_path = row_min(lim.a_max[None, :] / t_abs)
+            j_path = row_min(lim.j_max[None, :] / t_abs)
         j_path = np.where(soft, j_path, np.inf)
         # against passing at the programmed speed (the stretch form of the estimate,
         # ``half`` = half of the shorter neighbouring block, rounded more corners whose
@@ -309,22 +313,23 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     ra, rb = path.rapid[a], path.rapid[b]
     adis, adispos, ctol = attrs["adis"][ka], attrs["adispos"][ka], attrs["ctol"][ka]
     radius = attrs["radius"][ka]
-    # how each corner's distance is found: "adis", "tol" (MD33100 per axis and maybe a
-    # contour tolerance), "radius" (RND/RNDM) or "none" (not modelled)
-    how = np.full(k, "none", dtype=object)
+    # how each corner's distance is found: ADIS, TOL (MD33100 per axis and maybe a
+    # contour tolerance), RADIUS (RND/RNDM) or NONE (not modelled)
+    NONE, ADIS, TOL, RADIUS = 0, 1, 2, 3
+    how = np.full(k, NONE, dtype=np.int8)
     contour = np.full(k, np.inf)
     use_axis_tol = np.ones(k, bool)
-    how[np.isin(mode, _RADIUS_MODES)] = "radius"
-    how[mode == "G641"] = "adis"
+    how[np.isin(mode, _RADIUS_MODES)] = RADIUS
+    how[mode == "G641"] = ADIS
     dig644 = _digit(sm, 3)
-    how[mode == "G644"] = "adis" if dig644 in (1, 5) else "tol" if dig644 in (0, 4) else "none"
+    how[mode == "G644"] = ADIS if dig644 in (1, 5) else TOL if dig644 in (0, 4) else NONE
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
         sel = mode == md
         dig = _digit(sm, place)
         if dig == 4:
-            how[sel] = "adis"
+            how[sel] = ADIS
             continue
-        how[sel] = "tol"
+        how[sel] = TOL
         has_ctol = sel & ~np.isnan(ctol)           # CTOL overrides MD/SD values (5.7)
         contour[has_ctol], use_axis_tol[has_ctol] = ctol[has_ctol], False
         if dig in (1, 3):
@@ -333,13 +338,13 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.zeros(k)
     # G641-type: ADIS for G1/G2/G3, ADISPOS for G0, the smaller if one block is G0 (5.3)
     dist = np.where(ra & rb, adispos, np.where(ra | rb, np.minimum(adis, adispos), adis))
-    is_adis = how == "adis"
+    is_adis = how == ADIS
     decide(is_adis & (dist <= 0) & ((ra & rb) | ((ra | rb) & (adispos <= adis))),
            "rounding not parameterised (ADISPOS = 0)")
     decide(is_adis & (dist <= 0), "rounding not parameterised (ADIS = 0)")
     d = np.where(is_adis, dist, d)
     # tolerance type (5.4): per-axis MD33100 on the axes it applies to, contour tolerance
-    is_tol = how == "tol"
+    is_tol = how == TOL
     if is_tol.any():
         tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
@@ -350,9 +355,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
                          distance_for_deviation(theta, np.maximum(dev, 0.0)))
         d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
-    d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
-    decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
-    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == "tol")
+    d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
+    decide(how == NONE, "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
+    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
     return np.where(np.isfinite(d), d, 0.0), multi
 
 
@@ -376,8 +381,7 @@ def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarr
     blk = path.block
     line = path.kind == _LINE
     ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
-    # fixed-width strings compare in C; the object arrays would compare per element
-    mode, accel = attrs["mode"].astype("U8"), attrs["accel"].astype("U8")
+    mode, accel = attrs["mode"], attrs["accel"]
     ok &= mode[blk[:-1]] == mode[blk[1:]]
     ok &= accel[blk[:-1]] == accel[blk[1:]]
     ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
@@ -462,7 +466,7 @@ def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
     cnt = hi - lo + 1
     owner = np.repeat(np.arange(lo.size), cnt)
     flat = lo[owner] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-    np.maximum.at(out, owner, np.linalg.norm(path.d[flat] - path.d[ref[owner]], axis=1))
+    np.maximum.at(out, owner, row_norms(path.d[flat] - path.d[ref[owner]]))
     return out
 
 
@@ -587,27 +591,37 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _S
     """
     kappa, sharp, piece = shape.kappa[o], shape.sharp[o], shape.piece[o]
     clo = sharp > 0
-    normal = t2 - np.sum(t2 * t1, axis=1)[:, None] * t1
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    normal = t2 - row_dots(t2, t1)[:, None] * t1
+    normal /= row_norms(normal)[:, None]
     rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
-    q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
     with np.errstate(divide="ignore", invalid="ignore"):
         a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
         w = np.where(rho > 0, rho, 1.0)
-        v_c = np.where(rho > 0, np.sqrt(a_c / (w * kappa[:, None])), np.inf).min(axis=1)
-        v_j = np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
-                                        / (w * q3[:, None])), np.inf).min(axis=1)
-    v_ipo = piece / t_ipo
+        v_c = row_min(np.where(rho > 0, np.sqrt(a_c / (w * kappa[:, None])), np.inf))
+    out = np.minimum(v_c, piece / t_ipo)
+    sel = np.flatnonzero(soft)                      # the SOFT rules, on those corners only
+    if sel.size == 0:
+        return out
+    kappa, sharp, clo, rho, w = kappa[sel], sharp[sel], clo[sel], rho[sel], w[sel]
+    q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_j = row_min(np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
+                                                / (w * q3[:, None])), np.inf))
     # the arc's curvature vector jumps from 0 to kappa n at the start and from the
-    # rotated normal to 0 at the end (same magnitude per axis bounded by rho kappa)
-    k_end = (normal * np.cos(theta)[:, None] - t1 * np.sin(theta)[:, None]) * kappa[:, None]
-    zero = np.zeros_like(t1)
-    v_k = np.minimum(
-        curvature_jump_speed_cap(zero, normal * kappa[:, None], lim.path_trans_jerk, t_ipo),
-        curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
-    v_k = np.where(clo, np.inf, v_k)
-    out = np.minimum(v_c, v_ipo)
-    return np.where(soft, np.minimum(out, np.minimum(v_j, v_k)), out)
+    # rotated normal to 0 at the end (same magnitude per axis bounded by rho kappa); a
+    # clothoid pair has none
+    v_k = np.full(sel.size, np.inf)
+    arc = np.flatnonzero(~clo)
+    if arc.size:
+        i = sel[arc]
+        nrm, ka, th = normal[i], kappa[arc][:, None], theta[i]
+        k_end = (nrm * np.cos(th)[:, None] - t1[i] * np.sin(th)[:, None]) * ka
+        zero = np.zeros_like(nrm)
+        v_k[arc] = np.minimum(
+            curvature_jump_speed_cap(zero, nrm * ka, lim.path_trans_jerk, t_ipo),
+            curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
+    out[sel] = np.minimum(out[sel], np.minimum(v_j, v_k))
+    return out
 
 
 def _inserted_rows(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.ndarray,

@@ -61,6 +61,7 @@ from typing import Literal
 
 import numpy as np
 
+from .arrays import row_dots, row_norms
 from .errors import PathError
 from .rounding import RoundingTable
 from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
@@ -300,12 +301,11 @@ def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
     """
     k = half_length.size
     n = start.shape[1]
-    theta = 2.0 * np.arctan2(np.linalg.norm(t_out - t_in, axis=1),
-                             np.linalg.norm(t_out + t_in, axis=1))
+    theta = 2.0 * np.arctan2(row_norms(t_out - t_in), row_norms(t_out + t_in))
     c = theta / half_length ** 2
     kmax = theta / half_length
-    nor = t_out - np.sum(t_out * t_in, axis=1)[:, None] * t_in
-    nor /= np.linalg.norm(nor, axis=1)[:, None]
+    nor = t_out - row_dots(t_out, t_in)[:, None] * t_in
+    nor /= row_norms(nor)[:, None]
     # the end: by symmetry about the bisector, the chord from start to end is
     # 2 L_s (Fx cos(theta/2) + Fy sin(theta/2)) along the mean direction
     scale = np.sqrt(np.pi / c)
@@ -314,8 +314,8 @@ def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
     d = X + Y * np.tan(theta / 2.0)                    # tangent distance to the corner
     corner = start + d[:, None] * t_in
     end = corner + d[:, None] * t_out
-    back_n = -t_in + np.sum(t_in * t_out, axis=1)[:, None] * t_out
-    back_n /= np.linalg.norm(back_n, axis=1)[:, None]
+    back_n = -t_in + row_dots(t_in, t_out)[:, None] * t_out
+    back_n /= row_norms(back_n)[:, None]
     origin = np.empty((2 * k, n))
     e1 = np.empty((2 * k, n))
     e2 = np.empty((2 * k, n))
