@@ -1148,6 +1148,24 @@ class Path:
                                        self.dradius, self.length, self.sharpness)
         return k_in, k_out
 
+    def junction_derivatives(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`junction_tangents` and :meth:`junction_curvatures` of every interior
+        break from one evaluation of each side: ``(t_in, t_out, k_in, k_out)``, each
+        shape (m - 1, n)."""
+        m = self.n_segments
+        if m < 2:
+            z = np.zeros((0, self.n_axes))
+            return z, z, z, z
+        idx_in = np.arange(m - 1)
+        _, t_in, k_in, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
+                                         self.omega, self.theta0, idx_in, self.length[:-1],
+                                         self.dradius, self.length, self.sharpness)
+        _, t_out, k_out, _ = _eval_helical(self.origin, self.e1, self.e2, self.d,
+                                           self.radius, self.omega, self.theta0, idx_in + 1,
+                                           np.zeros(m - 1), self.dradius, self.length,
+                                           self.sharpness)
+        return t_in, t_out, k_in, k_out
+
     def block_of(self, s: np.ndarray | float) -> np.ndarray:
         """NC block index at each global path position (segment rule ``side="right"``)."""
         return self.block[self.segment_index(s)]

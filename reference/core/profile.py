@@ -393,12 +393,26 @@ class Profile:
         del s, blk
         return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
 
-    def segment_times(self, path) -> np.ndarray:
-        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s."""
-        prof = self.split_at(path.s_breaks)
+    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
+        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
+
+        ``segments`` (int array, optional): only these are wanted; the profile is then
+        split at their own breaks only and the other entries are 0. A segment's
+        intervals are those between its two breaks either way, with the same knots, so
+        its time is the same number.
+        """
+        if segments is None:
+            prof = self.split_at(path.s_breaks)
+        else:
+            segments = np.asarray(segments, dtype=np.int64)
+            prof = self.split_at(path.s_breaks[np.union1d(segments, segments + 1)])
         moving = prof.s[1:] > prof.s[:-1]
         mid = 0.5 * (prof.s[:-1] + prof.s[1:])
         seg = path.segment_index(mid)
+        if segments is not None:
+            wanted = np.zeros(path.n_segments, dtype=bool)
+            wanted[segments] = True
+            moving &= wanted[seg]
         return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
                            minlength=path.n_segments)
 

@@ -176,8 +176,7 @@ def junction_limits(path: Path, lim: AxisArrays, t_ipo: float, modes: SegmentMod
     JunctionLimits
     """
     m = path.n_segments
-    t_in, t_out = path.junction_tangents()
-    k_in, k_out = path.junction_curvatures()
+    t_in, t_out, k_in, k_out = path.junction_derivatives()
     tangential = is_tangential(t_in, t_out, FEASIBLE)
     x = _Inputs(path=path, lim=lim, t_ipo=t_ipo, modes=modes, seg=seg, t_in=t_in,
                 t_out=t_out, k_in=k_in, k_out=k_out, tangential=tangential)

@@ -355,6 +355,12 @@ def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarr
     return idx[hit[first_hit]]
 
 
+def _group_members(lo: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """All indices of the contiguous groups ``[lo, lo + n)``, in order, shape (sum(n),)."""
+    starts = np.cumsum(n) - n
+    return np.repeat(lo, n) + (np.arange(int(n.sum())) - np.repeat(starts, n))
+
+
 class _SegmentRows(NamedTuple):
     """Per-segment and per-break results the block rows are made of (shapes (m,) and
     (m + 1,)), kept apart so that the planning units can be freed before them."""
@@ -439,7 +445,9 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     main = first.copy()
     multi = np.flatnonzero(nseg > 1)
     if multi.size:
-        main[multi] = _group_argmax(profile.segment_times(path), first[multi], nseg[multi])
+        segs = _group_members(first[multi], nseg[multi])
+        main[multi] = _group_argmax(profile.segment_times(path, segs), first[multi],
+                                    nseg[multi])
     mainc = np.clip(main, 0, max(m - 1, 0))
     t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
     kb = np.clip(first, 0, m)
