@@ -49,9 +49,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
    junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
    and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
-   TRUE skips it, G643 and G644 never make it); every mode rounds only when the
-   rounding is estimated to pass the corner in less time than G64
-   (:func:`corner_time_loss`, jerk-limited ramps under SOFT), with ``v_round``
+   TRUE skips it, G643 and G644 never make it); every mode but RND/RNDM rounds only
+   when the rounding is estimated to pass the corner in less time than G64
+   (:func:`corner_time_loss`: ramps on each line to its own programmed speed, BRISK or
+   jerk-limited, a stop costing its ramps), with ``v_round``
    (:func:`_rounding_speed`) = min of the centripetal limit at the largest curvature,
    the one-IPO-cycle limit per inserted block (5.3: "about ADIS/T_ipo"), under SOFT the
    in-rounding jerk limit and, on the arc only, the curvature-jump limit of the shared
@@ -254,12 +255,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     if open_.any():
         o = np.flatnonzero(open_)
         v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
-        feed = np.minimum(path.feed[a[o]], path.feed[b[o]])
-        t_abs = np.maximum(np.abs(t1[o]), np.abs(t2[o]))
-        with np.errstate(divide="ignore"):
-            v_axis = row_min(lim.v_max[None, :] / t_abs)
-        v_prog = np.minimum(feed, v_axis)
         soft = attrs["accel"][ka[o]] == "SOFT"
+        # per line: programmed speed (feed, axis velocities), acceleration, jerk
+        a1, a2 = np.abs(t1[o]), np.abs(t2[o])
+        with np.errstate(divide="ignore"):
+            v_in = np.minimum(path.feed[a[o]], row_min(lim.v_max[None, :] / a1))
+            v_out = np.minimum(path.feed[b[o]], row_min(lim.v_max[None, :] / a2))
+            acc_in = row_min(lim.a_max[None, :] / a1)
+            acc_out = row_min(lim.a_max[None, :] / a2)
+            j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
+            j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
+        v_prog = np.minimum(v_in, v_out)
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
@@ -268,17 +274,10 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         sub[o] = ovl & (v64[o] >= v_prog)
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         sub[:] = False
-        with np.errstate(divide="ignore"):
-            a_path = row_min(lim.a_max[None, :] / t_abs)
-            j_path = row_min(lim.j_max[None, :] / t_abs)
-        j_path = np.where(soft, j_path, np.inf)
-        # against passing at the programmed speed (the stretch form of the estimate,
-        # ``half`` = half of the shorter neighbouring block, rounded more corners whose
-        # rounding the heuristic then planned slower, on both bundled machines, BRISK
-        # and SOFT: measured on the bench polylines, so the classic form decides)
-        sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, shape.length[o], 2 * d[o],
-                                    j_path)
-                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0, j_path)
+        sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
+                                    shape.length[o], d[o])
+                   < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
+                                      0.0, 0.0)
                    ) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
@@ -470,62 +469,62 @@ def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
     return out
 
 
-def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarray,
-                     inserted: np.ndarray | float, replaced: np.ndarray | float,
-                     j_path: np.ndarray | float = np.inf,
-                     half: np.ndarray | float = np.inf) -> np.ndarray:
-    """Estimated time to pass a corner and the stretch ``half`` before and after it, s.
+def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
+                     a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
+                     j_out: np.ndarray, inserted: np.ndarray | float,
+                     replaced: np.ndarray | float) -> np.ndarray:
+    """Time a corner passed at ``v_corner`` costs against passing it at the programmed
+    speeds, s: the decision's estimate of "rounding would slow the program down"
+    (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
+    the heuristic then plans whichever contour results exactly.
 
-    Each side: the speed rises from the corner speed ``v`` over the ``x = half -
-    replaced / 2`` of straight line left beside the corner (or the rounding) to
-    ``v_pk = min(v_p, v + dv_max(x))`` and costs the ramp's duration ``T`` plus the rest
-    of ``x`` at ``v_pk``; a ramp that is symmetric in time covers ``(v_pk + v) T / 2``.
-    ``T = dv / a`` at the constant path acceleration ``a`` (BRISK); with the path jerk
-    ``j`` (SOFT) ``T = dv / a + a / j`` where the ramp reaches ``a`` (``dv >= a^2 / j``),
-    else ``2 sqrt(dv / j)``. ``dv_max(x)`` is the gain over ``x`` from ``v``:
-    ``sqrt(v^2 + a x) - v`` (BRISK over half of ``x``, the other half left for the next
-    corner's braking) and, with jerk, at most ``(x sqrt(j))^(2/3)`` (an S-ramp by ``dv``
-    covers at least ``dv T / 2 = dv^1.5 / sqrt(j)``). A rounding of length ``l`` adds
-    ``l / v`` (a SOFT profile crosses its ends at zero path acceleration, so it stays
-    near ``v`` on it). This is the model's reading of "rounding would slow the program
-    down" (5.2 group 2), also "between two very short blocks": an estimate for the
-    decision only; the heuristic then plans whichever contour results exactly.
+    Each side ``i`` (the line before, with programmed speed ``v_in``, and the one after,
+    ``v_out``) ramps between the corner speed ``v = min(v_corner, v_in, v_out)`` and its
+    programmed speed ``v_i``: the ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
+    a_i / j_i`` (SOFT, where it reaches ``a_i``: ``dv_i >= a_i^2 / j_i``) or ``2 sqrt(dv_i
+    / j_i)``, and is symmetric in time, so it covers ``(v + v_i) T_i / 2`` and costs
+    ``T_i dv_i / (2 v_i)`` more than that distance at ``v_i``. A rounding of length ``l``
+    adds ``l / v`` (it is passed at about ``v``: a SOFT profile crosses its ends at zero
+    path acceleration) and removes ``replaced`` of each line, which would have been
+    passed at ``v_i``. Per side because the two lines may have other programmed speeds
+    (a G0 into a G1 at a low feed: the rounding runs at the lower, the replaced stretch
+    of the G0 at rapid speed).
 
     Parameters
     ----------
-    v_prog, v_corner, a_path : numpy.ndarray, shape (k,)
-        mm/s, mm/s, mm/s^2.
-    inserted, replaced : numpy.ndarray or float
-        Rounding length ``l`` and the replaced contour length ``2 d``, mm (0 for G64).
-    j_path : numpy.ndarray or float
-        Path jerk, mm/s^3 (``inf``: no jerk limit, BRISK).
-    half : numpy.ndarray or float
-        Length of the stretch on each side of the corner, mm (``inf``: the programmed
-        speed is reached; the function then returns the classic loss against passing at
-        ``v_p``: ``(v_p - v)^2 / (a v_p)`` for BRISK, plus ``l / v - 2 d / v_p``).
+    v_in, v_out : numpy.ndarray, shape (k,)
+        Programmed path speed of the line before and after (feed, axis velocities),
+        mm/s.
+    v_corner : numpy.ndarray, shape (k,)
+        Speed at the corner (G64: the corner rule; rounding: the rounding's speed), mm/s.
+    a_in, a_out : numpy.ndarray, shape (k,)
+        Path acceleration of each line, mm/s^2.
+    j_in, j_out : numpy.ndarray, shape (k,)
+        Path jerk of each line, mm/s^3 (``inf``: BRISK).
+    inserted : numpy.ndarray or float
+        Rounding length ``l``, mm (0 for G64).
+    replaced : numpy.ndarray or float
+        Length cut from each line, mm (the tangent distance ``d``; 0 for G64).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
+        s; ``inf`` for a rounding that would be passed at no speed.
     """
-    v = np.minimum(v_corner, v_prog)
+    v = np.minimum(v_corner, np.minimum(v_in, v_out))
+    inserted = np.asarray(inserted, dtype=np.float64)
+    total = np.zeros(np.shape(v))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        x = np.maximum(np.asarray(half, dtype=np.float64) - np.asarray(replaced) / 2.0, 0.0)
-        gain = np.minimum(np.sqrt(v * v + a_path * x) - v, np.cbrt((x * x) * j_path))
-        v_pk = np.minimum(v_prog, v + gain)
-        dv = np.maximum(v_pk - v, 0.0)
-        reach = dv * j_path >= a_path * a_path
-        T = np.where(reach, dv / a_path + a_path / j_path, 2.0 * np.sqrt(dv / j_path))
-        T = np.where(dv > 0, T, 0.0)
-        path = np.where(np.asarray(inserted) > 0, np.asarray(inserted) / v, 0.0)
-        finite = np.isfinite(x)
-        # the time beyond covering the stretch at v_pk (for an infinite stretch, at v_p)
-        side = T * dv / (2.0 * np.where(v_pk > 0, v_pk, 1.0))
-        stretch = np.where(finite, 2.0 * (T + np.maximum(x - (v_pk + v) * T / 2.0, 0.0)
-                                          / np.where(v_pk > 0, v_pk, 1.0)),
-                           2.0 * side - np.where(np.isfinite(v_prog),
-                                                 np.asarray(replaced) / v_prog, 0.0))
-    return np.where(v > 0, stretch + path, np.inf)
+        for v_p, a, j in ((v_in, a_in, j_in), (v_out, a_out, j_out)):
+            dv = np.maximum(v_p - v, 0.0)
+            reach = dv * j >= a * a
+            T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
+            T = np.where(dv > 0, T, 0.0)
+            total = total + np.where(np.isfinite(v_p) & (v_p > 0),
+                                     T * dv / (2.0 * v_p) - np.asarray(replaced) / v_p, 0.0)
+        total = total + np.where(inserted > 0, inserted / v, 0.0)
+    # a stop costs its ramps; only a rounding passed at no speed would never end
+    return np.where((v > 0) | ~(inserted > 0), total, np.inf)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -32,13 +32,20 @@ BASE = {
 ROUNDING = KIND_CODES.index("rounding")
 
 
-def machine(ovl: float = 1.2, **channel):
-    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner, so every
-    parameterised corner is rounded and a test sees the geometry alone."""
+def machine(ovl: float = 1.2, velo: float = 30000.0, **channel):
+    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner; ``velo``:
+    MAX_AX_VELO, mm/min (the G0 speed).
+
+    A stop costs its braking and acceleration ramps; a rounding passed at the programmed
+    speed costs nothing and shortens the path, so where the feed (or, for G0, the axis
+    velocity) is below the rounding's own speed every parameterised corner is rounded
+    and a test sees the geometry alone (5.2: rounding only where it does not slow the
+    program down)."""
     d = copy.deepcopy(BASE)
     d["channel"].update(channel)
     for ax in d["axis"].values():
         ax["MAX_ACCEL_OVL_FACTOR"] = ovl
+        ax["MAX_AX_VELO"] = velo
     return machine_from_dict(d)
 
 
@@ -146,8 +153,9 @@ def test_g641_clamp_to_half_the_shorter_block():
 def test_adispos_for_g0_and_the_smaller_distance_for_mixed_blocks():
     """spec 5.3: "ADISPOS is the same for G0"; "If only one of the two blocks is G0,
     the smaller distance applies"."""
-    text = "G90 G641 ADIS=0.5 ADISPOS=0.2 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
-    _, _, path = rounded(text)
+    text = "G90 G641 ADIS=0.5 ADISPOS=0.2 F60\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    # G0 at 60 mm/min: below the speed of the 0.2 mm roundings (see ``machine``)
+    _, _, path = rounded(text, machine(1.0, velo=60.0))
     np.testing.assert_allclose(path.rounding.distance_mm[:2], [0.2, 0.2])
 
 
@@ -370,8 +378,9 @@ def test_smoothing_mode_digits(mode, smoothing, expect):
 def test_g0_tolerance_factor_widens_the_g642_tolerance():
     """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
     factor 3 x COMPRESS_POS_TOL)"."""
-    text = "G90 G642 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
-    _, _, path = rounded(text, machine(1.0, G0_TOLERANCE_FACTOR=3.0))
+    text = "G90 G642 F60\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    # G0 at 60 mm/min: below the speed of the roundings (see ``machine``)
+    _, _, path = rounded(text, machine(1.0, velo=60.0, G0_TOLERANCE_FACTOR=3.0))
     np.testing.assert_allclose(path.rounding.deviation_mm[0], 3 * 0.01 * math.sqrt(2),
                                rtol=1e-12)
     np.testing.assert_allclose(path.rounding.deviation_mm[1], 0.01 * math.sqrt(2), rtol=1e-12)
