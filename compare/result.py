@@ -19,12 +19,9 @@ from reference.core.geometry import BlockSpan, Path
 from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
-from reference.core.rows import BlockRow
+from reference.core.rows import INSERTED_KINDS, BlockRow
 from reference.core.rules import STEPS_AT_BREAKS
 from reference.core.tolerances import RATIO_TOL
-
-#: Kinds of blocks the planner inserts (they have no NC line of their own).
-INSERTED_KINDS = ("rounding", "trc", "tlift")
 
 #: Block gaps within this many seconds of zero count as zero whatever the oracle's
 #: band (1 us: far below one IPO cycle, above round-off of summed interval times).

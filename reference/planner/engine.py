@@ -25,6 +25,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from ..core.arrays import readonly
 from ..core.constraints import BOUND_SETS, check_profile
 from ..core.geometry import Path
 from ..core.holds import SETTLE_CAUSE, Holds, with_holds
@@ -224,6 +225,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     del seg, horizon, base_units, units, speeds, prof
     sm = fac = new_units = None     # noqa: F841 - the smoothing's and adaptation's copies
     rows = _block_rows(path, modes, junc, at_segments, profile, holds)
+    seg_cause = readonly(at_segments.seg_cause, np.int8)
     del modes, junc, at_segments
     report = None
     if check:
@@ -240,7 +242,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                          profile=profile, blocks=rows, corners=corners,
                          trace=tuple(TraceEntry(*e) for e in trace),
                          bound_set=bound_set, report=report, limits=limits,
-                         parameters=params, holds=holds)
+                         parameters=params, holds=holds, segment_cause=seg_cause)
 
 
 def _cause_counts(what: str, codes: np.ndarray) -> str:
