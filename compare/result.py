@@ -125,6 +125,11 @@ class ComparedBlock:
         Explanation of a negative or unresolved gap, ``""`` otherwise.
     hold_cause : str
         ``"dwell"``, ``"exact stop settle"`` or ``""`` (no hold).
+    rounding : str
+        For a block whose end is a corner in a rounding mode (G641..G645, RND/RNDM):
+        ``"rounded"`` or ``"none: <reason>"``, the rounding stage's decision
+        (:meth:`reference.core.rounding.RoundingTable.decision_by_block`); ``""``
+        otherwise and on inserted rows.
 
     The flat names of the JSON and CSV contract (``t_reference_s``, ``v_exit_oracle``,
     ``limit_reference``, ``hold_s``, ...) are properties reading the two rows.
@@ -140,6 +145,7 @@ class ComparedBlock:
     stop_reason: str = ""
     note: str = ""
     hold_cause: str = ""
+    rounding: str = ""
 
     # identity and the contract's flat names
     block = property(lambda self: self.reference.block, doc="Block index.")

@@ -19,9 +19,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 
 1. the block before the corner programs RND (non-modal) or RNDM (modal radius > 0) or is
    in G641..G645, else nothing is recorded;
-2. no rounding where the axes stop anyway (5.2 group 1): a stop at the break (exact stop,
-   auxiliary output before motion, M0, ...), a block without path motion between, a
-   change of acceleration mode (BRISK/SOFT), geometry axes moving in one block only;
+2. no rounding where the axes stop anyway (5.2 group 1): geometry axes moving in one
+   block only (named first: it is a path stop too), a stop at the break (exact stop,
+   auxiliary output before motion, M0, a positioning axis, ...), a block without path
+   motion between, a change of acceleration mode (BRISK/SOFT);
 3. model limits of this version: only line-to-line corners of geometry axes are rounded
    (arc transitions and corners where other axes move are passed as under G64, named);
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
@@ -207,14 +208,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
     geo = path.geometry
     # --- 5.2 group 1: the axes stop between the blocks anyway -----------------------
-    decide(path.stop[brk], "stop between the blocks")
-    decide(kb - ka > 1, "block without path motion between")
-    decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
+    # the documented causes first, then any other stop at the break (exact stop,
+    # auxiliary output before motion, positioning axes...): a geometry-axis change is a
+    # path stop as well (reference.prepare), and the trace should name it as such
     is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
     da, db = path.d[a], path.d[b]
     geo_a = np.where(path.kind[a] == _LINE, row_norms(da[:, geo]) > MOVING_AXIS_TOL, True)
     geo_b = np.where(path.kind[b] == _LINE, row_norms(db[:, geo]) > MOVING_AXIS_TOL, True)
-    decide(geo_a != geo_b, "geometry axes move in one block only")
+    decide((geo_a != geo_b) & (kb - ka <= 1), "geometry axes move in one block only")
+    decide(path.stop[brk], "stop between the blocks")
+    decide(kb - ka > 1, "block without path motion between")
+    decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
     # --- model limits of this version ------------------------------------------------
     decide(~is_line, "arc transition: rounding not modelled yet")
     other = np.zeros(a.size, bool)

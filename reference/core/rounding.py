@@ -127,6 +127,21 @@ class RoundingTable:
         """The reason of corner ``i`` as words."""
         return ROUNDING_REASONS[int(self.reason[i])]
 
+    def decision_by_block(self) -> dict[int, str]:
+        """The decision at the corner each block ends in, for the block rows (issue 13:
+        every case where no rounding block is inserted is "named in the trace and in
+        the block rows").
+
+        Returns
+        -------
+        dict
+            Program block index (the block before the corner) -> ``"rounded"`` or
+            ``"none: <reason>"`` (:data:`ROUNDING_REASONS`); blocks whose end is not a
+            corner in a rounding mode are absent.
+        """
+        words = ["rounded"] + [f"none: {r}" for r in ROUNDING_REASONS[1:]]
+        return dict(zip(self.block.tolist(), (words[k] for k in self.reason.tolist())))
+
 
 def deflection_angle(t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
     """Angle between unit directions, rad, shape (k,) from (k, n) each.

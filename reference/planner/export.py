@@ -64,7 +64,9 @@ def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
     the corner's first line, ``corner_lines`` both lines of the corner), as the
     comparison shows it: the block's row then keeps the rest of its length and time
     and, where the rounding ends the block, exits at the rounding's entry speed
-    (:func:`_inserted_rows`).
+    (:func:`_inserted_rows`). A block whose end is a corner in a rounding mode carries
+    ``rounding``: ``"rounded"`` or ``"none: <reason>"``
+    (:meth:`reference.core.rounding.RoundingTable.decision_by_block`).
     """
     # Built from the table's columns, a chunk of rows at a time: 10^6 blocks would cost
     # 10^6 row objects, or nine lists of 10^6 Python numbers, otherwise.
@@ -76,6 +78,10 @@ def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
                    else tab.column(name)) for name in names}
     hold_cause = plan.holds.causes_by_block()
     split = _inserted_rows(plan)
+    # the rounding stage's decision at each block's end corner (G641..G645, RND/RNDM):
+    # "rounded" or why none was inserted (issue 13: named in the block rows)
+    decided = (plan.path.rounding.decision_by_block() if plan.path.rounding is not None
+               else {})
     for lo in range(0, len(tab), _ROW_CHUNK):
         cols = [full[name][lo:lo + _ROW_CHUNK] for name in names]
         cols = [c.tolist() if isinstance(c, np.ndarray) else c for c in cols]
@@ -85,6 +91,8 @@ def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
                    "length_mm": max(0.0, length), "t_reference_s": max(0.0, t),
                    "v_exit_reference": max(0.0, v), "limit_reference": cause,
                    "hold_s": hold, "hold_cause": hold_cause.get(b, "")}
+            if b in decided:
+                row["rounding"] = decided[b]
             extra = split.get(i)
             if extra is None:
                 yield row

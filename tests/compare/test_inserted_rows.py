@@ -163,3 +163,28 @@ def test_plan_rows_show_each_rounding_on_its_own_row_as_compare_does(comparison,
             assert r["t_reference_s"] == pytest.approx(t1 - t0, abs=4e-6)
         s += r["length_mm"]
     assert sum(1 for ln in text.splitlines() if " rounding " in ln) == 3
+
+
+def test_comparison_rows_name_the_rounding_decision_per_corner_block(comparison):
+    """Issue 13 item 2: the cases where no rounding is inserted are "named in the trace
+    and in the block rows". The comparison's rows (JSON, CSV, HTML) carry the rounding
+    stage's decision on the row of the block that ends at the corner, the inserted
+    rounding rows carry none; the program's last corner (X0 -> Y0 -> end) is a stop."""
+    from compare.export import blocks_csv, comparison_dict
+    from compare.report_html import render_report
+
+    c = comparison
+    table = c.path.rounding
+    want = {int(table.block[i]): ("rounded" if table.inserted[i]
+                                  else "none: " + table.reason_text(i))
+            for i in range(table.n)}
+    assert "rounded" in want.values() and any(v.startswith("none") for v in want.values())
+    got = {r.block: r.rounding for r in c.rows if not r.inserted and r.rounding}
+    assert got == want
+    assert all(r.rounding == "" for r in c.rows if r.inserted)
+    doc = comparison_dict(c)
+    assert {r["block"]: r["rounding"] for r in doc["blocks"] if "rounding" in r} == want
+    csv_text = blocks_csv(c)
+    assert "rounding" in csv_text.splitlines()[0].split(",")
+    html = render_report(c)
+    assert ">rounding</th>" in html and "none: " in html
