@@ -292,6 +292,7 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     corners = _corners(path)
     lines = program_lines
     split = _split_inserted(path, limits, ref_prof, opt_prof, jerk_ref, jerk_opt)
+    decided = path.rounding.decision_by_block() if path.rounding is not None else {}
     rows = []
     for i, sp in enumerate(spans):
         corner = corners.get(i)
@@ -325,7 +326,8 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                                 v_peak=mo[3], cause=co),
                 source=src.strip(), corner=corn, s_start=s_start,
                 ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
-                stop_reason=stop, note=note, hold_cause=hold_cause if hld > 0 else ""))
+                stop_reason=stop, note=note, hold_cause=hold_cause if hld > 0 else "",
+                rounding=decided.get(sp.block, "") if corn is None else ""))
 
     all_notes = list(notes)
     if not set(BOUND_SETS[reference.bound_set]) <= set(BOUND_SETS.get(oracle.bounds, ())):

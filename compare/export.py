@@ -36,7 +36,7 @@ CSV_COLUMNS = ("block", "line", "label", "kind", "corner", "length_mm", "t_refer
                "t_oracle_s", "hold_s", "hold_cause", "gap_s", "gap_rel", "v_entry_reference", "v_exit_reference",
                "v_peak_reference", "v_entry_oracle", "v_exit_oracle", "v_peak_oracle",
                "limit_reference", "limit_oracle", "ratio_reference", "ratio_oracle",
-               "stop_reason", "note", "source")
+               "stop_reason", "rounding", "note", "source")
 
 
 def schema() -> dict:
@@ -71,6 +71,8 @@ def _row_dict(r: ComparedBlock) -> dict:
         d["corner_lines"] = list(r.corner)
     if r.note:
         d["note"] = r.note
+    if r.rounding:
+        d["rounding"] = r.rounding
     return d
 
 

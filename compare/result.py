@@ -19,12 +19,9 @@ from reference.core.geometry import BlockSpan, Path
 from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
-from reference.core.rows import BlockRow
+from reference.core.rows import INSERTED_KINDS, BlockRow
 from reference.core.rules import STEPS_AT_BREAKS
 from reference.core.tolerances import RATIO_TOL
-
-#: Kinds of blocks the planner inserts (they have no NC line of their own).
-INSERTED_KINDS = ("rounding", "trc", "tlift")
 
 #: Block gaps within this many seconds of zero count as zero whatever the oracle's
 #: band (1 us: far below one IPO cycle, above round-off of summed interval times).
@@ -128,6 +125,11 @@ class ComparedBlock:
         Explanation of a negative or unresolved gap, ``""`` otherwise.
     hold_cause : str
         ``"dwell"``, ``"exact stop settle"`` or ``""`` (no hold).
+    rounding : str
+        For a block whose end is a corner in a rounding mode (G641..G645, RND/RNDM):
+        ``"rounded"`` or ``"none: <reason>"``, the rounding stage's decision
+        (:meth:`reference.core.rounding.RoundingTable.decision_by_block`); ``""``
+        otherwise and on inserted rows.
 
     The flat names of the JSON and CSV contract (``t_reference_s``, ``v_exit_oracle``,
     ``limit_reference``, ``hold_s``, ...) are properties reading the two rows.
@@ -143,6 +145,7 @@ class ComparedBlock:
     stop_reason: str = ""
     note: str = ""
     hold_cause: str = ""
+    rounding: str = ""
 
     # identity and the contract's flat names
     block = property(lambda self: self.reference.block, doc="Block index.")

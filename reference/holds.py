@@ -127,28 +127,29 @@ def imposed_holds(program: Program, path: Path, machine: Machine) -> Holds:
         first, then the dwell blocks sitting there, in program order.
     """
     rows: list[tuple[int, int, int, float, str]] = []    # (break, order, block, time, cause)
-    for order, span in enumerate(path.blocks):
-        if span.dwell_s > 0:
-            rows.append((span.first_segment, 1 + order, span.block, float(span.dwell_s),
-                         DWELL_CAUSE))
+    spans = path.blocks
+    for order in np.flatnonzero(spans.dwell_s > 0).tolist():
+        rows.append((int(spans.first_segment[order]), 1 + order, int(spans.block[order]),
+                     float(spans.dwell_s[order]), DWELL_CAUSE))
     if program.dialect != "ngc" and path.n_segments:
         settings = [machine.settings_of(a) for a in path.axes]
         kv = np.array([st.kv_per_s for st in settings])
         ffw = np.array([st.velo_ffw_weight for st in settings])
         v_max = machine.limits.for_axes(path.axes).v_max
-        ends = [sp for sp in path.blocks if sp.n_segments
-                and program.blocks[sp.block].exact_stop_here
-                and CRITERION_WINDOW.get(program.blocks[sp.block].exact_stop_criterion)]
+        pb, blk = program.blocks, spans.block.tolist()
+        ends = [i for i in np.flatnonzero(spans.n_segments > 0).tolist()
+                if pb[blk[i]].exact_stop_here
+                and CRITERION_WINDOW.get(pb[blk[i]].exact_stop_criterion)]
         if ends:
-            k_end = np.array([sp.first_segment + sp.n_segments for sp in ends])
+            k_end = spans.first_segment[ends] + spans.n_segments[ends]
             _, dq, _, _ = path.evaluate(path.s_breaks[k_end], side="left")
-            for row, sp in enumerate(ends):
-                field = CRITERION_WINDOW[program.blocks[sp.block].exact_stop_criterion]
+            for row, i in enumerate(ends):
+                field = CRITERION_WINDOW[pb[blk[i]].exact_stop_criterion]
                 window = np.array([getattr(st, field) for st in settings])
                 v_prog = programmed_speed(dq[row], float(path.feed[k_end[row] - 1]), v_max)
                 t = settle_time(dq[row], v_prog, kv, window, ffw)
                 if t > 0:
-                    rows.append((int(k_end[row]), 0, sp.block, t, SETTLE_CAUSE))
+                    rows.append((int(k_end[row]), 0, blk[i], t, SETTLE_CAUSE))
     if not rows:
         return NO_HOLDS
     rows.sort(key=lambda r: (r[0], r[1]))

@@ -37,12 +37,12 @@ planner (:mod:`reference.planner.stops`), not to the path.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from .core.errors import MachineDataError, PathError
-from .core.geometry import KIND_CODES, BlockSpan, Path, arc_segments, line_segments
+from .core.geometry import KIND_CODES, BlockSpans, Path, arc_segments, line_segments
 from .core.limits import MachineLimits
 from .core.rules import is_tangential
 from .core.tolerances import (ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_MM, MAX_BLOCK_MOTION_S,
@@ -195,16 +195,16 @@ def prepare(program: Program) -> Path:
         geo_seg = geo_moves[rows]
         geo_change[1:m] = geo_seg[1:] != geo_seg[:-1]
 
-    spans: list[BlockSpan] = []
+    # the block spans as columns (:class:`BlockSpans`): per block its break range
+    # ``[k0, k0 + n)`` (a block without motion sits at the break in front of the next
+    # segment), its stop reason and its dwell
+    k0 = np.empty(nb, dtype=np.int64)
+    n_seg = np.empty(nb, dtype=np.int64)
+    span_stop = [""] * nb
+    dwell = np.zeros(nb)
     next_break = 0            # break index in front of the next segment
-    # Python numbers taken once from the arrays: a block's start is the very float
-    # object of the previous block's end, and equal feeds share one object (10^6 spans
-    # would otherwise hold some 3e6 floats of their own)
-    s_at = np.concatenate(([0.0], np.cumsum(packed["length"]))).tolist()
     seg_list = seg_of_block.tolist()
-    feeds: dict[float, float] = {}
-    feed_list = [feeds.setdefault(f, f) for f in feed.tolist()]
-    for b in blocks:
+    for i, b in enumerate(blocks):
         seg = seg_list[b.index]
         if seg >= 0:
             at_start, at_end = _aux_stops(b)
@@ -216,35 +216,35 @@ def prepare(program: Program) -> Path:
                                             else "exact stop G9")
             if end_reason:
                 reasons[seg + 1] = end_reason
-            spans.append(BlockSpan(
-                block=b.index, line=b.line, label=b.label, kind=b.motion or "none",
-                s_start=s_at[seg], s_end=s_at[seg + 1],
-                first_segment=seg, n_segments=1,
-                feed_mm_s=feed_list[seg], stop_reason=end_reason))
+            k0[i], n_seg[i], span_stop[i] = seg, 1, end_reason
             next_break = seg + 1
         else:
             why = _idle_stop(b)
             if why and not reasons[next_break]:
                 reasons[next_break] = why
-            kind = "none" if b.motion is None else b.motion
-            spans.append(BlockSpan(
-                block=b.index, line=b.line, label=b.label, kind=kind,
-                s_start=s_at[next_break], s_end=s_at[next_break],
-                first_segment=next_break, n_segments=0, stop_reason=why,
-                dwell_s=float(b.dwell_s or 0.0)))
+            k0[i], n_seg[i], span_stop[i] = next_break, 0, why
+            dwell[i] = float(b.dwell_s or 0.0)
     # the geometry-axes stop last: a reason the program states (POS, M6, ...) names it
     for k in np.flatnonzero(geo_change).tolist():
         if not reasons[k]:
             reasons[k] = GEOMETRY_AXES_STOP
             i = int(rows[k - 1])                # the block that ends at break k
-            if not spans[i].stop_reason:
-                spans[i] = replace(spans[i], stop_reason=GEOMETRY_AXES_STOP)
+            if not span_stop[i]:
+                span_stop[i] = GEOMETRY_AXES_STOP
+    s_at = np.concatenate(([0.0], np.cumsum(packed["length"])))
+    span_feed = np.full(nb, np.inf)
+    span_feed[rows] = feed
+    spans = BlockSpans(
+        block=[b.index for b in blocks], line=[b.line for b in blocks], label=[b.label for b in blocks],
+        kind=[b.motion or "none" for b in blocks], s_start=s_at[k0],
+        s_end=s_at[k0 + n_seg], first_segment=k0, n_segments=n_seg, feed_mm_s=span_feed,
+        stop_reason=span_stop, dwell_s=dwell)
     reasons[0] = reasons[0] or "start"
     reasons[m] = reasons[m] or "end"
 
     path = Path(axes=tuple(axes), geometry=geometry, rotary=np.array(program.rotary),
                 feed=feed, rapid=rapid, stop=np.array([bool(r) for r in reasons]),
-                stop_reason=tuple(reasons), blocks=tuple(spans), source=program.file,
+                stop_reason=tuple(reasons), blocks=spans, source=program.file,
                 **packed)
     return _exact_path_stops(path, program)
 

@@ -19,9 +19,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 
 1. the block before the corner programs RND (non-modal) or RNDM (modal radius > 0) or is
    in G641..G645, else nothing is recorded;
-2. no rounding where the axes stop anyway (5.2 group 1): a stop at the break (exact stop,
-   auxiliary output before motion, M0, ...), a block without path motion between, a
-   change of acceleration mode (BRISK/SOFT), geometry axes moving in one block only;
+2. no rounding where the axes stop anyway (5.2 group 1): geometry axes moving in one
+   block only (named first: it is a path stop too), a stop at the break (exact stop,
+   auxiliary output before motion, M0, a positioning axis, ...), a block without path
+   motion between, a change of acceleration mode (BRISK/SOFT);
 3. model limits of this version: only line-to-line corners of geometry axes are rounded
    (arc transitions and corners where other axes move are passed as under G64, named);
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
@@ -49,9 +50,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
    junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
    and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
-   TRUE skips it, G643 and G644 never make it); every mode rounds only when the
-   rounding is estimated to pass the corner in less time than G64
-   (:func:`corner_time_loss`, jerk-limited ramps under SOFT), with ``v_round``
+   TRUE skips it, G643 and G644 never make it); every mode but RND/RNDM rounds only
+   when the rounding is estimated to pass the corner in less time than G64
+   (:func:`corner_time_loss`: ramps on each line to its own programmed speed, BRISK or
+   jerk-limited, a stop costing its ramps), with ``v_round``
    (:func:`_rounding_speed`) = min of the centripetal limit at the largest curvature,
    the one-IPO-cycle limit per inserted block (5.3: "about ADIS/T_ipo"), under SOFT the
    in-rounding jerk limit and, on the arc only, the curvature-jump limit of the shared
@@ -74,8 +76,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.geometry import (KIND_CODES, BlockSpan, Path, clothoid_pair_shape,
-                            clothoid_pieces)
+from .core.arrays import row_dots, row_max, row_min, row_norms
+from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_pieces
 from .core.limits import AxisArrays
 from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
                             deflection_angle, distance_for_deviation, fillet_pieces)
@@ -118,6 +120,9 @@ _ALL_MODES = ROUNDING_MODES + _RADIUS_MODES
 #: the decision uses the default, not the parameter of a particular plan.
 CENTRIPETAL_SHARE = 0.75
 
+#: Group-10 and acceleration modes as fixed-width strings (the longest is 5 characters).
+_MODE_DTYPE = "U8"
+
 _LINE = KIND_CODES.index("line")
 _ROUNDING = KIND_CODES.index("rounding")
 
@@ -148,12 +153,14 @@ def _block_attributes(program: Program, default_accel: str) -> dict[str, np.ndar
             uniq.append(md)
         code[i] = j
     rnd = np.array([blk.extra.rnd_mm for blk in blocks], dtype=np.float64)
-    mode = np.array([md.continuous_mode for md in uniq], dtype=object)[code]
+    # fixed-width strings: numpy compares them in C (object arrays per element)
+    mode = np.array([md.continuous_mode for md in uniq], dtype=_MODE_DTYPE)[code]
     rndm = np.array([md.rndm_mm for md in uniq], dtype=np.float64)[code]
-    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode))
+    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode)).astype(_MODE_DTYPE)
     return {
         "mode": mode,
-        "accel": np.array([md.accel_mode or default_accel for md in uniq], dtype=object)[code],
+        "accel": np.array([md.accel_mode or default_accel for md in uniq],
+                          dtype=_MODE_DTYPE)[code],
         "adis": np.array([md.adis_mm for md in uniq], dtype=np.float64)[code],
         "adispos": np.array([md.adispos_mm for md in uniq], dtype=np.float64)[code],
         "ctol": np.array([np.nan if md.contour_tol_mm is None else md.contour_tol_mm
@@ -193,7 +200,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     brk = cand + 1                        # break index of each corner
     ka, kb = path.block[a], path.block[b]
     mode_arr = attrs["mode"][ka]
-    mode = tuple(mode_arr)
+    mode = tuple(mode_arr.tolist())
     reason = np.full(a.size, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
@@ -201,20 +208,23 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
     geo = path.geometry
     # --- 5.2 group 1: the axes stop between the blocks anyway -----------------------
+    # the documented causes first, then any other stop at the break (exact stop,
+    # auxiliary output before motion, positioning axes...): a geometry-axis change is a
+    # path stop as well (reference.prepare), and the trace should name it as such
+    is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
+    da, db = path.d[a], path.d[b]
+    geo_a = np.where(path.kind[a] == _LINE, row_norms(da[:, geo]) > MOVING_AXIS_TOL, True)
+    geo_b = np.where(path.kind[b] == _LINE, row_norms(db[:, geo]) > MOVING_AXIS_TOL, True)
+    decide((geo_a != geo_b) & (kb - ka <= 1), "geometry axes move in one block only")
     decide(path.stop[brk], "stop between the blocks")
     decide(kb - ka > 1, "block without path motion between")
     decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
-    is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
-    da, db = path.d[a], path.d[b]
-    geo_a = np.where(path.kind[a] == _LINE, np.linalg.norm(da[:, geo], axis=1) > MOVING_AXIS_TOL,
-                     True)
-    geo_b = np.where(path.kind[b] == _LINE, np.linalg.norm(db[:, geo], axis=1) > MOVING_AXIS_TOL,
-                     True)
-    decide(geo_a != geo_b, "geometry axes move in one block only")
     # --- model limits of this version ------------------------------------------------
     decide(~is_line, "arc transition: rounding not modelled yet")
-    other = (np.abs(da[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL) | (
-        np.abs(db[:, ~geo]).max(axis=1, initial=0.0) > MOVING_AXIS_TOL)
+    other = np.zeros(a.size, bool)
+    if not geo.all():
+        other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
+            row_max(np.abs(db[:, ~geo])) > MOVING_AXIS_TOL)
     decide(other, "non-geometry axes move: rounding not modelled yet")
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
     decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
@@ -249,12 +259,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     if open_.any():
         o = np.flatnonzero(open_)
         v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
-        feed = np.minimum(path.feed[a[o]], path.feed[b[o]])
-        with np.errstate(divide="ignore"):
-            v_axis = np.min(lim.v_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
-        v_prog = np.minimum(feed, v_axis)
         soft = attrs["accel"][ka[o]] == "SOFT"
+        # per line: programmed speed (feed, axis velocities), acceleration, jerk
+        a1, a2 = np.abs(t1[o]), np.abs(t2[o])
+        with np.errstate(divide="ignore"):
+            v_in = np.minimum(path.feed[a[o]], row_min(lim.v_max[None, :] / a1))
+            v_out = np.minimum(path.feed[b[o]], row_min(lim.v_max[None, :] / a2))
+            acc_in = row_min(lim.a_max[None, :] / a1)
+            acc_out = row_min(lim.a_max[None, :] / a2)
+            j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
+            j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
+        v_prog = np.minimum(v_in, v_out)
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
@@ -263,19 +278,10 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         sub[o] = ovl & (v64[o] >= v_prog)
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         sub[:] = False
-        with np.errstate(divide="ignore"):
-            a_path = np.min(lim.a_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
-            j_path = np.min(lim.j_max[None, :] / np.maximum(np.abs(t1[o]), np.abs(t2[o])),
-                            axis=1)
-        j_path = np.where(soft, j_path, np.inf)
-        # against passing at the programmed speed (the stretch form of the estimate,
-        # ``half`` = half of the shorter neighbouring block, rounded more corners whose
-        # rounding the heuristic then planned slower, on both bundled machines, BRISK
-        # and SOFT: measured on the bench polylines, so the classic form decides)
-        sub[o] = ~(corner_time_loss(v_prog, v_round[o], a_path, shape.length[o], 2 * d[o],
-                                    j_path)
-                   < corner_time_loss(v_prog, v64[o], a_path, 0.0, 0.0, j_path)
+        sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
+                                    shape.length[o], d[o])
+                   < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
+                                      0.0, 0.0)
                    ) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
@@ -310,22 +316,23 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     ra, rb = path.rapid[a], path.rapid[b]
     adis, adispos, ctol = attrs["adis"][ka], attrs["adispos"][ka], attrs["ctol"][ka]
     radius = attrs["radius"][ka]
-    # how each corner's distance is found: "adis", "tol" (MD33100 per axis and maybe a
-    # contour tolerance), "radius" (RND/RNDM) or "none" (not modelled)
-    how = np.full(k, "none", dtype=object)
+    # how each corner's distance is found: ADIS, TOL (MD33100 per axis and maybe a
+    # contour tolerance), RADIUS (RND/RNDM) or NONE (not modelled)
+    NONE, ADIS, TOL, RADIUS = 0, 1, 2, 3
+    how = np.full(k, NONE, dtype=np.int8)
     contour = np.full(k, np.inf)
     use_axis_tol = np.ones(k, bool)
-    how[np.isin(mode, _RADIUS_MODES)] = "radius"
-    how[mode == "G641"] = "adis"
+    how[np.isin(mode, _RADIUS_MODES)] = RADIUS
+    how[mode == "G641"] = ADIS
     dig644 = _digit(sm, 3)
-    how[mode == "G644"] = "adis" if dig644 in (1, 5) else "tol" if dig644 in (0, 4) else "none"
+    how[mode == "G644"] = ADIS if dig644 in (1, 5) else TOL if dig644 in (0, 4) else NONE
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
         sel = mode == md
         dig = _digit(sm, place)
         if dig == 4:
-            how[sel] = "adis"
+            how[sel] = ADIS
             continue
-        how[sel] = "tol"
+        how[sel] = TOL
         has_ctol = sel & ~np.isnan(ctol)           # CTOL overrides MD/SD values (5.7)
         contour[has_ctol], use_axis_tol[has_ctol] = ctol[has_ctol], False
         if dig in (1, 3):
@@ -334,13 +341,13 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.zeros(k)
     # G641-type: ADIS for G1/G2/G3, ADISPOS for G0, the smaller if one block is G0 (5.3)
     dist = np.where(ra & rb, adispos, np.where(ra | rb, np.minimum(adis, adispos), adis))
-    is_adis = how == "adis"
+    is_adis = how == ADIS
     decide(is_adis & (dist <= 0) & ((ra & rb) | ((ra | rb) & (adispos <= adis))),
            "rounding not parameterised (ADISPOS = 0)")
     decide(is_adis & (dist <= 0), "rounding not parameterised (ADIS = 0)")
     d = np.where(is_adis, dist, d)
     # tolerance type (5.4): per-axis MD33100 on the axes it applies to, contour tolerance
-    is_tol = how == "tol"
+    is_tol = how == TOL
     if is_tol.any():
         tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
@@ -351,9 +358,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
                          distance_for_deviation(theta, np.maximum(dev, 0.0)))
         d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
-    d = np.where(how == "radius", radius * np.tan(theta / 2.0), d)
-    decide(how == "none", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
-    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == "tol")
+    d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
+    decide(how == NONE, "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
+    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
     return np.where(np.isfinite(d), d, 0.0), multi
 
 
@@ -377,8 +384,7 @@ def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarr
     blk = path.block
     line = path.kind == _LINE
     ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
-    # fixed-width strings compare in C; the object arrays would compare per element
-    mode, accel = attrs["mode"].astype("U8"), attrs["accel"].astype("U8")
+    mode, accel = attrs["mode"], attrs["accel"]
     ok &= mode[blk[:-1]] == mode[blk[1:]]
     ok &= accel[blk[:-1]] == accel[blk[1:]]
     ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
@@ -463,66 +469,66 @@ def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
     cnt = hi - lo + 1
     owner = np.repeat(np.arange(lo.size), cnt)
     flat = lo[owner] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-    np.maximum.at(out, owner, np.linalg.norm(path.d[flat] - path.d[ref[owner]], axis=1))
+    np.maximum.at(out, owner, row_norms(path.d[flat] - path.d[ref[owner]]))
     return out
 
 
-def corner_time_loss(v_prog: np.ndarray, v_corner: np.ndarray, a_path: np.ndarray,
-                     inserted: np.ndarray | float, replaced: np.ndarray | float,
-                     j_path: np.ndarray | float = np.inf,
-                     half: np.ndarray | float = np.inf) -> np.ndarray:
-    """Estimated time to pass a corner and the stretch ``half`` before and after it, s.
+def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
+                     a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
+                     j_out: np.ndarray, inserted: np.ndarray | float,
+                     replaced: np.ndarray | float) -> np.ndarray:
+    """Time a corner passed at ``v_corner`` costs against passing it at the programmed
+    speeds, s: the decision's estimate of "rounding would slow the program down"
+    (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
+    the heuristic then plans whichever contour results exactly.
 
-    Each side: the speed rises from the corner speed ``v`` over the ``x = half -
-    replaced / 2`` of straight line left beside the corner (or the rounding) to
-    ``v_pk = min(v_p, v + dv_max(x))`` and costs the ramp's duration ``T`` plus the rest
-    of ``x`` at ``v_pk``; a ramp that is symmetric in time covers ``(v_pk + v) T / 2``.
-    ``T = dv / a`` at the constant path acceleration ``a`` (BRISK); with the path jerk
-    ``j`` (SOFT) ``T = dv / a + a / j`` where the ramp reaches ``a`` (``dv >= a^2 / j``),
-    else ``2 sqrt(dv / j)``. ``dv_max(x)`` is the gain over ``x`` from ``v``:
-    ``sqrt(v^2 + a x) - v`` (BRISK over half of ``x``, the other half left for the next
-    corner's braking) and, with jerk, at most ``(x sqrt(j))^(2/3)`` (an S-ramp by ``dv``
-    covers at least ``dv T / 2 = dv^1.5 / sqrt(j)``). A rounding of length ``l`` adds
-    ``l / v`` (a SOFT profile crosses its ends at zero path acceleration, so it stays
-    near ``v`` on it). This is the model's reading of "rounding would slow the program
-    down" (5.2 group 2), also "between two very short blocks": an estimate for the
-    decision only; the heuristic then plans whichever contour results exactly.
+    Each side ``i`` (the line before, with programmed speed ``v_in``, and the one after,
+    ``v_out``) ramps between the corner speed ``v = min(v_corner, v_in, v_out)`` and its
+    programmed speed ``v_i``: the ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
+    a_i / j_i`` (SOFT, where it reaches ``a_i``: ``dv_i >= a_i^2 / j_i``) or ``2 sqrt(dv_i
+    / j_i)``, and is symmetric in time, so it covers ``(v + v_i) T_i / 2`` and costs
+    ``T_i dv_i / (2 v_i)`` more than that distance at ``v_i``. A rounding of length ``l``
+    adds ``l / v`` (it is passed at about ``v``: a SOFT profile crosses its ends at zero
+    path acceleration) and removes ``replaced`` of each line, which would have been
+    passed at ``v_i``. Per side because the two lines may have other programmed speeds
+    (a G0 into a G1 at a low feed: the rounding runs at the lower, the replaced stretch
+    of the G0 at rapid speed).
 
     Parameters
     ----------
-    v_prog, v_corner, a_path : numpy.ndarray, shape (k,)
-        mm/s, mm/s, mm/s^2.
-    inserted, replaced : numpy.ndarray or float
-        Rounding length ``l`` and the replaced contour length ``2 d``, mm (0 for G64).
-    j_path : numpy.ndarray or float
-        Path jerk, mm/s^3 (``inf``: no jerk limit, BRISK).
-    half : numpy.ndarray or float
-        Length of the stretch on each side of the corner, mm (``inf``: the programmed
-        speed is reached; the function then returns the classic loss against passing at
-        ``v_p``: ``(v_p - v)^2 / (a v_p)`` for BRISK, plus ``l / v - 2 d / v_p``).
+    v_in, v_out : numpy.ndarray, shape (k,)
+        Programmed path speed of the line before and after (feed, axis velocities),
+        mm/s.
+    v_corner : numpy.ndarray, shape (k,)
+        Speed at the corner (G64: the corner rule; rounding: the rounding's speed), mm/s.
+    a_in, a_out : numpy.ndarray, shape (k,)
+        Path acceleration of each line, mm/s^2.
+    j_in, j_out : numpy.ndarray, shape (k,)
+        Path jerk of each line, mm/s^3 (``inf``: BRISK).
+    inserted : numpy.ndarray or float
+        Rounding length ``l``, mm (0 for G64).
+    replaced : numpy.ndarray or float
+        Length cut from each line, mm (the tangent distance ``d``; 0 for G64).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
+        s; ``inf`` for a rounding that would be passed at no speed.
     """
-    v = np.minimum(v_corner, v_prog)
+    v = np.minimum(v_corner, np.minimum(v_in, v_out))
+    inserted = np.asarray(inserted, dtype=np.float64)
+    total = np.zeros(np.shape(v))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        x = np.maximum(np.asarray(half, dtype=np.float64) - np.asarray(replaced) / 2.0, 0.0)
-        gain = np.minimum(np.sqrt(v * v + a_path * x) - v, np.cbrt((x * x) * j_path))
-        v_pk = np.minimum(v_prog, v + gain)
-        dv = np.maximum(v_pk - v, 0.0)
-        reach = dv * j_path >= a_path * a_path
-        T = np.where(reach, dv / a_path + a_path / j_path, 2.0 * np.sqrt(dv / j_path))
-        T = np.where(dv > 0, T, 0.0)
-        path = np.where(np.asarray(inserted) > 0, np.asarray(inserted) / v, 0.0)
-        finite = np.isfinite(x)
-        # the time beyond covering the stretch at v_pk (for an infinite stretch, at v_p)
-        side = T * dv / (2.0 * np.where(v_pk > 0, v_pk, 1.0))
-        stretch = np.where(finite, 2.0 * (T + np.maximum(x - (v_pk + v) * T / 2.0, 0.0)
-                                          / np.where(v_pk > 0, v_pk, 1.0)),
-                           2.0 * side - np.where(np.isfinite(v_prog),
-                                                 np.asarray(replaced) / v_prog, 0.0))
-    return np.where(v > 0, stretch + path, np.inf)
+        for v_p, a, j in ((v_in, a_in, j_in), (v_out, a_out, j_out)):
+            dv = np.maximum(v_p - v, 0.0)
+            reach = dv * j >= a * a
+            T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
+            T = np.where(dv > 0, T, 0.0)
+            total = total + np.where(np.isfinite(v_p) & (v_p > 0),
+                                     T * dv / (2.0 * v_p) - np.asarray(replaced) / v_p, 0.0)
+        total = total + np.where(inserted > 0, inserted / v, 0.0)
+    # a stop costs its ramps; only a rounding passed at no speed would never end
+    return np.where((v > 0) | ~(inserted > 0), total, np.inf)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -588,27 +594,37 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _S
     """
     kappa, sharp, piece = shape.kappa[o], shape.sharp[o], shape.piece[o]
     clo = sharp > 0
-    normal = t2 - np.sum(t2 * t1, axis=1)[:, None] * t1
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    normal = t2 - row_dots(t2, t1)[:, None] * t1
+    normal /= row_norms(normal)[:, None]
     rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
-    q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
     with np.errstate(divide="ignore", invalid="ignore"):
         a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
         w = np.where(rho > 0, rho, 1.0)
-        v_c = np.where(rho > 0, np.sqrt(a_c / (w * kappa[:, None])), np.inf).min(axis=1)
-        v_j = np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
-                                        / (w * q3[:, None])), np.inf).min(axis=1)
-    v_ipo = piece / t_ipo
+        v_c = row_min(np.where(rho > 0, np.sqrt(a_c / (w * kappa[:, None])), np.inf))
+    out = np.minimum(v_c, piece / t_ipo)
+    sel = np.flatnonzero(soft)                      # the SOFT rules, on those corners only
+    if sel.size == 0:
+        return out
+    kappa, sharp, clo, rho, w = kappa[sel], sharp[sel], clo[sel], rho[sel], w[sel]
+    q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_j = row_min(np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
+                                                / (w * q3[:, None])), np.inf))
     # the arc's curvature vector jumps from 0 to kappa n at the start and from the
-    # rotated normal to 0 at the end (same magnitude per axis bounded by rho kappa)
-    k_end = (normal * np.cos(theta)[:, None] - t1 * np.sin(theta)[:, None]) * kappa[:, None]
-    zero = np.zeros_like(t1)
-    v_k = np.minimum(
-        curvature_jump_speed_cap(zero, normal * kappa[:, None], lim.path_trans_jerk, t_ipo),
-        curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
-    v_k = np.where(clo, np.inf, v_k)
-    out = np.minimum(v_c, v_ipo)
-    return np.where(soft, np.minimum(out, np.minimum(v_j, v_k)), out)
+    # rotated normal to 0 at the end (same magnitude per axis bounded by rho kappa); a
+    # clothoid pair has none
+    v_k = np.full(sel.size, np.inf)
+    arc = np.flatnonzero(~clo)
+    if arc.size:
+        i = sel[arc]
+        nrm, ka, th = normal[i], kappa[arc][:, None], theta[i]
+        k_end = (nrm * np.cos(th)[:, None] - t1[i] * np.sin(th)[:, None]) * ka
+        zero = np.zeros_like(nrm)
+        v_k[arc] = np.minimum(
+            curvature_jump_speed_cap(zero, nrm * ka, lim.path_trans_jerk, t_ipo),
+            curvature_jump_speed_cap(k_end, zero, lim.path_trans_jerk, t_ipo))
+    out[sel] = np.minimum(out[sel], np.minimum(v_j, v_k))
+    return out
 
 
 def _inserted_rows(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.ndarray,
@@ -695,8 +711,6 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     # meet tangentially and the line is dropped; a line inside a window that reaches
     # across short blocks (:func:`_across_blocks`) is covered whole and dropped too
     keep = length > MIN_SEGMENT_LENGTH_MM
-    has_arc = np.zeros(m, bool)
-    has_arc[a] = True
     n_ins = np.zeros(m, dtype=np.int64)
     n_ins[a] = np.where(g2, 2, 1)
     count = keep.astype(np.int64) + n_ins
@@ -707,8 +721,9 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
     # rows of the inserted segments: after the kept part of segment a, one or two each
     base = first[:-1][a] + keep[a]
-    arc_pos = np.concatenate([base[i:i + 1] + np.arange(k) for i, k in
-                              enumerate(n_ins[a].tolist())]) if a.size else base
+    k_ins = n_ins[a]
+    arc_pos = np.repeat(base, k_ins) + (np.arange(int(k_ins.sum()))
+                                        - np.repeat(np.cumsum(k_ins) - k_ins, k_ins))
     line_pos = first[:-1][keep]
     new = {}
     for key in ("origin", "e1", "e2", "d"):
@@ -744,22 +759,12 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         stop[int(first[k])] = True
     sb = np.concatenate(([0.0], np.cumsum(new["length"])))
     # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
-    j0 = np.fromiter((sp.first_segment for sp in path.blocks), np.int64, len(path.blocks))
-    j1 = j0 + np.fromiter((sp.n_segments for sp in path.blocks), np.int64, len(path.blocks))
-    f, e = first[j0], first[j1]
-    # spans that end before the first segment a window touches keep their segments,
-    # indices and positions (same objects); the others move (positional arguments:
-    # 10^5 spans, and keywords cost a third more)
-    touched = np.flatnonzero((trim_start > 0) | (trim_end > 0) | has_arc | ~keep)
-    n_same = int(np.searchsorted(j1, touched[0], side="right")) if touched.size else len(j0)
-    spans = list(path.blocks[:n_same]) + [
-        BlockSpan(sp.block, sp.line, sp.label, sp.kind, s0, s1, fi, ei - fi, sp.feed_mm_s,
-                  sp.stop_reason, sp.dwell_s)
-        for sp, s0, s1, fi, ei in zip(path.blocks[n_same:], sb[f[n_same:]].tolist(),
-                                      sb[e[n_same:]].tolist(), f[n_same:].tolist(),
-                                      e[n_same:].tolist())]
+    spans = path.blocks
+    j0 = spans.first_segment
+    f, e = first[j0], first[j0 + spans.n_segments]
+    spans = spans.moved(sb[f], sb[e], f, e - f)
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
-                rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=tuple(spans),
+                rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=spans,
                 source=path.source, rounding=table, **new)
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .core.geometry import BlockSpan, Path
+from .core.geometry import Path
 
 #: The packed row arrays of a path (keys of :func:`reference.core.geometry.line_segments`).
 ROW_KEYS = ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length", "block",
@@ -73,17 +73,15 @@ def splice(path: Path, packed: dict[str, np.ndarray], owner: np.ndarray,
     reasons[0] = reasons[0] or "start"
     reasons[total] = reasons[total] or "end"
     length = np.asarray(packed["length"], dtype=np.float64)
-    sb = np.concatenate(([0.0], np.cumsum(length))).tolist()
-    spans = []
-    for sp in path.blocks:
-        f = int(first[sp.first_segment])
-        e = int(first[sp.first_segment + sp.n_segments])
-        spans.append(BlockSpan(sp.block, sp.line, sp.label, sp.kind, sb[f], sb[e], f, e - f,
-                               sp.feed_mm_s, sp.stop_reason, sp.dwell_s))
+    sb = np.concatenate(([0.0], np.cumsum(length)))
+    spans = path.blocks
+    f = first[spans.first_segment]
+    e = first[spans.first_segment + spans.n_segments]
+    spans = spans.moved(sb[f], sb[e], f, e - f)
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary,
                 feed=np.asarray(feed, dtype=np.float64), rapid=np.asarray(rapid, bool),
                 stop=np.array([bool(r) for r in reasons]), stop_reason=tuple(reasons),
-                blocks=tuple(spans), source=path.source, rounding=path.rounding,
+                blocks=spans, source=path.source, rounding=path.rounding,
                 **{k: packed[k] for k in ROW_KEYS})
 
 

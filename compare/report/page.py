@@ -240,7 +240,9 @@ def _table(c: Comparison, links: Mapping[str, str] | None, shown: Shown,
             "<th>v in ref</th><th>v out ref</th><th>v peak ref</th>"
             "<th>v in opt</th><th>v out opt</th><th>v peak opt</th>"
             "<th class='t'>limit ref</th><th class='t'>limit opt</th><th>ratio ref</th>"
-            "<th class='t'>stop</th><th class='t'>note</th><th class='t'>source</th>"
+            "<th class='t'>stop</th><th class='t' title='the rounding stage at the corner "
+            "this block ends in (G641..G645, RND/RNDM): rounded, or why not'>rounding</th>"
+            "<th class='t'>note</th><th class='t'>source</th>"
             "</tr></thead>")
 
     def num(x: float, nd: int) -> str:
@@ -278,7 +280,8 @@ def _table(c: Comparison, links: Mapping[str, str] | None, shown: Shown,
             f"{num(r.v_exit_oracle, 1)}{num(r.v_peak_oracle, 1)}"
             f"<td class='t'>{_e(r.limit_reference)}</td><td class='t'>{_e(r.limit_oracle)}</td>"
             f"{num(r.ratio_reference, 3) if not idle else '<td>–</td>'}"
-            f"<td class='t'>{_e(r.stop_reason)}</td><td class='note'>{_e(r.note)}</td>"
+            f"<td class='t'>{_e(r.stop_reason)}</td><td class='t'>{_e(r.rounding)}</td>"
+            f"<td class='note'>{_e(r.note)}</td>"
             f"<td class='t'><code>{_e(src)}</code></td></tr>")
     if limited:
         data = " and ".join(f"<a href='{_e(u)}'>{_e(k)}</a>" for k, u in (links or {}).items())

@@ -459,28 +459,35 @@ def plot_toolpath(c: Comparison, worst: Sequence[ComparedBlock] | None = None) -
     ax.set_xlabel(f"{path.axes[i]} [mm]")
     ax.set_ylabel(f"{path.axes[j]} [mm]")
     ax.grid(alpha=0.3)
-    # "best" scans every drawn point for a free spot: seconds at 10^6 points
-    ax.legend(loc="upper right" if raster else "best", fontsize=8, framealpha=0.9)
-    if q_prog is not None:
-        _corner_inset(fig, ax, c, q, seg, q_prog, i, j, style_of, styles)
+    inset = q_prog is not None and _corner_inset(fig, ax, c, q, seg, q_prog, i, j,
+                                                  style_of, styles)
+    if inset:
+        # the zoom sits in the lower right of the plot: the legend goes below the axes,
+        # where it can cover neither the zoom nor the path
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=8,
+                  framealpha=0.9)
+    else:
+        # "best" scans every drawn point for a free spot: seconds at 10^6 points
+        ax.legend(loc="upper right" if raster else "best", fontsize=8, framealpha=0.9)
     return svg_uri(fig)
 
 
 def _corner_inset(fig, ax, c: Comparison, q: np.ndarray, seg: np.ndarray,
                   q_prog: np.ndarray, i: int, j: int, style_of: np.ndarray,
-                  styles: dict) -> None:
+                  styles: dict) -> bool:
     """A zoom on the rounded corner whose rounding lies farthest from the programmed
     corner (relative to the plot's size), so the rounding is visible beside the
-    programmed corner even where it is far below the plot's resolution."""
+    programmed corner even where it is far below the plot's resolution. Returns whether
+    it was drawn."""
     table = c.path.rounding
     if table is None or not table.inserted.any():
-        return
+        return False
     k = int(np.flatnonzero(table.inserted)[np.argmax(table.deviation_mm[table.inserted])])
     rnd = np.flatnonzero(c.path.kind == KIND_CODES.index("rounding"))
     # the rounding segment of that corner: the one attributed to its block
     own = rnd[c.path.block[rnd] == table.block[k]]
     if own.size == 0:
-        return
+        return False
     r = int(own[0])
     a, b = c.path.segment(r).start, c.path.segment(r).end
     half = 1.6 * max(table.distance_mm[k], 1e-6)
@@ -489,7 +496,7 @@ def _corner_inset(fig, ax, c: Comparison, q: np.ndarray, seg: np.ndarray,
     y0, y1 = centre[j] - half, centre[j] + half
     span = max(np.ptp(q[:, i]), np.ptp(q[:, j]), 1e-12)
     if half / span > 0.05:             # visible in the main plot already
-        return
+        return False
     sub = fig.add_axes([0.70, 0.14, 0.2, 0.3])
 
     def near(pts: np.ndarray, owner: np.ndarray) -> np.ndarray:
@@ -526,6 +533,7 @@ def _corner_inset(fig, ax, c: Comparison, q: np.ndarray, seg: np.ndarray,
                   f"{c_line(c, int(table.next_block[k]))}: {table.mode[k]}, deviation "
                   f"{table.deviation_mm[k]:.3g} mm", fontsize=7)
     ax.indicate_inset_zoom(sub, edgecolor="#555")
+    return True
 
 
 def c_line(c: Comparison, block: int) -> int:

@@ -412,7 +412,7 @@ def check_profile(path: Path, limits: MachineLimits, profile: Profile, *,
         raise ProfileError(f"profile starts at s = {profile.s[0]:.6g} mm and ends at s = "
                            f"{profile.s[-1]:.6g} mm but the path is {L:.6g} mm long")
     # (a generator: a list would hold 10^6 ints for one maximum)
-    n_blocks = max(max((b.block + 1 for b in path.blocks), default=0),
+    n_blocks = max(int(path.blocks.block.max()) + 1 if len(path.blocks) else 0,
                    int(path.block.max()) + 1 if path.n_segments else 0)
     worst = {c: _Worst(n_blocks) for c in CONSTRAINTS}
     jerk_step = _Worst(n_blocks)

@@ -55,11 +55,13 @@ Shapes: ``m`` segments, ``n`` axes, ``N`` evaluation points.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
+from .arrays import row_dots, row_norms
 from .errors import PathError
 from .rounding import RoundingTable
 from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
@@ -299,12 +301,11 @@ def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
     """
     k = half_length.size
     n = start.shape[1]
-    theta = 2.0 * np.arctan2(np.linalg.norm(t_out - t_in, axis=1),
-                             np.linalg.norm(t_out + t_in, axis=1))
+    theta = 2.0 * np.arctan2(row_norms(t_out - t_in), row_norms(t_out + t_in))
     c = theta / half_length ** 2
     kmax = theta / half_length
-    nor = t_out - np.sum(t_out * t_in, axis=1)[:, None] * t_in
-    nor /= np.linalg.norm(nor, axis=1)[:, None]
+    nor = t_out - row_dots(t_out, t_in)[:, None] * t_in
+    nor /= row_norms(nor)[:, None]
     # the end: by symmetry about the bisector, the chord from start to end is
     # 2 L_s (Fx cos(theta/2) + Fy sin(theta/2)) along the mean direction
     scale = np.sqrt(np.pi / c)
@@ -313,8 +314,8 @@ def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
     d = X + Y * np.tan(theta / 2.0)                    # tangent distance to the corner
     corner = start + d[:, None] * t_in
     end = corner + d[:, None] * t_out
-    back_n = -t_in + np.sum(t_in * t_out, axis=1)[:, None] * t_out
-    back_n /= np.linalg.norm(back_n, axis=1)[:, None]
+    back_n = -t_in + row_dots(t_in, t_out)[:, None] * t_out
+    back_n /= row_norms(back_n)[:, None]
     origin = np.empty((2 * k, n))
     e1 = np.empty((2 * k, n))
     e2 = np.empty((2 * k, n))
@@ -776,6 +777,119 @@ class BlockSpan:
         return self.s_end - self.s_start
 
 
+#: Columns of :class:`BlockSpans`, in the order of :class:`BlockSpan`'s fields.
+SPAN_COLUMNS = ("block", "line", "label", "kind", "s_start", "s_end", "first_segment",
+                "n_segments", "feed_mm_s", "stop_reason", "dwell_s")
+_SPAN_INT = ("block", "line", "first_segment", "n_segments")
+_SPAN_FLOAT = ("s_start", "s_end", "feed_mm_s", "dwell_s")
+_SPAN_TEXT = ("label", "kind", "stop_reason")
+
+
+class BlockSpans(Sequence):
+    """Where every NC block lies on the path: a read-only sequence of :class:`BlockSpan`
+    stored as columns.
+
+    The stages that move blocks along the path (rounding, tool radius compensation,
+    tangential control) and the per-block rows work on the columns; a
+    :class:`BlockSpan` is built only where one is asked for (the tuple of all of them
+    once, on the first iteration, and kept). 10^5 spans as objects cost some 40 MB and
+    0.2 s to build again after every stage that moves them.
+
+    Attributes
+    ----------
+    block, line, first_segment, n_segments : numpy.ndarray of int64, shape (nb,)
+        As in :class:`BlockSpan` (read-only).
+    s_start, s_end, feed_mm_s, dwell_s : numpy.ndarray of float64, shape (nb,)
+        As in :class:`BlockSpan`, mm, mm/s, s (read-only).
+    label, kind, stop_reason : tuple[str, ...]
+        As in :class:`BlockSpan`, length ``nb``.
+    """
+
+    __slots__ = SPAN_COLUMNS + ("_items",)
+
+    def __init__(self, block, line, label, kind, s_start, s_end, first_segment, n_segments,
+                 feed_mm_s=None, stop_reason=None, dwell_s=None) -> None:
+        n = len(block)
+        cols = {"block": block, "line": line, "s_start": s_start, "s_end": s_end,
+                "first_segment": first_segment, "n_segments": n_segments,
+                "feed_mm_s": np.full(n, np.inf) if feed_mm_s is None else feed_mm_s,
+                "dwell_s": np.zeros(n) if dwell_s is None else dwell_s}
+        for name in _SPAN_INT:
+            a = np.ascontiguousarray(cols[name], dtype=np.int64)
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+        for name in _SPAN_FLOAT:
+            object.__setattr__(self, name, _readonly(cols[name]))
+        for name, val in (("label", label), ("kind", kind),
+                          ("stop_reason", ("",) * n if stop_reason is None else stop_reason)):
+            object.__setattr__(self, name, tuple(val))
+        for name in SPAN_COLUMNS:
+            if len(getattr(self, name)) != n:
+                raise PathError(f"block spans: column {name!r} has {len(getattr(self, name))}"
+                                f" entries, expected {n}")
+        object.__setattr__(self, "_items", None)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("BlockSpans is read-only")
+
+    @classmethod
+    def of(cls, spans) -> "BlockSpans":
+        """``spans`` as :class:`BlockSpans` (itself if it is one; a sequence of
+        :class:`BlockSpan` keeps its objects as the items)."""
+        if isinstance(spans, BlockSpans):
+            return spans
+        spans = tuple(spans)
+        out = cls(*([getattr(sp, name) for sp in spans] for name in SPAN_COLUMNS))
+        object.__setattr__(out, "_items", spans)
+        return out
+
+    def moved(self, s_start, s_end, first_segment, n_segments) -> "BlockSpans":
+        """The same blocks at new path positions and segment ranges (shape (nb,) each)."""
+        return BlockSpans(self.block, self.line, self.label, self.kind, s_start, s_end,
+                          first_segment, n_segments, self.feed_mm_s, self.stop_reason,
+                          self.dwell_s)
+
+    @property
+    def length(self) -> np.ndarray:
+        """Block path lengths, mm, shape (nb,)."""
+        return self.s_end - self.s_start
+
+    def _all(self) -> tuple[BlockSpan, ...]:
+        items = self._items
+        if items is None:
+            cols = [getattr(self, name) for name in SPAN_COLUMNS]
+            items = tuple(BlockSpan(*row) for row in zip(*(
+                c if isinstance(c, tuple) else c.tolist() for c in cols)))
+            object.__setattr__(self, "_items", items)
+        return items
+
+    def __len__(self) -> int:
+        return int(self.block.size)
+
+    def __getitem__(self, i):
+        if self._items is not None or isinstance(i, slice):
+            return self._all()[i]
+        i = range(len(self))[i]          # negative indices, IndexError
+        return BlockSpan(*(c[i] if isinstance(c, tuple) else c[i].item()
+                           for c in (getattr(self, name) for name in SPAN_COLUMNS)))
+
+    def __iter__(self):
+        return iter(self._all())
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, (BlockSpans, tuple, list)):
+            return NotImplemented
+        return len(self) == len(other) and tuple(self) == tuple(other)
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"BlockSpans({len(self)} blocks)"
+
+    def __reduce__(self):
+        return (BlockSpans, tuple(getattr(self, name) for name in SPAN_COLUMNS))
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Path:
     """An ordered sequence of segments parameterised by cumulative path length.
@@ -806,8 +920,9 @@ class Path:
         ``k = m`` the end; both are always True).
     stop_reason : tuple[str, ...]
         Length ``m + 1``: why the motion stops at each break (``""`` if it need not).
-    blocks : tuple[BlockSpan, ...]
-        One span per NC block of the program, in program order (zero-length blocks too).
+    blocks : BlockSpans
+        One span per NC block of the program, in program order (zero-length blocks too);
+        any sequence of :class:`BlockSpan` is taken and stored as :class:`BlockSpans`.
     source : str
         Program file the path was built from.
     dradius : numpy.ndarray, shape (m,)
@@ -839,7 +954,7 @@ class Path:
     rapid: np.ndarray
     stop: np.ndarray
     stop_reason: tuple[str, ...]
-    blocks: tuple[BlockSpan, ...]
+    blocks: BlockSpans
     source: str = ""
     dradius: np.ndarray | None = None
     rounding: RoundingTable | None = None
@@ -847,6 +962,7 @@ class Path:
     s_breaks: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "blocks", BlockSpans.of(self.blocks))
         if self.dradius is None:
             object.__setattr__(self, "dradius", np.zeros(np.shape(self.length)))
         if self.sharpness is None:
@@ -1031,6 +1147,24 @@ class Path:
                                        self.omega, self.theta0, idx_in + 1, np.zeros(m - 1),
                                        self.dradius, self.length, self.sharpness)
         return k_in, k_out
+
+    def junction_derivatives(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`junction_tangents` and :meth:`junction_curvatures` of every interior
+        break from one evaluation of each side: ``(t_in, t_out, k_in, k_out)``, each
+        shape (m - 1, n)."""
+        m = self.n_segments
+        if m < 2:
+            z = np.zeros((0, self.n_axes))
+            return z, z, z, z
+        idx_in = np.arange(m - 1)
+        _, t_in, k_in, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
+                                         self.omega, self.theta0, idx_in, self.length[:-1],
+                                         self.dradius, self.length, self.sharpness)
+        _, t_out, k_out, _ = _eval_helical(self.origin, self.e1, self.e2, self.d,
+                                           self.radius, self.omega, self.theta0, idx_in + 1,
+                                           np.zeros(m - 1), self.dradius, self.length,
+                                           self.sharpness)
+        return t_in, t_out, k_in, k_out
 
     def block_of(self, s: np.ndarray | float) -> np.ndarray:
         """NC block index at each global path position (segment rule ``side="right"``)."""

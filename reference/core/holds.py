@@ -137,13 +137,14 @@ def dwell_holds(path) -> Holds:
         One :data:`DWELL_CAUSE` hold per block with ``dwell_s > 0``, at the break where the
         block sits, in program order.
     """
-    rows = [(sp.first_segment, sp.block, sp.dwell_s) for sp in path.blocks if sp.dwell_s > 0]
-    if not rows:
+    spans = path.blocks
+    sel = np.flatnonzero(spans.dwell_s > 0)
+    if not sel.size:
         return NO_HOLDS
-    k, b, d = (np.array(x) for x in zip(*rows))
+    k, b, d = spans.first_segment[sel], spans.block[sel], spans.dwell_s[sel]
     order = np.argsort(k, kind="stable")
     return Holds(break_index=k[order], block=b[order], duration_s=d[order],
-                 cause=(DWELL_CAUSE,) * len(rows))
+                 cause=(DWELL_CAUSE,) * sel.size)
 
 
 def with_holds(profile: Profile, path, holds: Holds) -> Profile:

@@ -378,8 +378,9 @@ class Profile:
         numpy.ndarray, shape (n_blocks,)
             Indexed by block index (``path.blocks[i].block``), s.
         """
-        n_blocks = (max(b.block for b in path.blocks) + 1) if path.blocks else 0
-        cuts = [b.s_end for b in path.blocks if b.s_end > b.s_start]
+        spans = path.blocks
+        n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
+        cuts = spans.s_end[spans.s_end > spans.s_start]
         cut = self._cuts(cuts)
         if cut is None:
             t, s, blk = self.t, self.s, self.block
@@ -392,12 +393,26 @@ class Profile:
         del s, blk
         return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
 
-    def segment_times(self, path) -> np.ndarray:
-        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s."""
-        prof = self.split_at(path.s_breaks)
+    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
+        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
+
+        ``segments`` (int array, optional): only these are wanted; the profile is then
+        split at their own breaks only and the other entries are 0. A segment's
+        intervals are those between its two breaks either way, with the same knots, so
+        its time is the same number.
+        """
+        if segments is None:
+            prof = self.split_at(path.s_breaks)
+        else:
+            segments = np.asarray(segments, dtype=np.int64)
+            prof = self.split_at(path.s_breaks[np.union1d(segments, segments + 1)])
         moving = prof.s[1:] > prof.s[:-1]
         mid = 0.5 * (prof.s[:-1] + prof.s[1:])
         seg = path.segment_index(mid)
+        if segments is not None:
+            wanted = np.zeros(path.n_segments, dtype=bool)
+            wanted[segments] = True
+            moving &= wanted[seg]
         return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
                            minlength=path.n_segments)
 
@@ -412,9 +427,9 @@ def _interval_blocks(s: np.ndarray, block: np.ndarray, path) -> np.ndarray:
     blk = np.array(block, dtype=np.int64)
     if not np.any(blk < 0) or not path.blocks:
         return blk
-    ends = np.array([b.s_end for b in path.blocks])
-    ids = np.array([b.block for b in path.blocks])
-    last = path.blocks[-1].block
+    ends = path.blocks.s_end
+    ids = path.blocks.block
+    last = int(ids[-1])
     for lo in range(0, blk.size, _LABEL_CHUNK):
         hi = min(blk.size, lo + _LABEL_CHUNK)
         part = blk[lo:hi]                       # a view: written in place

@@ -15,7 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .geometry import Path
+from .geometry import KIND_CODES, Path
 from .profile import Profile
 
 
@@ -97,12 +97,10 @@ def block_motion(path: Path, profile: Profile) -> BlockMotion:
     if not spans:
         z = np.zeros(0)
         return BlockMotion(z, z, z, z)
-    idx = np.array([b.block for b in spans], dtype=np.int64)
+    idx = spans.block
     time_s = profile.block_times(path)[idx]
-    cuts = [b.s_end for b in spans if b.s_end > b.s_start]
-    prof = profile.split_at(cuts)
-    s0 = np.array([b.s_start for b in spans])
-    s1 = np.array([b.s_end for b in spans])
+    s0, s1 = spans.s_start, spans.s_end
+    prof = profile.split_at(s1[s1 > s0])
     K = prof.n_intervals
     k_dep = np.clip(np.searchsorted(prof.s, s0, side="right") - 1, 0, prof.s.size - 1)
     k_arr = np.clip(np.searchsorted(prof.s, s1, side="left"), 0, prof.s.size - 1)
@@ -150,3 +148,85 @@ def block_rows(path: Path, motion: BlockMotion, causes: Sequence[str],
                  v_peak=float(motion.v_peak[i]), cause=str(causes[i]),
                  hold_s=float(hold[i]))
         for i, sp in enumerate(spans))
+
+
+# ------------------------------------------------------------------ inserted blocks
+#: Kinds of spans and segments a path stage inserts (corner rounding, tool radius
+#: compensation, tangential lift): a span of such a kind is never split into rows.
+INSERTED_KINDS = ("rounding", "trc", "tlift")
+#: Inserted segments shown on rows of their own: corner roundings (issue 13). The
+#: segments tool radius compensation and tangential control insert (``trc``, ``tlift``)
+#: stay in the row of the block they belong to, as those stages define.
+_ROW_KINDS = ("rounding",)
+_INSERTED_CODES = np.array([KIND_CODES.index(k) for k in _ROW_KINDS], dtype=np.int8)
+
+
+def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
+    """Inserted blocks inside program-block spans: runs of consecutive inserted segments
+    (a clothoid pair's two pieces are one rounding, one row).
+
+    Returns
+    -------
+    dict
+        Span index (into ``path.blocks``) -> ``(first, last)`` segment of each run,
+        shape (r, 2), ascending; spans that are themselves of an inserted kind are not
+        split.
+    """
+    segs = np.flatnonzero(np.isin(path.kind, _INSERTED_CODES))
+    if segs.size == 0:
+        return {}
+    first, nseg = path.blocks.first_segment, path.blocks.n_segments
+    # the span holding each segment: the last span starting at or before it with segments
+    has = np.flatnonzero(nseg > 0)
+    owner = has[np.searchsorted(first[has], segs, side="right") - 1]
+    out: dict[int, list[int]] = {}
+    for i, k in zip(owner.tolist(), segs.tolist()):
+        if path.blocks.kind[i] not in INSERTED_KINDS:
+            out.setdefault(i, []).append(k)
+    runs = {}
+    for i, v in out.items():
+        ks = np.array(v, dtype=np.int64)
+        cut = np.flatnonzero(np.diff(ks) != 1) + 1
+        starts = np.concatenate(([0], cut))
+        ends = np.concatenate((cut, [ks.size])) - 1
+        runs[i] = np.column_stack((ks[starts], ks[ends]))
+    return runs
+
+
+def stretch_motion(profile: Profile, s0: np.ndarray, s1: np.ndarray) -> BlockMotion:
+    """Time, entry, exit and peak speed of a profile on disjoint path stretches.
+
+    Parameters
+    ----------
+    profile : Profile
+    s0, s1 : numpy.ndarray, shape (p,)
+        Stretch ends, mm, ascending and disjoint (``s0 < s1``).
+
+    Returns
+    -------
+    BlockMotion
+        Time from leaving ``s0`` to arriving at ``s1`` (a hold at either end is not in
+        it: inserted segments never carry a stop), the speeds there, and the largest
+        speed in between (knots and the stationary points of the cubic pieces).
+    """
+    s0 = np.asarray(s0, dtype=np.float64)
+    s1 = np.asarray(s1, dtype=np.float64)
+    t0 = profile.time_at(s0, which="last")
+    t1 = profile.time_at(s1, which="first")
+    v0 = profile.state(t0)[1]
+    v1 = profile.state(t1)[1]
+    prof = profile.split_at(np.concatenate((s0, s1)))
+    h = np.diff(prof.t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ts = np.where(prof.j != 0, -prof.a / np.where(prof.j != 0, prof.j, 1.0), -1.0)
+    inside = (ts > 0) & (ts < h)
+    ts = np.where(inside, ts, 0.0)
+    v_in = np.where(inside, prof.v[:-1] + prof.a * ts + prof.j * ts ** 2 / 2, 0.0)
+    v_int = np.maximum(np.maximum(prof.v[:-1], prof.v[1:]), v_in)
+    mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+    piece = np.searchsorted(s0, mid, side="right") - 1
+    ok = (piece >= 0) & (prof.s[1:] > prof.s[:-1])
+    ok[ok] &= mid[ok] < s1[piece[ok]]
+    peak = np.maximum(v0, v1)
+    np.maximum.at(peak, piece[ok], v_int[ok])
+    return BlockMotion(time_s=t1 - t0, v_entry=v0, v_exit=v1, v_peak=peak)

@@ -42,6 +42,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..core.arrays import row_argmin, row_min
 from ..core.geometry import Path
 from ..core.limits import AxisArrays
 from ..core.rules import (FEASIBLE, curvature_jump_speed_cap, curvature_jumps, is_tangential,
@@ -175,15 +176,14 @@ def junction_limits(path: Path, lim: AxisArrays, t_ipo: float, modes: SegmentMod
     JunctionLimits
     """
     m = path.n_segments
-    t_in, t_out = path.junction_tangents()
-    k_in, k_out = path.junction_curvatures()
+    t_in, t_out, k_in, k_out = path.junction_derivatives()
     tangential = is_tangential(t_in, t_out, FEASIBLE)
     x = _Inputs(path=path, lim=lim, t_ipo=t_ipo, modes=modes, seg=seg, t_in=t_in,
                 t_out=t_out, k_in=k_in, k_out=k_out, tangential=tangential)
     results = [rule(x) for _, rule in JUNCTION_RULES]
     caps = np.stack([r[0] for r in results], axis=1)
     codes = np.stack([np.broadcast_to(r[1], (m + 1,)) for r in results], axis=1)
-    arg = np.argmin(caps, axis=1)
+    arg = row_argmin(caps)
     rows = np.arange(m + 1)
     tang = np.zeros(m + 1, dtype=bool)
     tang[1:-1] = tangential
@@ -219,5 +219,5 @@ def through_acceleration(x: _Inputs) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         a = np.where(dt > 0, budget / np.where(dt > 0, dt, 1.0),
                      np.where(budget >= 0, np.inf, -np.inf))
-    out[1:-1] = a.min(axis=1)
+    out[1:-1] = row_min(a)
     return out

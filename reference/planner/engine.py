@@ -25,6 +25,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from ..core.arrays import readonly
 from ..core.constraints import BOUND_SETS, check_profile
 from ..core.geometry import Path
 from ..core.holds import SETTLE_CAUSE, Holds, with_holds
@@ -224,6 +225,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     del seg, horizon, base_units, units, speeds, prof
     sm = fac = new_units = None     # noqa: F841 - the smoothing's and adaptation's copies
     rows = _block_rows(path, modes, junc, at_segments, profile, holds)
+    seg_cause = readonly(at_segments.seg_cause, np.int8)
     del modes, junc, at_segments
     report = None
     if check:
@@ -240,7 +242,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                          profile=profile, blocks=rows, corners=corners,
                          trace=tuple(TraceEntry(*e) for e in trace),
                          bound_set=bound_set, report=report, limits=limits,
-                         parameters=params, holds=holds)
+                         parameters=params, holds=holds, segment_cause=seg_cause)
 
 
 def _cause_counts(what: str, codes: np.ndarray) -> str:
@@ -355,6 +357,12 @@ def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarr
     return idx[hit[first_hit]]
 
 
+def _group_members(lo: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """All indices of the contiguous groups ``[lo, lo + n)``, in order, shape (sum(n),)."""
+    starts = np.cumsum(n) - n
+    return np.repeat(lo, n) + (np.arange(int(n.sum())) - np.repeat(starts, n))
+
+
 class _SegmentRows(NamedTuple):
     """Per-segment and per-break results the block rows are made of (shapes (m,) and
     (m + 1,)), kept apart so that the planning units can be freed before them."""
@@ -433,15 +441,15 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     times = profile.block_times(path) if path.blocks else np.zeros(0)
     spans = path.blocks
     nb = len(spans)
-    first = np.array([sp.first_segment for sp in spans], dtype=np.int64)
-    nseg = np.array([sp.n_segments for sp in spans], dtype=np.int64)
-    ids = np.array([sp.block for sp in spans], dtype=np.int64)
+    first, nseg, ids = spans.first_segment, spans.n_segments, spans.block
     moving = nseg > 0
     # per block: the segment where it spends most time decides cause, mode and case
     main = first.copy()
     multi = np.flatnonzero(nseg > 1)
     if multi.size:
-        main[multi] = _group_argmax(profile.segment_times(path), first[multi], nseg[multi])
+        segs = _group_members(first[multi], nseg[multi])
+        main[multi] = _group_argmax(profile.segment_times(path, segs), first[multi],
+                                    nseg[multi])
     mainc = np.clip(main, 0, max(m - 1, 0))
     t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
     kb = np.clip(first, 0, m)
@@ -456,14 +464,13 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     cause_code = np.where(moving, seg_cause[mainc] if m else 0, junc.cause[kb])
     cause_code = np.where(moving | stop_here, cause_code, -1)
     # a dwell block's whole time is its hold: the hold's own cause, not "forced stop"
-    is_dwell = np.array([sp.dwell_s > 0 and sp.n_segments == 0 for sp in spans], dtype=bool)
+    is_dwell = (spans.dwell_s > 0) & (nseg == 0)
     cause_code = np.where(is_dwell & (t_blk > 0), C.DWELL, cause_code)
     mode_code = np.where(moving, modes.mode[mainc] if m else 0, -1)
     case_code = np.where(moving, case_seg[mainc] if m else 0, -1)
     return BlockTable(
-        block=ids, line=np.array([sp.line for sp in spans], dtype=np.int64),
-        label=tuple(sp.label for sp in spans), kind=tuple(sp.kind for sp in spans),
-        length_mm=np.array([sp.s_end - sp.s_start for sp in spans], dtype=np.float64),
+        block=ids, line=spans.line, label=spans.label, kind=spans.kind,
+        length_mm=spans.s_end - spans.s_start,
         v_entry=v_entry, v_exit=v_exit, v_peak=v_pk, time_s=t_blk, cause_code=cause_code,
         mode_code=mode_code, case_code=case_code,
         hold_s=holds.per_block(int(ids.max()) + 1)[ids] if nb else np.zeros(0))

@@ -7,6 +7,8 @@ from typing import Iterator
 import numpy as np
 
 from ..core.constraints import BOUND_SETS
+from ..core.geometry import KIND_CODES
+from ..core.rows import inserted_pieces, stretch_motion
 from . import causes as C
 from .result import ReferencePlan
 
@@ -55,7 +57,17 @@ _ROW_CHUNK = 1 << 16
 
 def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
     """The ``blocks`` rows of :func:`to_json_dict`, one dict at a time (a table printed
-    from them never holds all 10^6 of them at once)."""
+    from them never holds all 10^6 of them at once).
+
+    One row per program block, in program order; an inserted corner rounding follows
+    the block it is attributed to on a row of its own (``kind`` ``"rounding"``, ``line``
+    the corner's first line, ``corner_lines`` both lines of the corner), as the
+    comparison shows it: the block's row then keeps the rest of its length and time
+    and, where the rounding ends the block, exits at the rounding's entry speed
+    (:func:`_inserted_rows`). A block whose end is a corner in a rounding mode carries
+    ``rounding``: ``"rounded"`` or ``"none: <reason>"``
+    (:meth:`reference.core.rounding.RoundingTable.decision_by_block`).
+    """
     # Built from the table's columns, a chunk of rows at a time: 10^6 blocks would cost
     # 10^6 row objects, or nine lists of 10^6 Python numbers, otherwise.
     tab = plan.blocks
@@ -65,12 +77,86 @@ def iter_json_rows(plan: ReferencePlan) -> Iterator[dict]:
     full = {name: (np.asarray(tab.column(name), dtype=np.float64) if name in floats
                    else tab.column(name)) for name in names}
     hold_cause = plan.holds.causes_by_block()
+    split = _inserted_rows(plan)
+    # the rounding stage's decision at each block's end corner (G641..G645, RND/RNDM):
+    # "rounded" or why none was inserted (issue 13: named in the block rows)
+    decided = (plan.path.rounding.decision_by_block() if plan.path.rounding is not None
+               else {})
     for lo in range(0, len(tab), _ROW_CHUNK):
         cols = [full[name][lo:lo + _ROW_CHUNK] for name in names]
         cols = [c.tolist() if isinstance(c, np.ndarray) else c for c in cols]
         cols[7] = [C.CAUSES[k] if k >= 0 else "" for k in cols[7]]
-        for b, ln, lab, kind, length, t, v, cause, hold in zip(*cols):
-            yield {"block": b, "line": max(1, ln), "label": lab, "kind": kind,
+        for i, (b, ln, lab, kind, length, t, v, cause, hold) in enumerate(zip(*cols), lo):
+            row = {"block": b, "line": max(1, ln), "label": lab, "kind": kind,
                    "length_mm": max(0.0, length), "t_reference_s": max(0.0, t),
                    "v_exit_reference": max(0.0, v), "limit_reference": cause,
                    "hold_s": hold, "hold_cause": hold_cause.get(b, "")}
+            if b in decided:
+                row["rounding"] = decided[b]
+            extra = split.get(i)
+            if extra is None:
+                yield row
+                continue
+            own, inserted = extra
+            row.update(own)
+            yield row
+            yield from inserted
+
+
+def _inserted_rows(plan: ReferencePlan) -> dict[int, tuple[dict, list[dict]]]:
+    """Per span holding inserted corner roundings: the fields of the block's own row
+    that change and the rows of its roundings (a clothoid pair is one rounding).
+
+    Each rounding is measured on the plan's profile exactly
+    (:func:`reference.core.rows.stretch_motion`, the comparison's measure); its limiting
+    cause is the planner's own for its first segment; the block keeps the rest of its
+    length and time, so the rows still sum to the plan's duration.
+    """
+    path = plan.path
+    found = inserted_pieces(path)
+    if not found:
+        return {}
+    spans = path.blocks
+    order = sorted(found)
+    runs = np.concatenate([found[i] for i in order])            # (R, 2) first, last
+    sb = path.s_breaks
+    s0, s1 = sb[runs[:, 0]], sb[runs[:, 1] + 1]
+    mot = stretch_motion(plan.profile, s0, s1)
+    cause = (plan.segment_cause[runs[:, 0]] if plan.segment_cause is not None
+             else np.full(runs.shape[0], -1))
+    corner = {}
+    table = path.rounding
+    if table is not None:
+        line_of = dict(zip(spans.block.tolist(), spans.line.tolist()))
+        for k in np.flatnonzero(table.inserted).tolist():
+            corner[int(table.block[k])] = [max(1, line_of.get(int(table.block[k]), 1)),
+                                           max(1, line_of.get(int(table.next_block[k]), 1))]
+    t_blk = np.asarray(plan.blocks.column("time_s"), dtype=np.float64)
+    out = {}
+    pos = 0
+    for i in order:
+        ks = found[i]
+        nk = ks.shape[0]
+        sl = slice(pos, pos + nk)
+        pos += nk
+        blk, line = int(spans.block[i]), max(1, int(spans.line[i]))
+        lengths = sb[ks[:, 1] + 1] - sb[ks[:, 0]]
+        times = mot.time_s[sl]
+        tail = bool(ks[-1, 1] == spans.first_segment[i] + spans.n_segments[i] - 1
+                    and nk == 1)
+        own = {"length_mm": max(0.0, float(spans.s_end[i] - spans.s_start[i]
+                                           - lengths.sum())),
+               "t_reference_s": max(0.0, float(t_blk[i] - times.sum()))}
+        if tail:
+            own["v_exit_reference"] = max(0.0, float(mot.v_entry[sl][0]))
+        lines = corner.get(blk, [line, line])
+        rows = [{"block": blk, "line": lines[0], "label": "",
+                 "kind": KIND_CODES[int(path.kind[a])], "length_mm": float(ln),
+                 "t_reference_s": max(0.0, float(t)), "v_exit_reference": max(0.0, float(v)),
+                 "limit_reference": C.CAUSES[int(c)] if c >= 0 else "", "hold_s": 0.0,
+                 "hold_cause": "", "corner_lines": list(lines)}
+                for (a, _), ln, t, v, c in zip(ks.tolist(), lengths.tolist(),
+                                               times.tolist(), mot.v_exit[sl].tolist(),
+                                               cause[sl].tolist())]
+        out[i] = (own, rows)
+    return out

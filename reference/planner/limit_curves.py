@@ -46,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.arrays import row_argmin, row_min
 from ..core.geometry import Path, plane_amplitudes
 from ..machine import Machine
 from . import causes as C
@@ -133,8 +134,9 @@ def _axis_factors(path: Path, machine: Machine, modes: SegmentModes):
 
 
 def _min_with_cause(candidates: list[tuple[np.ndarray, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """Smallest candidate per segment and its cause (the first of equal ones)."""
     vals = np.stack([c[0] for c in candidates], axis=1)
-    arg = np.argmin(vals, axis=1)
+    arg = row_argmin(vals)
     codes = np.array([c[1] for c in candidates])
     return vals[np.arange(vals.shape[0]), arg], codes[arg]
 
@@ -147,7 +149,7 @@ def _accel_at(cap, A, D, P, Q, moving):
     with np.errstate(divide="ignore", invalid="ignore"):
         a = np.where(den > 0, A2K2 / np.where(den > 0, den, 1.0), np.inf)
     a = np.where(moving, a, np.inf)
-    return a.min(axis=1)
+    return row_min(a)
 
 
 def _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving):
@@ -162,7 +164,7 @@ def _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving):
     with np.errstate(divide="ignore", invalid="ignore"):
         j = np.where(den > 0, rest / np.where(den > 0, den, 1.0), np.inf)
     j = np.where(moving, j, np.inf)
-    return j.min(axis=1)
+    return row_min(j)
 
 
 def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
@@ -189,12 +191,12 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     inf = np.full(m, np.inf)
     soft = modes.jerk_limited
     with np.errstate(divide="ignore", invalid="ignore"):
-        v_axis = np.where(moving, lim.v_max[None, :] / (D + P), np.inf).min(axis=1)
-        v_cent = np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A / np.where(
-            Q > 0, Q, 1.0)), np.inf).min(axis=1)
+        v_axis = row_min(np.where(moving, lim.v_max[None, :] / (D + P), np.inf))
+        v_cent = row_min(np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A / np.where(
+            Q > 0, Q, 1.0)), np.inf))
         R3 = np.hypot(R, Rn)            # third-derivative amplitude (= R on circles)
-        v_jerk = np.where(R3 > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
-            R3 > 0, R3, 1.0)), np.inf).min(axis=1)
+        v_jerk = row_min(np.where(R3 > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
+            R3 > 0, R3, 1.0)), np.inf))
     v_jerk = np.where(soft, v_jerk, inf)
     v_ipo = path.length / machine.limits.t_ipo_s
     cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
@@ -205,12 +207,11 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     acc = _accel_at(cap, A, D, P, Q, moving)
     # SOFT: leave the jerk budget share for 3 |q''| v a
     with np.errstate(divide="ignore", invalid="ignore"):
-        a_j = np.where(moving & (Q > 0), params.arc_jerk_accel_share * J / (
-            3.0 * np.where(Q > 0, Q, 1.0) * np.maximum(cap, 1e-300)[:, None]), np.inf
-        ).min(axis=1)
+        a_j = row_min(np.where(moving & (Q > 0), params.arc_jerk_accel_share * J / (
+            3.0 * np.where(Q > 0, Q, 1.0) * np.maximum(cap, 1e-300)[:, None]), np.inf))
     acc = np.where(soft, np.minimum(acc, a_j), acc)
     jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving), inf)
-    freq = np.where(moving, lim.frequency_hz[None, :], np.inf).min(axis=1)
+    freq = row_min(np.where(moving, lim.frequency_hz[None, :], np.inf))
     if np.isfinite(knee).any():
         d = np.flatnonzero(np.isfinite(knee))
         acc_hi = _accel_at(cap[d], A[d] * share[d], D[d], P[d], Q[d], moving[d])
@@ -239,8 +240,8 @@ def _drive(path: Path, machine: Machine, modes: SegmentModes, lim, A, D, P, Q, m
     knee, share = drive_reduction(drive, moving, D + P, cap, lim.v_max, sp, fac, kind)
     # centripetal above the knee with the reduced accelerations, not below the knee
     with np.errstate(divide="ignore", invalid="ignore"):
-        v_cent = np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A * share / np.where(
-            Q > 0, Q, 1.0)), np.inf).min(axis=1)
+        v_cent = row_min(np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A * share
+                                                 / np.where(Q > 0, Q, 1.0)), np.inf))
     lower = np.isfinite(knee) & (v_cent < cap)
     new_cap = np.where(lower, np.maximum(v_cent, knee), cap)
     cause = np.where(new_cap < cap, C.AXIS_ACCELERATION, cause)

@@ -27,9 +27,14 @@ Three steps, all O(n) in the number of segments:
    trapezoids are optimal between the junction speeds). SOFT plans with zero acceleration
    at the ends of a unit, so consecutive SOFT segments are merged into one unit, through
    which the jerk-limited ramps continue, when the break between them does not bind (its
-   own limit is at least the unit's cap) and the caps stay within
-   ``soft_merge_cap_ratio``; the unit runs at the smallest cap of its segments with the
-   smallest acceleration and jerk (a safe model).
+   own limit is at least the unit's cap), the caps stay within ``soft_merge_cap_ratio``
+   and the two segments' accelerations and jerks within ``soft_merge_accel_ratio`` of
+   each other; the unit runs at the smallest cap of its segments with the smallest
+   acceleration and jerk (a safe model). The last condition keeps a segment whose
+   dynamics are far lower (a short curved segment at its speed cap: a clothoid pair
+   of a rounding, whose jerk budget the centripetal part uses up) from imposing them on
+   the lines beside it: those ramp with their own limits, and the curved segment is
+   passed at about the speed it is entered with.
 
 3. **Passes** (:func:`lookahead_passes`): a backward pass from the end and a forward pass
    from the start over the units, each step the closed-form reachable speed of
@@ -185,15 +190,21 @@ def _limit_nodes(node_cap, node_cause, cap, cap_cause):
 def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
                  own_cap: np.ndarray, through: np.ndarray, ratio: float,
                  accel_ratio: float) -> np.ndarray:
-    """True at interior breaks where two SOFT segments become one unit (greedy runs)."""
+    """True at interior breaks where two SOFT segments become one unit (greedy runs):
+    both SOFT, no stop, the break lets ``accel_ratio`` of the smaller acceleration
+    through, the two segments' accelerations and jerks within ``accel_ratio`` of each
+    other, and the effective caps of the run within ``ratio``."""
     m = path.n_segments
     merge = np.zeros(m + 1, dtype=bool)
     if m < 2:
         return merge
     jl = modes.jerk_limited
     cand = np.zeros(m + 1, dtype=bool)
+    a0, a1, j0, j1 = seg.accel[:-1], seg.accel[1:], seg.jerk[:-1], seg.jerk[1:]
     cand[1:m] = (jl[:-1] & jl[1:] & ~modes.stop[1:m]
-                 & (through[1:m] >= accel_ratio * np.minimum(seg.accel[:-1], seg.accel[1:])))
+                 & (through[1:m] >= accel_ratio * np.minimum(a0, a1))
+                 & (np.minimum(a0, a1) >= accel_ratio * np.maximum(a0, a1))
+                 & (np.minimum(j0, j1) >= accel_ratio * np.maximum(j0, j1)))
     idx = np.flatnonzero(cand)
     if idx.size == 0:
         return merge

@@ -63,7 +63,10 @@ class PlannerParameters:
         SOFT only: a break is merged into a unit only if the path acceleration that may
         cross it (axis acceleration steps spread over one IPO cycle within the jerk
         limits, :func:`reference.planner.corners.through_acceleration`) is at least this
-        share of the neighbouring segments' acceleration; the unit then accelerates at
+        share of the neighbouring segments' acceleration, and the smaller acceleration
+        and the smaller jerk of the two segments are at least this share of the larger
+        (a unit runs with its smallest: a short curved segment at its cap would
+        otherwise slow the ramps on the lines beside it); the unit then accelerates at
         most with that value (0 < x <= 1). Default 0.5.
     smoothing_rounds : int
         LOOKAH_SMOOTH_FACTOR: rounds of bump removal, shortest bumps first; each round

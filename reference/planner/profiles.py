@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.arrays import row_any, row_max, row_sums
 from ..core.errors import InfeasibleError
 from .parameters import CAUSE_REL_TOL, DISTANCE_REL_TOL, PEAK_SOLVE_ITERATIONS
 
@@ -400,17 +401,17 @@ class UnitProfiles:
     @property
     def time(self) -> np.ndarray:
         """Total time of each unit, s, shape (n,)."""
-        return self.duration.sum(axis=1)
+        return row_sums(self.duration)
 
     @property
     def rise_time(self) -> np.ndarray:
         """Duration of the rise process of each unit, s."""
-        return self.duration[:, :3].sum(axis=1)
+        return row_sums(self.duration[:, :3])
 
     @property
     def fall_time(self) -> np.ndarray:
         """Duration of the fall process of each unit, s."""
-        return self.duration[:, 4:].sum(axis=1)
+        return row_sums(self.duration[:, 4:])
 
 
 def _ramp_phases(dv, acc, jerk):
@@ -528,7 +529,7 @@ def verify_units(units: UnitProfiles, length, cap, acc_up, jerk_up, acc_dn, jerk
     tol = DISTANCE_REL_TOL
     dist = units.dist_rise + units.dist_cruise + units.dist_fall
     checks = (
-        ("negative phase duration", np.any(units.duration < 0, axis=1)),
+        ("negative phase duration", row_any(units.duration < 0)),
         ("distance differs from the unit length",
          np.abs(dist - L) > tol * np.maximum(L, 1.0)
          + 8 * np.finfo(float).eps * (units.v_in + units.v_peak + units.v_out) * units.time),
@@ -543,9 +544,9 @@ def verify_units(units: UnitProfiles, length, cap, acc_up, jerk_up, acc_dn, jerk
         ("fall acceleration above its limit",
          np.abs(units.a0[:, 5]) > acc_dn * (1 + tol)),
         ("jerk above its limit",
-         (np.abs(units.jerk[:, :3]).max(axis=1) > np.where(np.isfinite(jerk_up), jerk_up,
+         (row_max(np.abs(units.jerk[:, :3])) > np.where(np.isfinite(jerk_up), jerk_up,
                                                            np.inf) * (1 + tol))
-         | (np.abs(units.jerk[:, 4:]).max(axis=1) > np.where(np.isfinite(jerk_dn), jerk_dn,
+         | (row_max(np.abs(units.jerk[:, 4:])) > np.where(np.isfinite(jerk_dn), jerk_dn,
                                                              np.inf) * (1 + tol))),
     )
     for rule, bad in checks:

@@ -212,6 +212,10 @@ class ReferencePlan:
         The machine limits used.
     parameters : PlannerParameters
         The model parameters used.
+    segment_cause : numpy.ndarray of int, shape (m,), optional
+        Limiting cause code per path segment (index into
+        :data:`reference.planner.causes.CAUSES`): what the rows of inserted blocks
+        (corner roundings) report.
     """
 
     program: str
@@ -226,6 +230,7 @@ class ReferencePlan:
     report: ConstraintReport | None
     limits: MachineLimits
     parameters: PlannerParameters
+    segment_cause: np.ndarray | None = None
 
     @property
     def time_s(self) -> float:

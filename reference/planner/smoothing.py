@@ -37,7 +37,7 @@ it slows the program by at most that many percent.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import Callable
 
 import numpy as np
@@ -162,17 +162,29 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     replan : callable
         ``replan(units_subset_index -> ...)``: given ``(units, idx, v_nodes)`` returns the
         unit profiles of units ``idx`` with entry ``v_nodes[idx]`` and exit
-        ``v_nodes[idx + 1]``.
+        ``v_nodes[idx + 1]``; each unit's profile must depend on that unit's inputs
+        only (as :func:`reference.planner.profiles.unit_profiles` does, element by
+        element), so that the profiles of accepted bumps are spliced in without
+        planning the other units again.
 
     Returns
     -------
     SmoothingResult
     """
-    t0 = float(prof.time.sum())
+    time_u = prof.time                  # per unit, s (kept up to date below)
+    t0 = float(time_u.sum())
     n_bumps = 0
     if factor_pct <= 0.0 or rounds <= 0 or units.n_units == 0:
         return SmoothingResult(units, speeds, prof, 0, t0, t0)
     v = speeds.v.copy()
+    u = units.n_units
+    s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
+    # bumps rejected in an earlier round, as keys a (u + 1) + b: a bump whose units have
+    # not changed since is the same question with the same answer (same caps, speeds,
+    # profiles and frequency), so it is not planned again; a change to any of its units
+    # forgets it
+    rejected = np.zeros(0, dtype=np.int64)
+    owned = False                       # prof's arrays are copies this stage may write
     for _ in range(rounds):
         valleys = find_valleys(prof)
         if valleys.size < 2:
@@ -181,7 +193,7 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         rise, _ = _moves(prof)
         n_rise = np.concatenate(([0], np.cumsum(rise)))
         has_rise = (n_rise[b] - n_rise[a]) > 0
-        t_cum = np.concatenate(([0.0], np.cumsum(prof.time)))
+        t_cum = np.concatenate(([0.0], np.cumsum(time_u)))
         t_bump = t_cum[b] - t_cum[a]
         f_bump = np.minimum.reduceat(units.frequency[: b[-1]], a)
         with np.errstate(divide="ignore"):
@@ -190,11 +202,12 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         v_flat_all = np.maximum(v[a], v[b])
         # capped, no speed in the bump exceeds v_flat: it takes at least L / v_flat, so a
         # bump whose bound already costs more than the factor is rejected unplanned
-        s_node = np.concatenate((units.s_start, [units.s_start[-1] + units.length[-1]]))
         with np.errstate(divide="ignore", invalid="ignore"):
             t_low = (s_node[b] - s_node[a]) / v_flat_all
         affordable = t_low - t_bump <= factor_pct / 100.0 * t_bump * (1.0 + 1e-9)
         cand = np.flatnonzero(has_rise & short & (b > a) & (v_flat_all > 0) & affordable)
+        if rejected.size and cand.size:
+            cand = cand[~np.isin(a[cand] * (u + 1) + b[cand], rejected)]
         if cand.size == 0:
             break
         v_flat = np.maximum(v[a[cand]], v[b[cand]])
@@ -206,12 +219,15 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         new_cap = np.minimum(units.cap[uidx], vf_u)
         v_new = v.copy()
         nidx = uidx[uidx > 0]
-        v_new[nidx] = np.minimum(v_new[nidx], np.repeat(v_flat, counts)[uidx > 0])
-        trial = units.with_caps(_scatter(units.cap, uidx, new_cap), units.cap_cause)
+        v_new[nidx] = np.minimum(v_new[nidx], vf_u[uidx > 0])
+        # the trial plans units ``uidx`` only, from their caps (node caps unused)
+        trial = replace(units, cap=_scatter(units.cap, uidx, new_cap))
         p_new = replan(trial, uidx, v_new)
         starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
-        t_new = np.add.reduceat(p_new.time, starts)
+        t_new_u = p_new.time
+        t_new = np.add.reduceat(t_new_u, starts)
         ok = t_new - t_bump[cand] <= factor_pct / 100.0 * t_bump[cand]
+        rejected = np.concatenate((rejected, a[cand[~ok]] * (u + 1) + b[cand[~ok]]))
         if not ok.any():
             break
         keep_u = np.repeat(ok, counts)
@@ -235,9 +251,29 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         units = replace(units, node_cap=node_cap, node_cause=node_cause)
         v[nodes] = np.minimum(v[nodes], vf_sel)
         n_bumps += int(ok.sum())
-        prof = replan(units, np.arange(units.n_units), v)
+        # a unit's profile depends on its own cap, limits and end speeds only, and the
+        # accepted units are exactly those whose cap or end speeds changed (the nodes
+        # changed are interior to accepted bumps; the bumps' end nodes are unchanged),
+        # planned above with these very caps and speeds: their rows replace the old ones
+        # (what a replan of every unit would give, element by element)
+        rows = np.flatnonzero(keep_u)
+        if not owned:
+            prof = UnitProfiles(**{f.name: getattr(prof, f.name).copy()
+                                   for f in fields(UnitProfiles)})
+            time_u = time_u.copy()
+            owned = True
+        for f in fields(UnitProfiles):
+            getattr(prof, f.name)[sel] = getattr(p_new, f.name)[rows]
+        time_u[sel] = t_new_u[rows]
+        # rejected bumps that share a unit with an accepted one are open again
+        if rejected.size:
+            touched = np.zeros(u + 1, dtype=np.int64)
+            touched[sel + 1] = 1
+            np.cumsum(touched, out=touched)
+            ra, rb = rejected // (u + 1), rejected % (u + 1)
+            rejected = rejected[touched[rb] == touched[ra]]
     speeds = replace(speeds, v=v)
-    return SmoothingResult(units, speeds, prof, n_bumps, t0, float(prof.time.sum()))
+    return SmoothingResult(units, speeds, prof, n_bumps, t0, float(time_u.sum()))
 
 
 def _scatter(base: np.ndarray, idx: np.ndarray, values: np.ndarray) -> np.ndarray:

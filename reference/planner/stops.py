@@ -127,8 +127,10 @@ def segment_modes(program: Program, path: Path, machine: Machine) -> SegmentMode
     m = path.n_segments
     default = MODE_CODE[machine.channel.acceleration_mode]
     blocks = program.blocks
-    mode = np.array([MODE_CODE.get(blocks[int(b)].accel_mode or "", default)
-                     for b in path.block], dtype=np.int64)
+    # per program block, then per segment (a block may have several segments)
+    mode_of = np.array([MODE_CODE.get(blk.accel_mode or "", default) for blk in blocks],
+                       dtype=np.int64)
+    mode = mode_of[path.block] if m else np.zeros(0, dtype=np.int64)
     jl = JERK_LIMITED[mode] if m else np.zeros(0, bool)
     change = np.zeros(m + 1, dtype=bool)
     if m >= 2:
@@ -137,11 +139,14 @@ def segment_modes(program: Program, path: Path, machine: Machine) -> SegmentMode
     exact = np.zeros(m + 1, dtype=bool)
     es_block = np.full(m + 1, -1, dtype=np.int64)
     if m:
-        ends_exact = np.array([blocks[int(b)].exact_stop_here for b in path.block])
+        ends_exact = np.array([blk.exact_stop_here for blk in blocks], dtype=bool)[path.block]
         exact[1:] = ends_exact
         es_block[1:] = np.where(ends_exact, path.block, -1)
-        g61 = np.array([r.startswith("exact path G61") for r in path.stop_reason])
-        exact |= g61
+        # G61 exact path stops (looked at only where the motion stops: ``exact`` counts
+        # nowhere else)
+        at = np.flatnonzero(stop)
+        exact[at] |= np.array([path.stop_reason[k].startswith("exact path G61")
+                               for k in at.tolist()], dtype=bool)
     stop_class = np.where(exact & stop, STOP_EXACT, np.where(stop, STOP_FORCED, STOP_NONE))
     return SegmentModes(mode=mode, stop=stop, stop_class=stop_class, mode_change=change,
                         exact_stop_block=es_block, default_mode=default)

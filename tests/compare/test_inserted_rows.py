@@ -117,3 +117,74 @@ def test_a_clothoid_pair_is_one_inserted_row(tmp_path):
         assert r.length_mm == pytest.approx(table.length_mm[i], rel=1e-12)
     total = sum(r.t_reference_s for r in c.rows)
     assert total == pytest.approx(c.reference_profile.duration, rel=1e-12)
+
+
+# ------------------------------------------------------------------ feedoracle plan
+def test_plan_rows_show_each_rounding_on_its_own_row_as_compare_does(comparison, tmp_path,
+                                                                     capsys):
+    """``feedoracle plan`` rows (text table and JSON) have the comparison's layout: each
+    rounding on a row of its own after its corner block, with the corner's lines; the
+    block's row keeps the rest of its length and time. The numbers are the comparison's
+    reference side row for row; the rows sum to the plan's duration; each rounding row's
+    time is the time between crossing its two ends (dense-sampling reference)."""
+    import json
+
+    import jsonschema
+
+    from compare import cli
+    from compare.export import schema
+
+    f = tmp_path / "steps.mpf"
+    f.write_text(TEXT)
+    out = tmp_path / "p.json"
+    assert cli.main(["plan", str(f), "--quiet", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    doc = json.loads(out.read_text())
+    jsonschema.validate(doc, schema())
+    rows = doc["blocks"]
+    c = comparison
+    assert len(rows) == len(c.rows)
+    for r, cr in zip(rows, c.rows):
+        assert (r["block"], r["kind"], r["line"]) == (cr.block, cr.kind, cr.line)
+        assert r["length_mm"] == pytest.approx(cr.length_mm, rel=1e-12, abs=1e-12)
+        assert r["t_reference_s"] == pytest.approx(cr.t_reference_s, rel=1e-9, abs=1e-12)
+        assert r["v_exit_reference"] == pytest.approx(cr.v_exit_reference, rel=1e-9,
+                                                      abs=1e-9)
+        assert ("corner_lines" in r) == cr.inserted
+        if cr.inserted:
+            assert tuple(r["corner_lines"]) == cr.corner
+    assert sum(r["t_reference_s"] for r in rows) == pytest.approx(doc["reference"]["time_s"],
+                                                                  rel=1e-12)
+    prof = c.reference_profile
+    s = 0.0
+    for r in rows:
+        if r["kind"] == "rounding":
+            t0, t1 = _crossing_times(prof, np.array([s, s + r["length_mm"]]))
+            assert r["t_reference_s"] == pytest.approx(t1 - t0, abs=4e-6)
+        s += r["length_mm"]
+    assert sum(1 for ln in text.splitlines() if " rounding " in ln) == 3
+
+
+def test_comparison_rows_name_the_rounding_decision_per_corner_block(comparison):
+    """Issue 13 item 2: the cases where no rounding is inserted are "named in the trace
+    and in the block rows". The comparison's rows (JSON, CSV, HTML) carry the rounding
+    stage's decision on the row of the block that ends at the corner, the inserted
+    rounding rows carry none; the program's last corner (X0 -> Y0 -> end) is a stop."""
+    from compare.export import blocks_csv, comparison_dict
+    from compare.report_html import render_report
+
+    c = comparison
+    table = c.path.rounding
+    want = {int(table.block[i]): ("rounded" if table.inserted[i]
+                                  else "none: " + table.reason_text(i))
+            for i in range(table.n)}
+    assert "rounded" in want.values() and any(v.startswith("none") for v in want.values())
+    got = {r.block: r.rounding for r in c.rows if not r.inserted and r.rounding}
+    assert got == want
+    assert all(r.rounding == "" for r in c.rows if r.inserted)
+    doc = comparison_dict(c)
+    assert {r["block"]: r["rounding"] for r in doc["blocks"] if "rounding" in r} == want
+    csv_text = blocks_csv(c)
+    assert "rounding" in csv_text.splitlines()[0].split(",")
+    html = render_report(c)
+    assert ">rounding</th>" in html and "none: " in html

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
 from reference.core.errors import PathError
-from reference.core.geometry import arc_segment, line_segments, path_from_pieces
+from reference.core.geometry import (SPAN_COLUMNS, BlockSpan, BlockSpans, arc_segment,
+                                     line_segments, path_from_pieces)
 
 AX = ("X", "Y", "Z", "A", "B")
 GEO = np.array([True, True, True, False, False])
@@ -148,3 +151,49 @@ def test_restricted_path_keeps_the_moving_axes_exactly():
     assert not np.any(dq[:, rest]) and not np.any(ddq[:, rest]) and not np.any(d3[:, rest])
     for full, part in zip(path.junction_tangents(), sub.junction_tangents()):
         np.testing.assert_array_equal(part, full[:, mov])
+
+
+# ----------------------------------------------------------------- block spans
+SPANS = (BlockSpan(0, 1, "N10", "G1", 0.0, 2.5, 0, 1, 100.0),
+         BlockSpan(1, 2, "", "none", 2.5, 2.5, 1, 0, stop_reason="dwell G4 0.5 s",
+                   dwell_s=0.5),
+         BlockSpan(2, 4, "N30", "G0", 2.5, 7.0, 1, 2, stop_reason="exact stop G9"))
+
+
+def test_block_spans_are_the_spans_they_were_made_of():
+    """``BlockSpans`` (columns) reads back as the very ``BlockSpan`` values, in every
+    access: iteration, index (negative too), slice, columns; and a path stores any
+    sequence of spans as columns."""
+    cols = BlockSpans.of(SPANS)
+    fresh = BlockSpans(*(getattr(cols, c) for c in SPAN_COLUMNS))    # no kept objects
+    for spans in (cols, fresh):
+        assert len(spans) == 3 and bool(spans)
+        assert tuple(spans) == SPANS and spans == SPANS
+        assert spans[-1] == SPANS[2] and spans[1:] == SPANS[1:]
+        assert all(type(getattr(spans[0], f)) is type(getattr(SPANS[0], f))
+                   for f in SPAN_COLUMNS)                     # Python numbers, not numpy
+        np.testing.assert_array_equal(spans.s_end, [2.5, 2.5, 7.0])
+        np.testing.assert_array_equal(spans.length, [2.5, 0.0, 4.5])
+        assert spans.kind == ("G1", "none", "G0")
+        assert pickle.loads(pickle.dumps(spans)) == SPANS
+    with pytest.raises(IndexError):
+        fresh[3]
+    with pytest.raises(AttributeError):
+        cols.s_end = None
+    assert not cols.s_end.flags.writeable
+    path = path_from_pieces(("X",), [line_segments(np.zeros((1, 1)), np.ones((1, 1)),
+                                                   np.array([True]), np.array([0]))])
+    assert isinstance(path.blocks, BlockSpans)
+
+
+def test_block_spans_moved_keeps_everything_but_the_position():
+    """``moved`` changes the path range and segment range only."""
+    spans = BlockSpans.of(SPANS)
+    new = spans.moved(np.array([0.0, 2.0, 2.0]), np.array([2.0, 2.0, 6.0]),
+                      np.array([0, 2, 2]), np.array([2, 0, 3]))
+    for old, sp in zip(SPANS, new):
+        assert (sp.s_start, sp.s_end, sp.first_segment, sp.n_segments) != (
+            old.s_start, old.s_end, old.first_segment, old.n_segments)
+        assert (sp.block, sp.line, sp.label, sp.kind, sp.feed_mm_s, sp.stop_reason,
+                sp.dwell_s) == (old.block, old.line, old.label, old.kind, old.feed_mm_s,
+                                old.stop_reason, old.dwell_s)

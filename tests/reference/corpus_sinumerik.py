@@ -41,3 +41,39 @@ def short_segments_g642() -> str:
         line = re.sub(r"([A-Z]) +(?=[-\d.])", r"\1", line)
         out.append(line)
     return "\n".join(out) + "\n"
+
+
+def corpus_in_mode(name: str, mode: str) -> str:
+    """Corpus program ``name`` as a SINUMERIK program whose continuous-path mode is
+    ``mode`` (e.g. ``"G642"``, ``"G641 ADIS=0.2"``, ``"G64"``).
+
+    LinuxCNC programs (``.ngc``): ``G20``/``G21`` -> ``G700``/``G710``, every ``G64``
+    (with its ``P``/``Q`` blending tolerances) and ``G61`` -> ``mode``, arc radius ``R``
+    -> ``CR=``, ``( )`` comments -> ``;`` comments, tabs -> spaces, axis words upper
+    case; the motion is unchanged. SINUMERIK programs (``.mpf``): ``mode`` in a first
+    line of its own, before the program's own words (a ``G64`` in the program is
+    replaced as well).
+
+    Raises
+    ------
+    FileNotFoundError
+        The corpus is not beside the project.
+    """
+    src = (CORPUS / name).read_text()
+    if name.endswith(".mpf"):
+        return f"{mode}\n" + re.sub(r"\bG64\b", mode, src)
+    out = []
+    for line in src.splitlines():
+        line = line.replace("\t", " ").strip()
+        line = re.sub(r"\(([^)]*)\)", lambda k: f"; {k.group(1)}" if k.start() else
+                      f"; {k.group(1)}", line)
+        code, sep, comment = line.partition(";")
+        code = re.sub(r"\bG20\b", "G700", code)
+        code = re.sub(r"\bG21\b", "G710", code)
+        code = re.sub(r"\bG6[14]\b\s*(P\s*[-\d.]+)?\s*(Q\s*[-\d.]+)?", f" {mode} ", code)
+        code = re.sub(r"([xyzijkrf])(?=\s*[-\d.])", lambda k: k.group(1).upper(), code)
+        code = re.sub(r"([A-Z]) +(?=[-\d.])", r"\1", code)
+        code = re.sub(r"\bR(?=[-\d.])", "CR=", code)
+        out.append((code.strip() + (" " if code.strip() and sep else "") + sep + comment)
+                   .strip())
+    return "\n".join(out) + "\n"

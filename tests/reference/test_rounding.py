@@ -32,13 +32,20 @@ BASE = {
 ROUNDING = KIND_CODES.index("rounding")
 
 
-def machine(ovl: float = 1.2, **channel):
-    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner, so every
-    parameterised corner is rounded and a test sees the geometry alone."""
+def machine(ovl: float = 1.2, velo: float = 30000.0, **channel):
+    """The test machine; ``ovl = 1.0`` makes G64 stop at every corner; ``velo``:
+    MAX_AX_VELO, mm/min (the G0 speed).
+
+    A stop costs its braking and acceleration ramps; a rounding passed at the programmed
+    speed costs nothing and shortens the path, so where the feed (or, for G0, the axis
+    velocity) is below the rounding's own speed every parameterised corner is rounded
+    and a test sees the geometry alone (5.2: rounding only where it does not slow the
+    program down)."""
     d = copy.deepcopy(BASE)
     d["channel"].update(channel)
     for ax in d["axis"].values():
         ax["MAX_ACCEL_OVL_FACTOR"] = ovl
+        ax["MAX_AX_VELO"] = velo
     return machine_from_dict(d)
 
 
@@ -146,13 +153,14 @@ def test_g641_clamp_to_half_the_shorter_block():
 def test_adispos_for_g0_and_the_smaller_distance_for_mixed_blocks():
     """spec 5.3: "ADISPOS is the same for G0"; "If only one of the two blocks is G0,
     the smaller distance applies"."""
-    text = "G90 G641 ADIS=0.5 ADISPOS=0.2 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
-    _, _, path = rounded(text)
+    text = "G90 G641 ADIS=0.5 ADISPOS=0.2 F60\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    # G0 at 60 mm/min: below the speed of the 0.2 mm roundings (see ``machine``)
+    _, _, path = rounded(text, machine(1.0, velo=60.0))
     np.testing.assert_allclose(path.rounding.distance_mm[:2], [0.2, 0.2])
 
 
 # ------------------------------------------------------------------ no rounding block
-@pytest.mark.parametrize("text, why", [
+NO_ROUNDING = [
     # 5.2 group 1 "the axes stop between the blocks anyway"
     ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50 G9\nG1 Y50\n", "stop between the blocks"),
     ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nR1=5\nG1 Y50\n",
@@ -172,7 +180,10 @@ def test_adispos_for_g0_and_the_smaller_distance_for_mixed_blocks():
     ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 X60\n", "tangential transition"),
     ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG2 X60 Y0 I5 J0\n",
      "arc transition: rounding not modelled yet"),
-])
+]
+
+
+@pytest.mark.parametrize("text, why", NO_ROUNDING)
 def test_no_rounding_block_and_why(text, why):
     """spec 5.2 "When no rounding block is inserted": each case, named per corner, in the
     planner trace, and the path keeps the sharp corner."""
@@ -181,6 +192,89 @@ def test_no_rounding_block_and_why(text, why):
     assert not np.any(path.kind == ROUNDING)
     note = dict((e.stage, e.note) for e in plan(prog, mach, path=path).trace)["rounding"]
     assert why in note
+
+
+#: A machine with a rotary A axis beside X, Y, Z (the test machine's limits).
+def machine_a(**channel):
+    d = copy.deepcopy(BASE)
+    d["channel"].update(channel)
+    d["axis"]["A"] = dict(d["axis"]["X"])
+    return machine_from_dict(d)
+
+
+# each case: program, machine, the decision per recorded corner (block before it ->
+# words), so that every documented "no rounding block" reason of spec 5.2 appears in the
+# trace and the block rows, not only in the path
+NO_ROUNDING_CASES = {
+    # 5.2 group 1: "geometry axes move in one block but not in the other" (A alone
+    # between two X/Y blocks: both corners)
+    "geometry in one block": ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 A30\nG1 Y50\n",
+                              machine_a, {2: "geometry axes move in one block only",
+                                          3: "geometry axes move in one block only"}),
+    # 5.2 group 1: "auxiliary function output before the motion in the next block"
+    # (M6 rests at the start of its block, reference.prepare)
+    "aux before motion": ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 Y50 M6\n",
+                          machine, {2: "stop between the blocks"}),
+    # 5.2 group 1: "an axis changes from positioning axis to path axis"; the parser
+    # takes POS only in a block of its own, so the geometry rule names it first
+    "positioning axis": ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nPOS[A]=10\nG1 Y50\n",
+                         machine_a, {2: "geometry axes move in one block only",
+                                     3: "geometry axes move in one block only"}),
+    # 5.2 group 3: "a tolerance of 0"
+    "tolerance 0": ("G90 G642 CTOL=0 F3000\nG1 X0 Y0\nG1 X50\nG1 Y50\n", machine,
+                    {2: "rounding not parameterised (tolerance 0)"}),
+    # model limit, named: a rotary axis moving through the corner
+    "other axes": ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50 A10\nG1 Y50 A20\n", machine_a,
+                   {2: "non-geometry axes move: rounding not modelled yet"}),
+}
+
+
+@pytest.mark.parametrize("case", sorted(NO_ROUNDING_CASES))
+def test_more_no_rounding_cases_are_named(case):
+    """spec 5.2 "When no rounding block is inserted": group 1 "geometry axes move in one
+    block but not in the other", "auxiliary function output before the motion in the
+    next block", "an axis changes from positioning axis to path axis"; group 3 "a
+    tolerance of 0"; and the model's own limit (other axes moving at the corner), each
+    named per corner in the table, the trace and the plan's block rows."""
+    from reference.planner.export import iter_json_rows
+    text, mk, want = NO_ROUNDING_CASES[case]
+    prog, mach, path = rounded(text, mk())
+    assert not np.any(path.kind == ROUNDING)
+    t = path.rounding
+    assert {int(t.block[i]): t.reason_text(i) for i in range(t.n)} == want
+    res = plan(prog, mach, path=path)
+    note = dict(res.trace)["rounding"]
+    rows = {r["block"]: r.get("rounding") for r in iter_json_rows(res)}
+    for blk, why in want.items():
+        assert why in note
+        assert rows[blk] == "none: " + why
+    # blocks whose end is no corner in a rounding mode carry no rounding field
+    assert {b for b, v in rows.items() if v is not None} == set(want)
+
+
+def test_block_rows_name_every_reason_of_the_parametrised_cases():
+    """The block rows of :func:`test_no_rounding_block_and_why`'s programs name the
+    same reason as the trace (issue 13: "each named in the trace and in the block
+    rows")."""
+    from reference.planner.export import iter_json_rows
+    for text, why in NO_ROUNDING:
+        prog, mach, path = rounded(text, machine())
+        rows = [r for r in iter_json_rows(plan(prog, mach, path=path)) if "rounding" in r]
+        assert [r["rounding"] for r in rows] == ["none: " + why], text
+
+
+def test_the_mode_of_the_block_ending_at_the_corner_governs_it():
+    """spec 8: per transition k -> k+1 "if mode == G64: v_j = v64": the group-10 mode in
+    force for block k decides its end corner. G64 into a G642 block is a G64 corner (not
+    recorded, no rounding); a G642 block into a G64 block is rounded."""
+    g64_first = "G90 G64 CTOL=0.05 F3000\nG1 X0 Y0\nG1 X50\nG642 G1 Y50\nG1 X0\n"
+    _, _, path = rounded(g64_first)
+    t = path.rounding
+    assert t.block.tolist() == [3] and t.inserted.tolist() == [True]
+    g642_first = "G90 G642 CTOL=0.05 F3000\nG1 X0 Y0\nG1 X50\nG64 G1 Y50\nG1 X0\n"
+    _, _, path = rounded(g642_first)
+    t = path.rounding
+    assert t.block.tolist() == [2] and t.inserted.tolist() == [True]
 
 
 def test_ignore_ovl_factor_for_adis_rounds_even_a_small_kink():
@@ -370,8 +464,9 @@ def test_smoothing_mode_digits(mode, smoothing, expect):
 def test_g0_tolerance_factor_widens_the_g642_tolerance():
     """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
     factor 3 x COMPRESS_POS_TOL)"."""
-    text = "G90 G642 F3000\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
-    _, _, path = rounded(text, machine(1.0, G0_TOLERANCE_FACTOR=3.0))
+    text = "G90 G642 F60\nG0 X0 Y0\nG0 X50\nG0 Y50\nG1 X0\n"
+    # G0 at 60 mm/min: below the speed of the roundings (see ``machine``)
+    _, _, path = rounded(text, machine(1.0, velo=60.0, G0_TOLERANCE_FACTOR=3.0))
     np.testing.assert_allclose(path.rounding.deviation_mm[0], 3 * 0.01 * math.sqrt(2),
                                rtol=1e-12)
     np.testing.assert_allclose(path.rounding.deviation_mm[1], 0.01 * math.sqrt(2), rtol=1e-12)
