@@ -17,9 +17,8 @@ At 1,000, 2,000 and 5,000 grid intervals (and the scaling exponent of ours):
 Rows print both wall times and ``ours / plain`` (below 1: ours is faster), then the
 bracket of ``optimal.solve(bounds="jerk")`` at its default settings.
 
-copp (the ``copp-py`` package, TOPP3-SOCP) installs from PyPI, but a faithful setup
-(rescaling, repeated TOPP2 linearisation, a node at the end of the first jerk ramp) is
-not written yet, so it has no row here.
+copp (the ``copp-py`` package, TOPP3-SOCP) has its own rows at equal nodes in
+``bench_copp.py``.
 """
 
 from __future__ import annotations
