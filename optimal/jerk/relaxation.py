@@ -175,8 +175,9 @@ class _Rows:
             return sp.csc_matrix((0, n_cols)), np.zeros(0)
         A = sp.coo_matrix((np.concatenate(self.v), (np.concatenate(self.r),
                                                     np.concatenate(self.c))),
-                          shape=(self.n, n_cols))
-        return A.tocsc(), np.concatenate(self.rhs)
+                          shape=(self.n, n_cols)).tocsc()
+        A.eliminate_zeros()      # zero coefficients (a tangent component that vanishes)
+        return A, np.concatenate(self.rhs)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -310,11 +311,11 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
     lin = _Rows()      # A x <= b
     eq = _Rows()       # A x = b
     # ---- 1: node bounds, stops, acc interval times
-    lin.add([(ib + np.arange(N + 1), Bs)], b_hat, normalise=False)
+    lin.add([(ib + np.arange(N + 1), Bs)], b_hat)
     stops = grid.break_node[path.stop]
     if stops.size:
         eq.add([(ib + stops, 1.0)], np.zeros(stops.size), normalise=False)
-    lin.add([(CT, -Ts)], -np.asarray(t_acc, dtype=np.float64), normalise=False)
+    lin.add([(CT, -Ts)], -np.asarray(t_acc, dtype=np.float64))
     if seg_floor is not None:
         fl = np.asarray(seg_floor, dtype=np.float64)
         g_use = np.flatnonzero(fl > 0)
