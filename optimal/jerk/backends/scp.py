@@ -164,6 +164,10 @@ CLARABEL_MAX_ITER = 200
 OSQP_EPS = 1e-4
 OSQP_MAX_ITER = 20_000
 
+#: OSQP's ``status_val`` of "solved" and "solved inaccurate" (the same in 0.6 and 1.x);
+#: an inaccurate step is still only a proposal, judged by the acceptance test.
+_OSQP_SOLVED = (1, 2)
+
 IterateFn = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], None]
 
 
@@ -612,16 +616,17 @@ class _OsqpSub:
                 yr = np.maximum(self.y[r0:r0 + wz.shape[0]], 0.0)
                 np.add.at(diag, wc.ravel(), (yr[:, None] * 2 * wz).ravel())
         P = sp.diags(diag, format="csc")
+        # osqp 1.x renamed ``polish`` and warns unless ``raise_error`` is given
+        v1 = hasattr(osqp, "SolverStatus")
         if self.solver is None:
             self.solver = osqp.OSQP()
             self.solver.setup(P, q, A, lo, hi, eps_abs=OSQP_EPS, eps_rel=OSQP_EPS,
-                              polishing=True, warm_starting=True, verbose=False,
-                              max_iter=OSQP_MAX_ITER)
+                              warm_starting=True, verbose=False, max_iter=OSQP_MAX_ITER,
+                              **{"polishing" if v1 else "polish": True})
         else:
             self.solver.update(q=q, l=lo, u=hi, Ax=data, Px=P.data)
-        res = self.solver.solve()
-        ok = res.info.status_val in (osqp.constant("OSQP_SOLVED"),
-                                     osqp.constant("OSQP_SOLVED_INACCURATE"))
+        res = self.solver.solve(raise_error=False) if v1 else self.solver.solve()
+        ok = res.info.status_val in _OSQP_SOLVED
         if ok:
             self.y = np.asarray(res.y).copy()
         z = np.asarray(res.x) if ok else np.zeros(nx)
