@@ -91,11 +91,14 @@ relative position units; IPOPT's answers hold them to 1e-9). The convex model an
 trust region decide only how fast ``T`` decreases; a poor subproblem answer costs a
 rejected step, never feasibility. ∎
 
-Measured (``tests/bench/bench_jerk.py``, stadium, default machine, one core): Clarabel
-subproblems converge in 20-40 iterations to IPOPT's objective within 1e-8 relative at
-2-4 times IPOPT's wall time; OSQP subproblems reach the same objective but need
-thousands of ADMM iterations per subproblem on these LP-like QPs (tens of times
-slower on 1,000 intervals), so Clarabel is the default and OSQP the alternative.
+Measured (``tests/bench/bench_jerk.py``, stadium of 2 laps, default machine, one run on a
+shared 2-core machine): with Clarabel subproblems SCP reaches IPOPT's objective within
+3e-9 relative in 22-25 iterations, at 3.3 times IPOPT's wall time on 1,000 intervals and
+6.6 times on 5,000 (each interior-point subproblem costs about an IPOPT solve's
+factorisations); with OSQP subproblems it needs thousands of ADMM iterations per
+subproblem on these LP-like QPs, 31 times IPOPT's time on 1,000 intervals, and stalls
+7.5e-6 above IPOPT's objective there. IPOPT stays the default backend; Clarabel is the
+default subproblem solver here, OSQP the alternative.
 
 Units: dimensionless (the problem's :class:`~optimal.jerk.transcription.Units`).
 Shapes: ``N`` intervals, ``n_x = 3 N + 2 + n_extra`` variables.
