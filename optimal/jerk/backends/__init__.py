@@ -5,6 +5,8 @@ imported here only.
 name       method                                                 needs
 =========  =====================================================  ===========
 ipopt      interior point on the exact NLP, CasADi AD (default)   casadi
+scp        sequential convex programming, feasible iterates       clarabel or
+           (:mod:`.scp`; a cross-check of ``ipopt``)              osqp
 =========  =====================================================  ===========
 """
 
