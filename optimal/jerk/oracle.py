@@ -58,7 +58,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
                max_rounds: int = DEFAULT_JERK_MAX_ROUNDS,
                initial_intervals: int = DEFAULT_JERK_INITIAL_INTERVALS,
                progress: ProgressFn | None = None, holds: Holds | None = None,
-               acc_tol: float | None = None) -> OptimalSolution:
+               acc_tol: float | None = None, nlp_backend: str = "ipopt") -> OptimalSolution:
     """Minimum-time motion under the ``jerk`` bound set, with a certified bracket.
 
     Constraints: those of ``acc`` plus per-axis jerk
@@ -87,6 +87,9 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         Imposed holds (default: the dwells of ``path.blocks``).
     acc_tol : float, optional
         Gap requested from the inner ``acc`` solve (default ``min(tol / 4, 2e-3)``).
+    nlp_backend : {"ipopt", "scp"}
+        Solver of the upper bound's NLP (:mod:`optimal.jerk.backends`; ``scp`` is the
+        cross-check: same optimum, 3-7x slower, measured in ``bench_jerk.py``).
 
     Returns
     -------
@@ -139,7 +142,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             relax_note = f" (the relaxation ended {rel.status} on {grid_l.n_points} points)"
             tau_l = t_acc
         tr = time.perf_counter()
-        r = upper_bound_round(path, limits, grid_u, None if best is None else best.profile)
+        r = upper_bound_round(path, limits, grid_u, None if best is None else best.profile,
+                              nlp_backend)
         t_build += r.nlp.build_time_s
         t_solve += r.nlp.solve_time_s
         t_check += time.perf_counter() - tr - r.nlp.build_time_s - r.nlp.solve_time_s
@@ -177,7 +181,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             upper_bound_s=math.inf, objective_s=math.inf, gap=math.inf, time_scale=1.0,
             segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
             blocks=(), grid=acc.grid, active=(), grid_points=int(acc.grid.size),
-            iterations=rounds, backend="ipopt", build_time_s=t_build,
+            iterations=rounds, backend=nlp_backend, build_time_s=t_build,
             solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
             total_time_s=time.perf_counter() - t_start, dwell_s=_dwell_part(holds),
             history=tuple(history), message=f"jerk NLP failed: {msg}", holds=holds,
@@ -200,7 +204,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         objective_s=best.objective_s + hold_t, gap=gap, time_scale=best.time_scale,
         segment_times_s=prof_h.segment_times(path), block_times_s=prof_h.block_times(path),
         blocks=rows, grid=g.s, active=labels, grid_points=g.n_points, iterations=rounds,
-        backend="ipopt", build_time_s=t_build, solve_time_s=t_solve, check_time_s=t_check,
+        backend=nlp_backend, build_time_s=t_build, solve_time_s=t_solve,
+        check_time_s=t_check,
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
         message=message, holds=holds, bounds="jerk")

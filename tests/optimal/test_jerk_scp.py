@@ -203,3 +203,26 @@ def test_majorant_bounds_the_rows_on_the_trust_box():
                 bound = (b.F + np.sum(b.grad * d[b.cols], axis=1)
                          + np.sum(b.w * d[b.wcols] ** 2, axis=1))
                 assert np.all(b1.F <= bound + 1e-12 * b.scale)
+
+
+def test_scp_backend_through_solve_brackets_like_ipopt():
+    """``optimal.solve(..., nlp_backend="scp")``: the same certified bracket contract
+    (its profile accepted by the checker, within the requested gap), and its
+    upper bound within 1e-6 of IPOPT's on the same grid (both converge to the grid's
+    optimum; the lower bound does not depend on the NLP solver)."""
+    from reference.core.constraints import BOUND_SETS, check_profile
+    import optimal
+    path, lim = line_arc_line(5.0, 20.0), limits()
+    # a 3 % bracket: one or two rounds (each SCP round takes several IPOPT times)
+    ip = optimal.solve(path, lim, bounds="jerk", tol=0.03, initial_intervals=100)
+    sc = optimal.solve(path, lim, bounds="jerk", tol=0.03, initial_intervals=100,
+                       nlp_backend="scp")
+    assert sc.backend == "scp" and ip.backend == "ipopt"
+    assert sc.status == ip.status == optimal.SolveStatus.OPTIMAL, (sc.message, ip.message)
+    assert check_profile(path, lim, sc.profile).ok(BOUND_SETS["jerk"])
+    assert sc.lower_bound_s <= sc.upper_bound_s <= sc.lower_bound_s * 1.03
+    if sc.history[0].grid_points == ip.history[0].grid_points:
+        assert sc.history[0].upper_bound_s == pytest.approx(ip.history[0].upper_bound_s,
+                                                            rel=CROSS_CHECK_RTOL)
+    with pytest.raises(ValueError, match="nlp_backend"):
+        optimal.solve(path, lim, bounds="jerk", nlp_backend="fatrop")
