@@ -185,7 +185,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
             total_time_s=time.perf_counter() - t_start, dwell_s=_dwell_part(holds),
             history=tuple(history), message=f"jerk NLP failed: {msg}", holds=holds,
-            bounds="jerk")
+            bounds="jerk", segment_lower_bounds_s=floors)
     prof_h = with_holds(best.profile, path, holds)
     labels = active_labels(best)
     g = best.problem.grid
@@ -208,7 +208,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         check_time_s=t_check,
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
-        message=message, holds=holds, bounds="jerk")
+        message=message, holds=holds, bounds="jerk", segment_lower_bounds_s=floors)
 
 
 def _refine_marks(d: np.ndarray, target_s: float) -> tuple[np.ndarray, int]:

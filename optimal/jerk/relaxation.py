@@ -91,7 +91,8 @@ from reference.core.tolerances import ACCEL_CONTINUITY_TOL_REL
 from ..bounds import derivative_ranges
 from ..grid import Grid
 from ..problem import interval_geometry
-from .tolerances import RELAX_SOLVER_MARGIN_REL, RELAX_SOLVER_TOL
+from .backends.socp import solve_conic
+from .tolerances import RELAX_SOLVER_MARGIN_REL, RELAX_SOLVER_MAX_ITER, RELAX_SOLVER_TOL
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -455,44 +456,32 @@ def jerk_relaxation(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
     -------
     RelaxationResult
     """
-    import clarabel
-
     tb = time.perf_counter()
     prob = build_relaxation_problem(path, lim, t_ipo, grid, b_hat, t_acc, seg_floor)
     N = grid.n_intervals
     _, _, Ts = prob.scales
     Bs = prob.scales[0]
-    cones = []
-    if prob.n_eq:
-        cones.append(clarabel.ZeroConeT(prob.n_eq))
-    cones.append(clarabel.NonnegativeConeT(prob.n_lin))
-    cones.extend([clarabel.SecondOrderConeT(3)] * prob.n_soc)
     q = np.zeros(prob.n_var)
     q[prob.tau_col] = 1.0
-    P = sp.csc_matrix((prob.n_var, prob.n_var))
-    st = clarabel.DefaultSettings()
-    st.verbose = False
-    st.tol_gap_abs = st.tol_gap_rel = st.tol_feas = RELAX_SOLVER_TOL
-    st.max_iter = 200
-    solver = clarabel.DefaultSolver(P, q, prob.A, prob.b, cones, st)
     ts = time.perf_counter()
-    sol = solver.solve()
+    sol = solve_conic(prob.A, prob.b, q, prob.n_eq, prob.n_lin, prob.n_soc,
+                      RELAX_SOLVER_TOL, RELAX_SOLVER_MAX_ITER)
     te = time.perf_counter()
-    status = str(sol.status)
-    x = np.asarray(sol.x)
-    p_obj, d_obj = float(sol.obj_val), float(sol.obj_val_dual)
+    status = sol.status
+    x = sol.x
+    p_obj, d_obj = sol.primal_objective, sol.dual_objective
     rel_gap = (abs(p_obj - d_obj) / max(abs(p_obj), 1e-300)
                if np.isfinite(p_obj) and np.isfinite(d_obj) else np.inf)
     solved = (status in ("Solved", "AlmostSolved") and rel_gap <= RELAX_SOLVER_MARGIN_REL
               and np.all(np.isfinite(x)))
     if not solved:
         return RelaxationResult(False, 0.0, np.zeros(N), np.zeros(N + 1), status,
-                                int(sol.iterations), ts - tb, te - ts)
+                                sol.iterations, ts - tb, te - ts)
     obj = min(p_obj, d_obj) * Ts
     lb = max(obj, 0.0) * (1.0 - RELAX_SOLVER_MARGIN_REL - rel_gap)
     return RelaxationResult(True, lb, x[prob.tau_col] * Ts,
                             np.maximum(x[prob.b_col] * Bs, 0.0), status,
-                            int(sol.iterations), ts - tb, te - ts)
+                            sol.iterations, ts - tb, te - ts)
 
 
 def _cone3(K, t_terms, t_const, z_terms, z_const, n_var):

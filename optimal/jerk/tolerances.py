@@ -84,6 +84,10 @@ JERK_LB_ROUNDOFF_REL = 1e-9
 #: square and the demo, 52 against 35).
 RELAX_SOLVER_TOL = 1e-6
 
+#: Clarabel's iteration cap for the relaxation (it takes 20-40 on the corpus; a run that
+#: needs more has stalled and gives no bound, the per-segment floors remain).
+RELAX_SOLVER_MAX_ITER = 200
+
 #: Relative margin taken off the relaxation's objective (the smaller of Clarabel's primal
 #: and dual values, less also their own relative difference) before it is reported as a
 #: lower bound: ten times the solver's tolerance, so that an optimum reported within

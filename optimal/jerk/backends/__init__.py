@@ -8,6 +8,8 @@ ipopt      interior point on the exact NLP, CasADi AD (default)   casadi
 scp        sequential convex programming, feasible iterates       clarabel or
            (:mod:`.scp`; a cross-check of ``ipopt``)              osqp
 =========  =====================================================  ===========
+
+The relaxation's conic solve (:mod:`optimal.jerk.relaxation`) is :mod:`.socp` (Clarabel).
 """
 
 from __future__ import annotations
