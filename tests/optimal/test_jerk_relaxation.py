@@ -29,7 +29,9 @@ from reference.machine import load_machine
 CORPUS = "../shared/corpus/"
 PROGRAMS = ["examples/demo.mpf", "examples/slot.ngc", CORPUS + "lcnc_square.ngc",
             CORPUS + "sin_cead_arc.mpf", CORPUS + "lcnc_arc_arc_sawtooth.ngc",
-            CORPUS + "lcnc_tangent_helix.ngc"]
+            CORPUS + "lcnc_tangent_helix.ngc",
+            # arcs whose end radius differs from the start: spirals (step 6 on them)
+            CORPUS + "lcnc_sam_tolerance_issue.ngc"]
 #: The time offset at which a motion's acceleration is read on each side of a node:
 #: far below any interval, far above float resolution of the knot times.
 SIDE_S = 1e-9
