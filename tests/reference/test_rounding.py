@@ -560,6 +560,45 @@ def test_the_rounding_speed_estimate_uses_the_planner_default_centripetal_share(
     assert JERK_VELOCITY_SHARE == DEFAULT_PARAMETERS.arc_jerk_velocity_share
 
 
+def test_soft_corner_with_a_faster_but_longer_rounding_stays_sharp_on_the_bundled_machine(
+        monkeypatch):
+    """spec 5.2 group 2 "Rounding would slow the program down", on the bundled SOFT
+    machine (A = 2 m/s^2, J = 40 m/s^3, overload factor 1.2, T_ipo = 4 ms): a 90 degree
+    G642 CTOL=0.05 corner at F3000. G64 passes it at the axis jump A (1.2 - 1) T_ipo =
+    1.6 mm/s (96 mm/min); the clothoid pair that deviates by 0.05 mm (pieces L =
+    0.05 / e_1(pi/2)) is crossed faster, at the jerk limit cbrt(0.5 J / |q3|), |q3| =
+    theta sqrt(1 + theta^2) / L^2 (5.15 mm/s, 309 mm/min), but over 0.28 mm, and both
+    ramp almost the same way down from 50 mm/s. Reported as a suspected bug of the
+    decision; planned both ways by the heuristic, the rounded contour is the slower one
+    (0.04 s per corner), so leaving the corners sharp is right."""
+    from reference import rounding as rounding_stage
+    from reference.core.geometry import clothoid_pair_shape
+    text = square("G642", "CTOL=0.05").replace("G17", "G17 SOFT")
+    prog = parse_text(text)
+    mach = load_machine()
+    path = build_path(prog, mach)
+    t = path.rounding
+    assert reasons(path) == ["rounding would be slower than G64"] * 3
+    theta = math.pi / 2
+    np.testing.assert_allclose(t.v_g64, 2000.0 * 0.2 * 0.004, rtol=1e-9)
+    _, e_1 = clothoid_pair_shape(np.array([theta]))
+    L = 0.05 / e_1[0]
+    v_jerk = (0.5 * 40000.0 * L * L / (theta * math.sqrt(1 + theta * theta))) ** (1 / 3)
+    assert v_jerk == pytest.approx(309.0 / 60.0, rel=1e-3)
+    np.testing.assert_allclose(t.v_round, v_jerk, rtol=1e-9)
+    # the same corners rounded (the stage told that the rounding costs nothing; even a
+    # G64 stop would cost less than this rounding) and planned: slower than sharp
+    loss = rounding_stage.corner_time_loss
+    monkeypatch.setattr(rounding_stage, "corner_time_loss", lambda *a: np.where(
+        np.asarray(a[7]) > 0, -np.inf, loss(*a)))
+    forced = build_path(prog, mach)
+    assert forced.rounding.inserted.all()
+    np.testing.assert_allclose(forced.rounding.deviation_mm, 0.05, rtol=1e-9)
+    t_sharp = plan(prog, mach, path=path).time_s
+    t_round = plan(prog, mach, path=forced).time_s
+    assert t_round > t_sharp + 3 * 0.03
+
+
 def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
     """spec 5.2 group 2 "Rounding would slow the program down": BRISK, MD33100 0.01 mm,
     90 degree corners at F3000: the arc (R = 0.034 mm) is crossed at sqrt(0.75 * 2000 *
