@@ -80,6 +80,11 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     N = problem.n_intervals
     ne = problem.n_extra
     nx = 2 * (N + 1) + N + ne
+    # SX: nlpsol differentiates the scalar graph symbolically, about half of the round at
+    # 5,000 intervals (2.4 s of 5.3 s on the stadium). An MX graph (one node per vector
+    # operation) builds in 0.2 s and was 1.4-2.2x faster in all on the stadium, but its
+    # derivatives led IPOPT astray on sin_cead_arc.mpf (700 iterations, both barrier
+    # strategies, against 171 with SX): kept SX until that is understood.
     x = ca.SX.sym("x", nx)
     c = x[0:N + 1]
     a = x[N + 1:2 * (N + 1)]
@@ -141,9 +146,8 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     build = time.perf_counter() - tb
     solve = 0.0
     iters = 0
-    # IPOPT's adaptive barrier update is the faster one on most paths here, but on some
-    # (long arcs at the feed) it wandered for 900 iterations where the monotone update
-    # took 30: try adaptive with a short leash, then monotone
+    # the barrier strategies in turn (MU_STRATEGIES: monotone first, measured on the
+    # corpus), each with its own iteration cap
     for k, (strategy, max_iter) in enumerate(MU_STRATEGIES):
         tk = time.perf_counter()
         opts = {"ipopt.print_level": print_level, "print_time": False,
