@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from oracle_cases import XYZ, line_arc_line, line_path, semicircle
+from oracle_cases import XYZ, line_arc_line, line_path, ruckig_line_time, semicircle
 from optimal.grid import initial_grid
 from optimal.jerk.backends import ipopt, scp
 from optimal.jerk.transcription import build_jerk_problem
@@ -53,17 +53,6 @@ def limits(v=V, a=A, j=J) -> MachineLimits:
     return MachineLimits(tuple(AxisLimits(n, v, a, j, 1.2) for n in XYZ), T_IPO)
 
 
-def ruckig_time(L, a_s) -> float:
-    otg = ruckig.Ruckig(1)
-    inp = ruckig.InputParameter(1)
-    traj = ruckig.Trajectory(1)
-    inp.current_position, inp.target_position = [0.0], [L]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
-    inp.current_acceleration, inp.target_acceleration = [a_s], [-a_s]
-    otg.calculate(inp, traj)
-    return traj.duration
-
-
 def setup(path, lim, n):
     la = lim.for_axes(path.axes)
     grid = initial_grid(path, n)
@@ -81,7 +70,7 @@ def test_single_line_between_ruckig_and_one_percent_above(L):
     problem, start = setup(path, limits(), FINE_INTERVALS)
     res = scp.solve_nlp(problem, *start)
     assert res.success, res.message
-    exact = ruckig_time(L, J * T_IPO)
+    exact = ruckig_line_time(L, V, A, J, J * T_IPO)
     T = seconds(problem, res)
     assert T >= exact * (1 - BELOW_EXACT_RTOL)
     assert T <= exact * (1 + RUCKIG_RTOL)
