@@ -2,15 +2,20 @@
 
 Pipeline:
 
-1. the ``acc`` oracle on the same path (its lower bound is valid here too, and its final
-   grid carries the per-segment ``acc`` relaxation of :mod:`optimal.jerk.lower`);
-2. the certified lower bound (:func:`optimal.jerk.lower.jerk_lower_bound`);
-3. the jerk NLP on a piece-aware grid (:mod:`optimal.jerk.upper`): solve, verify with
-   ``check_profile``, time-scale; while the gap is above ``tol`` and a finer grid still
-   can close the gap (extrapolated from the last rounds), solve again on a grid with
-   every interval halved;
-4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met``
-   with both (valid) bounds; ``solver_error`` when IPOPT never produced a verified
+1. the ``acc`` oracle on the same path (its lower bound is valid here too, its optimum
+   says where the speed changes, and its relaxation bounds the speeds);
+2. per-segment floors (:func:`optimal.jerk.lower.jerk_lower_bound`), valid for every
+   jerk-feasible motion segment by segment (also the per-block lower bounds);
+3. the first grid (:func:`jerk_grid`): equal intervals per segment, graded toward the
+   segment ends where the ``acc`` optimum changes speed;
+4. rounds on that grid: the convex relaxation (:mod:`optimal.jerk.relaxation`, the
+   lower bound) and the jerk NLP (:mod:`optimal.jerk.upper`: solve, exact profile,
+   ``check_profile``, time scaling: the upper bound); then both are refined together
+   where the verified profile spends more time than the relaxation
+   (:func:`_refine_marks`), until the gap is met, the grid budget or the round budget
+   ends;
+5. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met``
+   with both (valid) bounds; ``solver_error`` when the NLP never produced a verified
    profile (then only the lower bound is reported, the upper bound is ``inf``).
 
 Units: mm, s.
@@ -89,7 +94,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         Gap requested from the inner ``acc`` solve (default ``min(tol / 4, 2e-3)``).
     nlp_backend : {"ipopt", "scp"}
         Solver of the upper bound's NLP (:mod:`optimal.jerk.backends`; ``scp`` is the
-        cross-check: same optimum, 3-7x slower, measured in ``bench_jerk.py``).
+        cross-check: same optimum, about 12x slower, measured in ``bench_jerk.py``).
 
     Returns
     -------
