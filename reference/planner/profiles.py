@@ -346,11 +346,16 @@ def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn, knee=None,
         with np.errstate(divide="ignore", invalid="ignore"):
             xn = xa - gx / slope
         bad = ~np.isfinite(xn) | (xn <= aa) | (xn >= ba)
-        xa = np.where(bad, 0.5 * (aa + ba), xn)
+        # g(x) <= 0 within round-off of 0: x is the root (feasible side); the Newton
+        # step from there may leave the bracket by round-off (then "bad"), and bisecting
+        # away from the root would take some 30 steps to come back (the quadratic start
+        # is such a root for every BRISK unit)
+        root = (gx <= 0) & (np.abs(gx) <= eps4 * L[idx])
+        xa = np.where(bad, np.where(root, xa, 0.5 * (aa + ba)), xn)
         a[act], b[act], x[act] = aa, ba, xa
         # converged: bracket at round-off width, or the step no longer moves x
         done = (ba - aa <= eps4 * np.maximum(ba, 1.0)) | (
-            ~bad & (np.abs(gx) <= eps4 * L[idx]))
+            (~bad | root) & (np.abs(gx) <= eps4 * L[idx]))
         act = act[~done]
         if act.size == 0:
             break
