@@ -375,12 +375,36 @@ def _fits(v_lo: float, v_hi: float, dist: float, acc: float, jerk: float) -> boo
         <= dist
 
 
+def _keeps_own(v_own: np.ndarray, v_from: np.ndarray, dist: np.ndarray, acc_fit: np.ndarray,
+               jerk: np.ndarray, acc: np.ndarray, brisk: np.ndarray) -> np.ndarray:
+    """True where a step of :func:`lookahead_passes` from ``v_from`` keeps ``v_own``
+    without computing a reachable speed one by one: the scalar tests of the pass
+    (``v_own <= v_from``, :func:`_fits`, and for BRISK units :func:`_reach_brisk`) with
+    the same operations, element by element, so the answers are bitwise theirs. False
+    does not mean the step binds: the pass then takes the step itself.
+    """
+    with np.errstate(invalid="ignore", over="ignore"):
+        keeps = ((v_own <= v_from)
+                 | ((v_own * v_own - v_from * v_from) / (2.0 * acc_fit)
+                    + (v_own + v_from) * acc_fit / (2.0 * jerk) <= dist))
+        keeps |= brisk & (v_own <= np.sqrt(v_from * v_from + 2.0 * acc * dist))
+    return keeps
+
+
 def lookahead_passes(units: Units) -> NodeSpeeds:
     """Backward and forward passes over the units (closed-form steps).
 
     Each step first tries the cheap sufficient test :func:`_fits` (most nodes are bound
     by their own limit; a DRIVE unit takes its reduced acceleration there, which keeps
     the test sufficient) and computes the exact reachable speed only when it fails.
+
+    Most nodes keep their own limit: where the neighbour a step comes from keeps its
+    own, that step's outcome is decided for all units at once (:func:`_keeps_own`).
+    The steps run one by one only along the chains that start where that fails (a
+    braking or an acceleration that binds, or a SOFT or DRIVE step the cheap test does
+    not settle) and end at the first node that keeps its limit. The speeds are those of
+    taking every step in order: each node is either decided from its neighbour's own
+    limit with the same operations, or stepped from its neighbour's final speed.
 
     Parameters
     ----------
@@ -401,35 +425,54 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     kn, kr = units.knee.tolist(), units.knee_ratio.tolist()
     # the cheap test with the acceleration above the knee (the smallest of a unit)
     r_fit = np.where(drive, units.knee_ratio, 1.0)
-    ad_fit, au_fit = (units.acc_dn * r_fit).tolist(), (units.acc_up * r_fit).tolist()
-    b = [0.0] * (n + 1)
-    origin = [0] * (n + 1)
-    b[n], origin[n] = cap[n], cause[n]
+    acd_fit, acu_fit = units.acc_dn * r_fit, units.acc_up * r_fit
+    ad_fit, au_fit = acd_fit.tolist(), acu_fit.tolist()
+    brisk = ~units.jerk_limited & ~drive
     reach = _REACH
     fits = _fits
-    for k in range(n - 1, -1, -1):
-        be, c = b[k + 1], cap[k]
-        if c <= be or fits(be, c, L[k], ad_fit[k], jd[k]):
-            b[k], origin[k] = c, cause[k]
-            continue
-        r = reach[jl[k]](be, L[k], ad[k], jd[k], kn[k], kr[k])
-        if c <= r:
-            b[k], origin[k] = c, cause[k]
-        else:
+    # backward: b[k] from b[k + 1]; a chain walks on while its nodes fall below their
+    # caps, so a node it does not reach has a neighbour at its cap (decided above)
+    nc = units.node_cap
+    start = ~_keeps_own(nc[:-1], nc[1:], units.length, acd_fit,
+                        units.jerk_dn, units.acc_dn, brisk)
+    b = list(cap)
+    origin = list(cause)
+    low = n                             # nodes >= low are final
+    for s0 in np.flatnonzero(start)[::-1].tolist():
+        if s0 >= low:
+            continue                    # inside the chain walked last
+        k = s0
+        while k >= 0:
+            be, c = b[k + 1], cap[k]
+            if c <= be or fits(be, c, L[k], ad_fit[k], jd[k]):
+                break
+            r = reach[jl[k]](be, L[k], ad[k], jd[k], kn[k], kr[k])
+            if c <= r:
+                break
             b[k], origin[k] = r, origin[k + 1]
-    w = [0.0] * (n + 1)
+            k -= 1
+        low = k
+    # forward: w[k + 1] from w[k], the same way (a node no chain reaches keeps b)
+    bb = np.array(b)
+    start = ~_keeps_own(bb[1:], bb[:-1], units.length, acu_fit,
+                        units.jerk_up, units.acc_up, brisk)
+    w = list(b)
     acc_lim = [False] * (n + 1)
-    w[0] = b[0]
-    for k in range(n):
-        ws, bn = w[k], b[k + 1]
-        if bn <= ws or fits(ws, bn, L[k], au_fit[k], ju[k]):
-            w[k + 1] = bn
+    high = 0                            # nodes <= high are final
+    for s0 in np.flatnonzero(start).tolist():
+        if s0 < high:
             continue
-        f = reach[jl[k]](ws, L[k], au[k], ju[k], kn[k], kr[k])
-        if bn <= f:
-            w[k + 1] = bn
-        else:
+        k = s0
+        while k < n:
+            ws, bn = w[k], b[k + 1]
+            if bn <= ws or fits(ws, bn, L[k], au_fit[k], ju[k]):
+                break
+            f = reach[jl[k]](ws, L[k], au[k], ju[k], kn[k], kr[k])
+            if bn <= f:
+                break
             w[k + 1] = f
             acc_lim[k + 1] = True
-    return NodeSpeeds(v=np.array(w), backward=np.array(b), origin_cause=np.array(origin),
+            k += 1
+        high = k + 1
+    return NodeSpeeds(v=np.array(w), backward=bb, origin_cause=np.array(origin),
                       accel_limited=np.array(acc_lim))
