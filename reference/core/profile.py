@@ -492,11 +492,14 @@ def _interval_blocks(s: np.ndarray, block: np.ndarray, path) -> np.ndarray:
             continue
         s0, s1 = s[lo:hi], s[lo + 1:hi + 1]
         moving = s1 > s0
-        mid = 0.5 * (s0 + s1)
-        by_pos = path.block_of(mid) if path.n_segments else np.full(mid.size, last)
-        # last block (program order) whose end is at or before each hold position
-        last_end = np.searchsorted(ends, s0, side="right") - 1
-        hold_blk = ids[np.clip(last_end, 0, len(ids) - 1)]
-        part[todo & moving] = by_pos[todo & moving]
-        part[todo & ~moving] = hold_blk[todo & ~moving]
+        # moving intervals: the block at the mid-point (looked up for those only, and the
+        # holds, usually a few, on their own)
+        mv = np.flatnonzero(todo & moving)
+        mid = 0.5 * (s0[mv] + s1[mv])
+        part[mv] = path.block_of(mid) if path.n_segments else last
+        # holds: the last block (program order) whose end is at or before the position
+        hd = np.flatnonzero(todo & ~moving)
+        if hd.size:
+            last_end = np.searchsorted(ends, s0[hd], side="right") - 1
+            part[hd] = ids[np.clip(last_end, 0, len(ids) - 1)]
     return blk
