@@ -63,8 +63,12 @@ def rounding_note(path: Path) -> str:
     ins = table.inserted
     # counted over the tuple of mode names (an array of 10^4 strings costs more to build
     # than the counts)
-    n_all = Counter(table.mode)
-    n_in = Counter(compress(table.mode, ins.tolist()))
+    kinds = set(table.mode)
+    if len(kinds) == 1:             # one mode at every corner (most programs): no counting
+        n_all, n_in = {md: table.n for md in kinds}, {md: int(ins.sum()) for md in kinds}
+    else:
+        n_all = Counter(table.mode)
+        n_in = Counter(compress(table.mode, ins.tolist()))
     per_mode = ", ".join(f"{md} {n_in[md]}/{n_all[md]}" for md in sorted(n_all))
     left = np.bincount(table.reason[~ins], minlength=len(ROUNDING_REASONS))
     order = sorted(np.flatnonzero(left), key=lambda r: (-left[r], ROUNDING_REASONS[r]))
@@ -88,6 +92,14 @@ def _replan(units: Units, idx: np.ndarray, v_nodes: np.ndarray) -> UnitProfiles:
     return unit_profiles(v_nodes[idx], v_nodes[idx + 1], units.length[idx], units.cap[idx],
                          units.acc_up[idx], units.jerk_up[idx], units.acc_dn[idx],
                          units.jerk_dn[idx], units.knee[idx], units.knee_ratio[idx])
+
+
+def _plan_all(units: Units, v_nodes: np.ndarray) -> UnitProfiles:
+    """:func:`_replan` of every unit (the arrays as they are, without gathering copies
+    of them; the profiles do not write to their inputs)."""
+    return unit_profiles(v_nodes[:-1], v_nodes[1:], units.length, units.cap, units.acc_up,
+                         units.jerk_up, units.acc_dn, units.jerk_dn, units.knee,
+                         units.knee_ratio)
 
 
 def plan(program: Program, machine: Machine, *, path: Path | None = None,
@@ -167,7 +179,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                                 params.soft_merge_accel_ratio)
     units = base_units
     speeds = lookahead_passes(units)
-    prof = _replan(units, np.arange(units.n_units), speeds.v)
+    prof = _plan_all(units, speeds.v)
     n_h = int(np.sum(units.node_cause == C.HORIZON))
     trace.append(("lookahead", f"horizon {ch.lookahead_blocks} blocks (v = 0 assumed at its "
                                f"end; binding at {n_h} nodes); {units.n_units} planning units "
@@ -202,7 +214,7 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                 break
             units = new_units
             speeds = lookahead_passes(units)
-            prof = _replan(units, np.arange(units.n_units), speeds.v)
+            prof = _plan_all(units, speeds.v)
             n_ad = int(np.sum(units.adapted_up) + np.sum(units.adapted_dn))
         trace.append(("adaptation", f"ADAPT_PATH_DYNAMIC {list(adapt)}: {n_ad} velocity-change "
                                     "processes stretched towards 1/LOOKAH_FREQUENCY"))

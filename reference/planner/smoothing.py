@@ -129,7 +129,11 @@ def find_valleys(prof: UnitProfiles) -> np.ndarray:
     numpy.ndarray of int
         Sorted node indices in ``[0, u]``.
     """
-    rise, fall = _moves(prof)
+    return _valleys(prof, *_moves(prof))
+
+
+def _valleys(prof: UnitProfiles, rise: np.ndarray, fall: np.ndarray) -> np.ndarray:
+    """:func:`find_valleys` with the units' rises and falls (:func:`_moves`) given."""
     length = prof.dist_rise + prof.dist_cruise + prof.dist_fall
     # a cruise shorter than the profiles' round-off is no constant-speed stretch
     cruise = prof.dist_cruise > DISTANCE_REL_TOL * np.maximum(length, 1.0)
@@ -186,11 +190,11 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
     rejected = np.zeros(0, dtype=np.int64)
     owned = False                       # prof's arrays are copies this stage may write
     for _ in range(rounds):
-        valleys = find_valleys(prof)
+        rise, fall = _moves(prof)
+        valleys = _valleys(prof, rise, fall)
         if valleys.size < 2:
             break
         a, b = valleys[:-1], valleys[1:]
-        rise, _ = _moves(prof)
         n_rise = np.concatenate(([0], np.cumsum(rise)))
         has_rise = (n_rise[b] - n_rise[a]) > 0
         t_cum = np.concatenate(([0.0], np.cumsum(time_u)))
