@@ -415,64 +415,58 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     NodeSpeeds
     """
     n = units.n_units
-    cap = units.node_cap.tolist()
-    cause = units.node_cause.tolist()
-    L = units.length.tolist()
+    cap = np.array(units.node_cap, dtype=np.float64)
+    L = units.length
     drive = np.isfinite(units.knee)
-    jl = np.where(drive, 2, units.jerk_limited.astype(int)).tolist()
-    ad, jd = units.acc_dn.tolist(), units.jerk_dn.tolist()
-    au, ju = units.acc_up.tolist(), units.jerk_up.tolist()
-    kn, kr = units.knee.tolist(), units.knee_ratio.tolist()
+    jl = np.where(drive, 2, units.jerk_limited.astype(np.int64))
+    ad, jd, au, ju = units.acc_dn, units.jerk_dn, units.acc_up, units.jerk_up
+    kn, kr = units.knee, units.knee_ratio
     # the cheap test with the acceleration above the knee (the smallest of a unit)
     r_fit = np.where(drive, units.knee_ratio, 1.0)
-    acd_fit, acu_fit = units.acc_dn * r_fit, units.acc_up * r_fit
-    ad_fit, au_fit = acd_fit.tolist(), acu_fit.tolist()
+    ad_fit, au_fit = ad * r_fit, au * r_fit
     brisk = ~units.jerk_limited & ~drive
     reach = _REACH
     fits = _fits
+    # The chains touch few nodes: their values are read one by one as Python floats
+    # (``item``), which is cheaper than converting every array to a list.
     # backward: b[k] from b[k + 1]; a chain walks on while its nodes fall below their
     # caps, so a node it does not reach has a neighbour at its cap (decided above)
-    nc = units.node_cap
-    start = ~_keeps_own(nc[:-1], nc[1:], units.length, acd_fit,
-                        units.jerk_dn, units.acc_dn, brisk)
-    b = list(cap)
-    origin = list(cause)
+    start = ~_keeps_own(cap[:-1], cap[1:], L, ad_fit, jd, ad, brisk)
+    b = cap.copy()
+    origin = np.array(units.node_cause, dtype=np.int64)
     low = n                             # nodes >= low are final
     for s0 in np.flatnonzero(start)[::-1].tolist():
         if s0 >= low:
             continue                    # inside the chain walked last
         k = s0
         while k >= 0:
-            be, c = b[k + 1], cap[k]
-            if c <= be or fits(be, c, L[k], ad_fit[k], jd[k]):
+            be, c, dist = b.item(k + 1), cap.item(k), L.item(k)
+            if c <= be or fits(be, c, dist, ad_fit.item(k), jd.item(k)):
                 break
-            r = reach[jl[k]](be, L[k], ad[k], jd[k], kn[k], kr[k])
+            r = reach[jl.item(k)](be, dist, ad.item(k), jd.item(k), kn.item(k), kr.item(k))
             if c <= r:
                 break
             b[k], origin[k] = r, origin[k + 1]
             k -= 1
         low = k
     # forward: w[k + 1] from w[k], the same way (a node no chain reaches keeps b)
-    bb = np.array(b)
-    start = ~_keeps_own(bb[1:], bb[:-1], units.length, acu_fit,
-                        units.jerk_up, units.acc_up, brisk)
-    w = list(b)
-    acc_lim = [False] * (n + 1)
+    start = ~_keeps_own(b[1:], b[:-1], L, au_fit, ju, au, brisk)
+    w = b.copy()
+    acc_lim = np.zeros(n + 1, dtype=bool)
     high = 0                            # nodes <= high are final
     for s0 in np.flatnonzero(start).tolist():
         if s0 < high:
             continue
         k = s0
         while k < n:
-            ws, bn = w[k], b[k + 1]
-            if bn <= ws or fits(ws, bn, L[k], au_fit[k], ju[k]):
+            ws, bn, dist = w.item(k), b.item(k + 1), L.item(k)
+            if bn <= ws or fits(ws, bn, dist, au_fit.item(k), ju.item(k)):
                 break
-            f = reach[jl[k]](ws, L[k], au[k], ju[k], kn[k], kr[k])
+            f = reach[jl.item(k)](ws, dist, au.item(k), ju.item(k), kn.item(k), kr.item(k))
             if bn <= f:
                 break
             w[k + 1] = f
             acc_lim[k + 1] = True
             k += 1
         high = k + 1
-    return NodeSpeeds(v=np.array(w), backward=bb, origin_cause=np.array(origin),
-                      accel_limited=np.array(acc_lim))
+    return NodeSpeeds(v=w, backward=b, origin_cause=origin, accel_limited=acc_lim)
