@@ -36,6 +36,34 @@ def test_time_at_first_and_last_around_a_hold():
     assert prof.time_at([10.0], "last")[0] == pytest.approx(4.0)
 
 
+def test_time_at_matches_bisection_on_random_intervals():
+    """``time_at`` inverts ``s(t)`` inside an interval (its docstring): against a plain
+    bisection on the interval's cubic, to round-off of the interval length, on random
+    intervals with constant, rising and falling speed, from rest and to rest."""
+    rng = np.random.default_rng(5)
+    for case in range(300):
+        h = rng.uniform(1e-4, 0.2)
+        a0 = 0.0 if case % 5 == 0 else rng.uniform(-300.0, 300.0)
+        jj = 0.0 if case % 2 else rng.uniform(-2e4, 2e4)
+        tt = np.linspace(0.0, h, 401)
+        v0 = 0.0 if case % 7 == 0 else rng.uniform(0.0, 100.0)
+        v0 -= min(np.min(v0 + a0 * tt + jj * tt ** 2 / 2), 0.0)     # v >= 0 throughout
+        if case % 11 == 0:              # braking to rest at the interval end
+            a0, jj, v0 = -abs(a0) - 1.0, 0.0, (abs(a0) + 1.0) * h
+        v1 = max(v0 + a0 * h + jj * h ** 2 / 2, 0.0)
+        ds = v0 * h + a0 * h ** 2 / 2 + jj * h ** 3 / 6
+        if not ds > 0:
+            continue
+        prof = Profile(t=[0.0, h], s=[0.0, ds], v=[v0, v1], a=[a0], j=[jj], block=[0])
+        q = rng.uniform(0.0, 1.0, 50) * ds
+        lo, hi = np.zeros(q.size), np.full(q.size, h)
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            below = v0 * mid + a0 * mid ** 2 / 2 + jj * mid ** 3 / 6 < q
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        np.testing.assert_allclose(prof.time_at(q), 0.5 * (lo + hi), rtol=0, atol=1e-13 * h)
+
+
 def test_split_at_keeps_the_motion():
     prof = Profile.from_phases([0.1, 0.3, 0.1], [0, 1000, 1000], [10000, 0, -10000])
     cut = prof.split_at([1.0, 7.5, 20.0])

@@ -14,6 +14,7 @@ import pytest
 
 from reference.machine import load_machine
 from reference.nc import parse_text
+from reference.planner import lookahead as LA
 from reference.planner import plan
 from reference.planner.profiles import (CASE_CRUISE, CASE_FALL_ACC, CASE_RISE_ACC,
                                         case_name, ramp_distance, ramp_reach, ramp_time,
@@ -118,6 +119,108 @@ def test_peak_is_the_largest_that_fits():
     assert np.all(g(vp) <= 1e-12 * L)
     not_max = (vp < cap * (1 - 1e-9)) & (g(vp * (1 + 1e-9) + 1e-12) <= 0)
     assert not not_max.any()
+
+
+def test_brisk_peak_is_the_closed_form_root():
+    """BRISK (jerk = inf): the peak of a unit is the closed form
+    ``vp^2 = (v0^2/(2 A_up) + v1^2/(2 A_dn) + L) / (1/(2 A_up) + 1/(2 A_dn))`` (the rise
+    and the fall fill the length), capped; the solve returns it to round-off, on the
+    feasible side (distance at most L)."""
+    rng = np.random.default_rng(11)
+    n = 4000
+    au, ad = rng.uniform(100, 5000, n), rng.uniform(100, 5000, n)
+    v0 = rng.uniform(0, 150, n)
+    L = 10 ** rng.uniform(-3, 1.5, n)
+    v1 = rng.uniform(0, 1, n) * np.sqrt(v0 ** 2 + 2 * ad * L)
+    ok = np.abs(v1 ** 2 - v0 ** 2) <= 2 * np.minimum(au, ad) * L
+    au, ad, v0, v1, L = au[ok], ad[ok], v0[ok], v1[ok], L[ok]
+    exact = np.sqrt((v0 ** 2 / (2 * au) + v1 ** 2 / (2 * ad) + L) / (0.5 / au + 0.5 / ad))
+    cap = np.where(rng.random(v0.size) < 0.3, rng.uniform(0.5, 1.0, v0.size) * exact,
+                   np.inf)
+    cap = np.maximum(cap, np.maximum(v0, v1))
+    inf = np.full(v0.size, np.inf)
+    vp = solve_peak(v0, v1, L, cap, au, inf, ad, inf)
+    np.testing.assert_allclose(vp, np.minimum(exact, cap), rtol=1e-13)
+    dist = (vp ** 2 - v0 ** 2) / (2 * au) + (vp ** 2 - v1 ** 2) / (2 * ad)
+    assert np.all(dist <= L * (1 + 1e-12))
+
+
+def _passes_in_order(units):
+    """The LookAhead passes as the model states them: every step in turn, backward from
+    the end, then forward from the start, each keeping the node's own limit where the
+    cheap test or the reachable speed allows it (the stage's scalar step functions)."""
+    n = units.n_units
+    cap, cause, L = units.node_cap, units.node_cause, units.length
+    drive = np.isfinite(units.knee)
+    mode = np.where(drive, 2, units.jerk_limited.astype(int))
+    r_fit = np.where(drive, units.knee_ratio, 1.0)
+    b, origin = cap.astype(float).copy(), cause.astype(np.int64).copy()
+    for k in range(n - 1, -1, -1):
+        be, c = float(b[k + 1]), float(cap[k])
+        if c <= be or LA._fits(be, c, L[k], units.acc_dn[k] * r_fit[k], units.jerk_dn[k]):
+            continue
+        r = LA._REACH[mode[k]](be, L[k], units.acc_dn[k], units.jerk_dn[k], units.knee[k],
+                               units.knee_ratio[k])
+        if c > r:
+            b[k], origin[k] = r, origin[k + 1]
+    w, lim = b.copy(), np.zeros(n + 1, dtype=bool)
+    for k in range(n):
+        ws, bn = float(w[k]), float(b[k + 1])
+        if bn <= ws or LA._fits(ws, bn, L[k], units.acc_up[k] * r_fit[k], units.jerk_up[k]):
+            continue
+        f = LA._REACH[mode[k]](ws, L[k], units.acc_up[k], units.jerk_up[k], units.knee[k],
+                               units.knee_ratio[k])
+        if bn > f:
+            w[k + 1], lim[k + 1] = f, True
+    return w, b, origin, lim
+
+
+def _random_units(rng, n, soft, drive):
+    jl = rng.random(n) < soft
+    dr = ~jl & (rng.random(n) < drive)
+    acc = rng.uniform(100, 3000, n)
+    jerk = np.where(jl, rng.uniform(1e3, 1e5, n), np.inf)
+    cap = np.where(rng.random(n) < 0.5, 100.0, rng.uniform(1, 200, n))
+    L = rng.choice([1e-3, 0.05, 0.5, 5.0], n) * rng.uniform(0.5, 1.5, n)
+    node = np.minimum(np.concatenate(([0.0], cap)), np.concatenate((cap, [0.0])))
+    node = np.where(rng.random(n + 1) < 0.3, node * rng.uniform(0, 1, n + 1), node)
+    node[[0, -1]] = 0.0
+    z = np.zeros(n, dtype=bool)
+    return LA.Units(
+        first_segment=np.arange(n), n_segments=np.ones(n, dtype=int),
+        node_break=np.arange(n + 1), s_start=np.cumsum(L) - L, length=L, cap=cap,
+        cap_cause=np.zeros(n, dtype=int), acc_up=acc, jerk_up=jerk,
+        acc_dn=acc * rng.uniform(0.5, 1.5, n), jerk_dn=jerk.copy(),
+        frequency=np.full(n, 10.0), jerk_limited=jl, node_cap=node,
+        node_cause=rng.integers(0, 9, n + 1), adapted_up=z, adapted_dn=z.copy(),
+        knee=np.where(dr, rng.uniform(5, 100, n), np.inf),
+        knee_ratio=np.where(dr, rng.uniform(0.3, 1, n), 1.0))
+
+
+@pytest.mark.parametrize("soft, drive", [(0.0, 0.0), (1.0, 0.0), (0.3, 0.2), (0.0, 0.3)])
+def test_lookahead_passes_equal_every_step_in_order(soft, drive):
+    """Model note 7, step 3: a backward pass from the end and a forward pass from the
+    start, each step the closed-form reachable speed. The stage decides the steps whose
+    neighbour keeps its own limit all at once and steps one by one only along binding
+    chains; its speeds, causes and flags must be those of taking every step in turn
+    (bit for bit), on BRISK, SOFT and DRIVE units and their mixes; for BRISK the
+    speeds also meet the closed form ``b_k = min(cap_k, sqrt(b_{k+1}^2 + 2 A_k L_k))``."""
+    rng = np.random.default_rng(int(100 * soft + 10 * drive))
+    for _ in range(60):
+        u = _random_units(rng, int(rng.integers(1, 300)), soft, drive)
+        got = LA.lookahead_passes(u)
+        w, b, origin, lim = _passes_in_order(u)
+        np.testing.assert_array_equal(got.backward, b)
+        np.testing.assert_array_equal(got.v, w)
+        np.testing.assert_array_equal(got.origin_cause, origin)
+        np.testing.assert_array_equal(got.accel_limited, lim)
+        if soft == 0.0 and drive == 0.0:
+            reach = np.sqrt(got.backward[1:] ** 2 + 2 * u.acc_dn * u.length)
+            np.testing.assert_allclose(got.backward[:-1], np.minimum(u.node_cap[:-1], reach),
+                                       rtol=1e-12)
+            reach = np.sqrt(got.v[:-1] ** 2 + 2 * u.acc_up * u.length)
+            np.testing.assert_allclose(got.v[1:], np.minimum(got.backward[1:], reach),
+                                       rtol=1e-12)
 
 
 @pytest.mark.parametrize("length, feed", [
