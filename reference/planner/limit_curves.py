@@ -133,6 +133,14 @@ def _axis_factors(path: Path, machine: Machine, modes: SegmentModes):
     return lim, acc, jerk
 
 
+def _rows(mask: np.ndarray):
+    """Index of the rows where ``mask`` holds: a full slice when it holds everywhere, None
+    when nowhere (no gathering copies in either case)."""
+    if mask.all():
+        return slice(None)
+    return np.flatnonzero(mask) if mask.any() else None
+
+
 def _min_with_cause(candidates: list[tuple[np.ndarray, int]]) -> tuple[np.ndarray, np.ndarray]:
     """Smallest candidate per segment and its cause (the first of equal ones)."""
     vals = np.stack([c[0] for c in candidates], axis=1)
@@ -194,10 +202,15 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
         v_axis = row_min(np.where(moving, lim.v_max[None, :] / (D + P), np.inf))
         v_cent = row_min(np.where(Q > 0, np.sqrt(params.arc_centripetal_share * A / np.where(
             Q > 0, Q, 1.0)), np.inf))
-        R3 = np.hypot(R, Rn)            # third-derivative amplitude (= R on circles)
-        v_jerk = row_min(np.where(R3 > 0, np.cbrt(params.arc_jerk_velocity_share * J / np.where(
-            R3 > 0, R3, 1.0)), np.inf))
-    v_jerk = np.where(soft, v_jerk, inf)
+    # the jerk terms bind SOFT segments only: worked out for those rows alone (row by
+    # row the same numbers; a BRISK program skips them)
+    sr = _rows(soft)
+    v_jerk = inf.copy()
+    if sr is not None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            R3 = np.hypot(R[sr], Rn[sr])    # third-derivative amplitude (= R on circles)
+            v_jerk[sr] = row_min(np.where(R3 > 0, np.cbrt(
+                params.arc_jerk_velocity_share * J[sr] / np.where(R3 > 0, R3, 1.0)), np.inf))
     v_ipo = path.length / machine.limits.t_ipo_s
     cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
                                   (v_cent, C.AXIS_ACCELERATION), (v_jerk, C.JERK),
@@ -206,11 +219,14 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
                                      cause, params)
     acc = _accel_at(cap, A, D, P, Q, moving)
     # SOFT: leave the jerk budget share for 3 |q''| v a
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a_j = row_min(np.where(moving & (Q > 0), params.arc_jerk_accel_share * J / (
-            3.0 * np.where(Q > 0, Q, 1.0) * np.maximum(cap, 1e-300)[:, None]), np.inf))
-    acc = np.where(soft, np.minimum(acc, a_j), acc)
-    jerk = np.where(soft, _jerk_at(cap, acc, J, D, P, Q, R, Rn, moving), inf)
+    jerk = inf.copy()
+    if sr is not None:
+        Qs, mv, cs = Q[sr], moving[sr], cap[sr]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a_j = row_min(np.where(mv & (Qs > 0), params.arc_jerk_accel_share * J[sr] / (
+                3.0 * np.where(Qs > 0, Qs, 1.0) * np.maximum(cs, 1e-300)[:, None]), np.inf))
+        acc[sr] = np.minimum(acc[sr], a_j)
+        jerk[sr] = _jerk_at(cs, acc[sr], J[sr], D[sr], P[sr], Qs, R[sr], Rn[sr], mv)
     freq = row_min(np.where(moving, lim.frequency_hz[None, :], np.inf))
     if np.isfinite(knee).any():
         d = np.flatnonzero(np.isfinite(knee))
