@@ -125,3 +125,20 @@ def row_any(x: np.ndarray) -> np.ndarray:
     for j in range(x.shape[1]):
         out |= x[:, j]
     return out
+
+
+def rows_where(mask: np.ndarray):
+    """Index of the rows where ``mask`` holds, for gathering only those: a full slice
+    when it holds everywhere and None when nowhere (no gathering copies then).
+
+    Parameters
+    ----------
+    mask : numpy.ndarray of bool, shape (k,)
+
+    Returns
+    -------
+    slice, numpy.ndarray of int or None
+    """
+    if mask.all():
+        return slice(None)
+    return np.flatnonzero(mask) if mask.any() else None

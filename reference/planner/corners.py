@@ -42,7 +42,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..core.arrays import row_argmin, row_min
+from ..core.arrays import row_argmin, row_min, rows_where
 from ..core.geometry import Path
 from ..core.limits import AxisArrays
 from ..core.rules import (FEASIBLE, curvature_jump_speed_cap, curvature_jumps, is_tangential,
@@ -69,8 +69,9 @@ class JunctionLimits:
     tangential : numpy.ndarray of bool, shape (m + 1,)
         Tangential interior breaks.
     through_accel : numpy.ndarray, shape (m + 1,)
-        Largest path acceleration that may cross each break (``0`` at the path ends),
-        mm/s^2 (:func:`through_acceleration`).
+        Largest path acceleration that may cross each break between two SOFT segments
+        (``0`` at the path ends, ``inf`` at the other breaks), mm/s^2
+        (:func:`through_acceleration`).
     """
 
     cap: np.ndarray
@@ -131,10 +132,13 @@ def _rule_g64(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rule_curvature(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
-    v = curvature_jump_speed_cap(x.k_in, x.k_out, x.lim.path_trans_jerk, x.t_ipo)
     jl = x.modes.jerk_limited
-    soft_both = jl[:-1] & jl[1:]
-    v = np.where(soft_both, v, np.inf)
+    # between two SOFT segments only (worked out there alone; none in a BRISK program)
+    both = rows_where(jl[:-1] & jl[1:])
+    v = np.full(x.k_in.shape[0], np.inf)
+    if both is not None:
+        v[both] = curvature_jump_speed_cap(x.k_in[both], x.k_out[both],
+                                           x.lim.path_trans_jerk, x.t_ipo)
     return _interior(x, v), np.full(x.path.n_segments + 1, C.JERK)
 
 
@@ -205,19 +209,27 @@ def through_acceleration(x: _Inputs) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (m + 1,)
-        mm/s^2; 0 at the path ends.
+        mm/s^2; 0 at the path ends, ``inf`` at breaks that are not between two SOFT
+        segments (only those can join one planning unit, the one use of this value;
+        not worked out there).
     """
     m = x.path.n_segments
     out = np.zeros(m + 1)
     if m < 2:
         return out
-    dk = np.abs(x.k_out - x.k_in)
-    dt = np.abs(x.t_out - x.t_in)
-    jlim = step_jerk_limit(curvature_jumps(x.k_in, x.k_out), x.lim.j_max, x.lim.path_trans_jerk)
-    c = np.minimum(x.seg.cap[:-1], x.seg.cap[1:])
+    jl = x.modes.jerk_limited
+    both = rows_where(jl[:-1] & jl[1:])
+    out[1:-1] = np.inf
+    if both is None:
+        return out
+    k_in, k_out, t_in, t_out = x.k_in[both], x.k_out[both], x.t_in[both], x.t_out[both]
+    dk = np.abs(k_out - k_in)
+    dt = np.abs(t_out - t_in)
+    jlim = step_jerk_limit(curvature_jumps(k_in, k_out), x.lim.j_max, x.lim.path_trans_jerk)
+    c = np.minimum(x.seg.cap[:-1], x.seg.cap[1:])[both]
     budget = jlim * x.t_ipo - dk * (c * c)[:, None]
     with np.errstate(divide="ignore", invalid="ignore"):
         a = np.where(dt > 0, budget / np.where(dt > 0, dt, 1.0),
                      np.where(budget >= 0, np.inf, -np.inf))
-    out[1:-1] = row_min(a)
+    out[1:-1][both] = row_min(a)
     return out

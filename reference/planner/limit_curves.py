@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.arrays import row_argmin, row_min
+from ..core.arrays import row_argmin, row_min, rows_where
 from ..core.geometry import Path, plane_amplitudes
 from ..machine import Machine
 from . import causes as C
@@ -133,14 +133,6 @@ def _axis_factors(path: Path, machine: Machine, modes: SegmentModes):
     return lim, acc, jerk
 
 
-def _rows(mask: np.ndarray):
-    """Index of the rows where ``mask`` holds: a full slice when it holds everywhere, None
-    when nowhere (no gathering copies in either case)."""
-    if mask.all():
-        return slice(None)
-    return np.flatnonzero(mask) if mask.any() else None
-
-
 def _min_with_cause(candidates: list[tuple[np.ndarray, int]]) -> tuple[np.ndarray, np.ndarray]:
     """Smallest candidate per segment and its cause (the first of equal ones)."""
     vals = np.stack([c[0] for c in candidates], axis=1)
@@ -204,7 +196,7 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
             Q > 0, Q, 1.0)), np.inf))
     # the jerk terms bind SOFT segments only: worked out for those rows alone (row by
     # row the same numbers; a BRISK program skips them)
-    sr = _rows(soft)
+    sr = rows_where(soft)
     v_jerk = inf.copy()
     if sr is not None:
         with np.errstate(divide="ignore", invalid="ignore"):
