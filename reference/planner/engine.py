@@ -295,9 +295,17 @@ def _case_counts(prof: UnitProfiles, units: Units) -> str:
 
 # ----------------------------------------------------------------- assembly
 def _exclusive_cumsum(x: np.ndarray) -> np.ndarray:
-    """Row-wise sums of the preceding columns (exactly 0 in the first column)."""
-    out = np.zeros_like(x)
-    np.cumsum(x[:, :-1], axis=1, out=out[:, 1:])
+    """Row-wise sums of the preceding columns (exactly 0 in the first column).
+
+    Column by column over whole rows (the phases are few): the same sequential sums as
+    ``np.cumsum(x[:, :-1], axis=1)``, without numpy's inner loop of a few elements per
+    row."""
+    out = np.empty_like(x)
+    out[:, 0] = 0.0
+    if x.shape[1] > 1:
+        out[:, 1] = x[:, 0]
+    for c in range(2, x.shape[1]):
+        np.add(out[:, c - 1], x[:, c - 1], out=out[:, c])
     return out
 
 
@@ -319,25 +327,29 @@ def _assemble(path: Path, units: Units, prof: UnitProfiles) -> Profile:
     for lo in range(0, h_all.shape[0], _ASSEMBLE_CHUNK):
         hi = lo + _ASSEMBLE_CHUNK
         h, a0, jj = h_all[lo:hi], prof.a0[lo:hi], prof.jerk[lo:hi]
+        # without jerk (BRISK, DRIVE) its terms are zeros: adding them changes nothing
+        jerk = bool(jj.any())
         dv = a0 * h
-        tmp = jj * h
-        tmp *= h
-        tmp /= 2
-        dv += tmp
+        if jerk:
+            tmp = jj * h
+            tmp *= h
+            tmp /= 2
+            dv += tmp
         v_start = _exclusive_cumsum(dv)
         del dv
         v_start += prof.v_in[lo:hi, None]
         ds = v_start * h
-        np.multiply(a0, h, out=tmp)
+        tmp = a0 * h
         tmp *= h
         tmp /= 2
         ds += tmp
         del tmp
-        tmp = h ** 3
-        tmp *= jj
-        tmp /= 6
-        ds += tmp
-        del tmp
+        if jerk:
+            tmp = h ** 3
+            tmp *= jj
+            tmp /= 6
+            ds += tmp
+            del tmp
         s_start = _exclusive_cumsum(ds)
         del ds
         s_start += units.s_start[lo:hi, None]
