@@ -379,7 +379,9 @@ def _group_argmax(values: np.ndarray, lo: np.ndarray, n: np.ndarray) -> np.ndarr
     top = np.maximum.reduceat(vals, starts)
     hit = np.flatnonzero(vals == np.repeat(top, n))
     group = np.repeat(np.arange(lo.size), n)[hit]
-    _, first_hit = np.unique(group, return_index=True)
+    # hits come in group order and every group has one (its maximum): a group's first
+    # hit is where the group number changes
+    first_hit = np.flatnonzero(np.concatenate(([True], group[1:] != group[:-1])))
     return idx[hit[first_hit]]
 
 
