@@ -274,6 +274,7 @@ class Profile:
             tau[act] = _cubic_time(q[act], h[act], s0[act], s1[act], self.v[k[act]],
                                    self.a[k[act]], self.j[k[act]])
         return self.t[k] + tau
+
     def sample(self, dt: float) -> tuple[np.ndarray, ...]:
         """Sample at a fixed period (the IPO cycle), ending exactly at the end.
 
