@@ -245,7 +245,9 @@ def smooth_velocity(units: Units, speeds: NodeSpeeds, prof: UnitProfiles,
         # interior nodes of accepted bumps keep the flat speed as their limit
         nodes = sel[sel > 0]
         vf_sel = vf_u[keep_u][sel > 0]
-        inner = np.isin(nodes, a[cand][ok], invert=True)
+        start = np.zeros(u + 1, dtype=bool)        # the accepted bumps' first nodes
+        start[a[cand][ok]] = True
+        inner = ~start[nodes]
         nodes, vf_sel = nodes[inner], vf_sel[inner]
         node_cap = units.node_cap.copy()
         node_cause = units.node_cause.copy()
