@@ -137,8 +137,12 @@ def _valleys(prof: UnitProfiles, rise: np.ndarray, fall: np.ndarray) -> np.ndarr
     length = prof.dist_rise + prof.dist_cruise + prof.dist_fall
     # a cruise shorter than the profiles' round-off is no constant-speed stretch
     cruise = prof.dist_cruise > DISTANCE_REL_TOL * np.maximum(length, 1.0)
-    last = np.where(fall, _FALL, np.where(cruise | ~rise, _LEVEL, _RISE))   # into exit node
-    first = np.where(rise, _RISE, np.where(cruise | ~fall, _LEVEL, _FALL))  # out of entry
+    # direction into the exit node: falling, else level (a cruise, or no rise), else
+    # rising; out of the entry node: rising, else level (a cruise, or no fall), else
+    # falling. As differences of 0/1 flags (_FALL, _LEVEL, _RISE = -1, 0, 1), which
+    # numpy forms several times faster than nested where() over the scalars.
+    last = (~fall & ~cruise & rise).view(np.int8) - fall.view(np.int8)
+    first = rise.view(np.int8) - (~rise & ~cruise & fall).view(np.int8)
     before = np.concatenate(([_LEVEL], last))
     after = np.concatenate((first, [_LEVEL]))
     valley = (before <= _LEVEL) & (after >= _LEVEL) & ~((before == _LEVEL)
