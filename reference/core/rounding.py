@@ -53,6 +53,11 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "arc transition: rounding not modelled yet",                      # 12 model limit
     "non-geometry axes move: rounding not modelled yet",              # 13 model limit
     "G644 SMOOTHING_MODE digit not documented",                       # 14 6xxx..9xxx
+    # G645 at tangential transitions with a curvature jump (5.7, 6.3)
+    "curvature jump allowed under BRISK (acceleration step)",         # 15 6.3
+    "G64 passes the curvature jump without reduction",                # 16 5.7 [M], 5.8
+    "tangential transition between arcs: rounding not modelled yet",  # 17 model limit
+    "tangential transition into a helix or spiral: rounding not modelled yet",  # 18
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
 
@@ -90,6 +95,12 @@ class RoundingTable:
         ``next_block`` unless the window reaches across short blocks (G642/G645), in
         which case the blocks strictly between ``first_block`` and ``block`` (and
         between ``next_block`` and ``last_block``) are covered by the rounding whole.
+    tangential : numpy.ndarray of bool, shape (k,)
+        The transition is tangential with a curvature jump (G645 at a line-arc
+        transition, :mod:`reference.core.transition`); for these ``distance_mm`` is the
+        length replaced of the line, ``deviation_mm`` the largest distance from the
+        programmed contour, ``radius_mm`` the arc's radius (the rounding's smallest),
+        ``v_g64`` the curvature-jump limit (6.3). Rounded ones have ``g2`` set.
     """
 
     block: np.ndarray
@@ -106,6 +117,7 @@ class RoundingTable:
     g2: np.ndarray
     first_block: np.ndarray
     last_block: np.ndarray
+    tangential: np.ndarray
 
     @property
     def n(self) -> int:
