@@ -29,8 +29,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
    pairs that takes up the classical shift and a curvature ramp onto the arc,
    :mod:`reference.core.transition`); other modes name it "tangential transition".
-   Model limits of this version: corners next to arcs (non-tangential) and corners where
-   non-geometry axes move are passed as under G64, named;
+   A corner between a line and a circular arc is rounded by a tangent fillet
+   (:func:`reference.rounding_arcs.arc_corners`, sized by the same mode parameters).
+   Model limits of this version: corners between two arcs, next to helices, and
+   corners where non-geometry axes move are passed as under G64, named;
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
 
    * G641: ``d = ADIS`` (G1/G2/G3), ``ADISPOS`` (G0), the smaller if one block is G0;
@@ -71,8 +73,10 @@ Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions is modelled between a line and a circle only
-(arc into arc, helices and spirals are named and passed as G64); a window
+G645's rounding of tangential transitions, and the rounding of corners next to arcs,
+are modelled between a line and a circle only (arc into arc, helices and spirals are
+named and passed as G64; a corner next to an arc gets a tangent arc, G1, also under
+SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
@@ -94,7 +98,8 @@ from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junct
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
 from .nc.program import Program
-from .rounding_tangential import PIECES, Transitions, tangential_transitions
+from .rounding_arcs import arc_corners
+from .rounding_tangential import PIECES, tangential_transitions
 
 #: Group-10 modes that round corners.
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
@@ -248,7 +253,6 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     near_arc = np.flatnonzero(~is_line & (reason < 0))
     if near_arc.size:
         tang_arc[near_arc] = is_tangential(*_junction_tangents(path, a[near_arc]), FEASIBLE)
-    decide(~is_line & ~tang_arc, "arc transition: rounding not modelled yet")
     other = np.zeros(a.size, bool)
     if not geo.all():
         other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
@@ -257,7 +261,11 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     decide(tang_arc & (mode_arr != "G645"), "tangential transition")
     trans = np.flatnonzero(tang_arc & (reason < 0))
     reason[trans] = _PENDING              # decided below, apart from the corners
+    arc_corner = ~is_line & ~tang_arc
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
+    if near_arc.size:                     # at corners next to arcs: the arcs' tangents
+        t1, t2 = t1.copy(), t2.copy()
+        t1[near_arc], t2[near_arc] = _junction_tangents(path, a[near_arc])
     decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
 
     # --- the rounding's shape (5.8, 5.9): under SOFT the axis motion in the rounding
@@ -266,8 +274,12 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     # radius) the tangent arc
     theta = deflection_angle(t1, t2)
     g2 = (attrs["accel"][ka] == "SOFT") & np.isin(mode_arr, ROUNDING_MODES)
-    d, multi = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, g2,
-                          decide)
+    d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta,
+                                   g2, decide)
+    # corners next to arcs: decided and sized apart (reference.rounding_arcs), after the
+    # mode's parameters were checked above
+    arcc = np.flatnonzero(arc_corner & (reason < 0))
+    reason[arcc] = _PENDING
     # clamp (5.3, the G644 excerpt): c times the shorter participating block; where the
     # mode rounds across short blocks, the participating "block" on each side is the
     # straight chain of blocks the window may cover (:func:`_straight_chains`)
@@ -324,7 +336,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     if trans.size:
         tr = tangential_transitions(path, machine, a[trans], ka[trans],
                                     attrs["accel"][ka[trans]], CENTRIPETAL_SHARE,
-                                    JERK_VELOCITY_SHARE)
+                                    JERK_VELOCITY_SHARE, corner_time_loss)
         reason[trans] = tr.reason
         done = (tr.reason == 0).astype(np.float64)
         dist[trans] = np.maximum(tr.trim_in, tr.trim_out)
@@ -334,6 +346,18 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         clamped[trans] = tr.clamped
         g2_out[trans] = tr.reason == 0
         v64[trans], v_round[trans] = tr.v_g64, tr.v_round
+    ac = None
+    if arcc.size:
+        ac = arc_corners(path, machine, a[arcc], ka[arcc], mode_arr[arcc], t1[arcc],
+                         t2[arcc], {key: val[arcc] for key, val in targets.items()},
+                         attrs["accel"][ka[arcc]], CENTRIPETAL_SHARE, JERK_VELOCITY_SHARE,
+                         corner_time_loss)
+        reason[arcc] = ac.reason
+        dist[arcc] = np.maximum(ac.trim_in, ac.trim_out)
+        length[arcc], dev[arcc], rad[arcc] = ac.length, ac.deviation, ac.radius
+        clamped[arcc] = ac.clamped
+        g2_out[arcc] = False
+        v64[arcc], v_round[arcc] = ac.v_g64, ac.v_round
     tangential = np.zeros(a.size, bool)
     tangential[trans] = True
     table = RoundingTable(
@@ -348,17 +372,27 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
                 "blocks", "source", "dradius", "sharpness")
         return Path(rounding=table, **{f: getattr(path, f) for f in keep})
+    extras = []
+    for part, at in ((tr, trans), (ac, arcc)):
+        if part is not None and (part.reason == 0).any():
+            done = part.reason == 0
+            n_rows = PIECES if part is tr else 1
+            extras.append((a[at[done]], part.trim_in[done],
+                           part.trim_out[done], part.rows, n_rows))
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],
-                     table, tr, a[trans])
+                     table, extras)
 
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
                t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, decide
-               ) -> tuple[np.ndarray, np.ndarray]:
+               ) -> tuple[np.ndarray, np.ndarray, dict]:
     """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
-    and whether the corner's window may reach across short blocks (G642/G645 with a
-    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,)."""
+    whether the corner's window may reach across short blocks (G642/G645 with a
+    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
+    the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
+    (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
+    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -397,10 +431,11 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.where(is_adis, dist, d)
     # tolerance type (5.4): per-axis MD33100 on the axes it applies to, contour tolerance
     is_tol = how == TOL
+    tol_k = np.full((k, path.n_axes), np.inf)
+    g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
     if is_tol.any():
         tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
-        g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
         dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
         d_dev = np.where(g2, _clothoid_distance(theta, np.maximum(dev, 0.0)),
@@ -415,7 +450,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
                                    theta[dyn], g2[dyn], how[dyn] == FREQ)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
-    return np.where(np.isfinite(d), d, 0.0), multi
+    targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
+               "radius": radius}
+    return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 
 def _junction_tangents(path: Path, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -616,7 +653,8 @@ def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
 def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
                      a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
                      j_out: np.ndarray, inserted: np.ndarray | float,
-                     replaced: np.ndarray | float) -> np.ndarray:
+                     replaced: np.ndarray | float,
+                     replaced_out: np.ndarray | float | None = None) -> np.ndarray:
     """Time a corner passed at ``v_corner`` costs against passing it at the programmed
     speeds, s: the decision's estimate of "rounding would slow the program down"
     (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
@@ -649,6 +687,10 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
         Rounding length ``l``, mm (0 for G64).
     replaced : numpy.ndarray or float
         Length cut from each line, mm (the tangent distance ``d``; 0 for G64).
+    replaced_out : numpy.ndarray or float, optional
+        Length cut from the segment after, where it differs from ``replaced`` (then cut
+        from the segment before only): G645's tangential transitions replace more of
+        the line than of the arc.
 
     Returns
     -------
@@ -659,13 +701,14 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
     inserted = np.asarray(inserted, dtype=np.float64)
     total = np.zeros(np.shape(v))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for v_p, a, j in ((v_in, a_in, j_in), (v_out, a_out, j_out)):
+        cut_out = replaced if replaced_out is None else replaced_out
+        for v_p, a, j, cut in ((v_in, a_in, j_in, replaced), (v_out, a_out, j_out, cut_out)):
             dv = np.maximum(v_p - v, 0.0)
             reach = dv * j >= a * a
             T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
             T = np.where(dv > 0, T, 0.0)
             total = total + np.where(np.isfinite(v_p) & (v_p > 0),
-                                     T * dv / (2.0 * v_p) - np.asarray(replaced) / v_p, 0.0)
+                                     T * dv / (2.0 * v_p) - np.asarray(cut) / v_p, 0.0)
         total = total + np.where(inserted > 0, inserted / v, 0.0)
     # a stop costs its ramps; only a rounding passed at no speed would never end
     return np.where((v > 0) | ~(inserted > 0), total, np.inf)
@@ -841,7 +884,7 @@ def _interleave(rows: np.ndarray, pos: np.ndarray, ins: np.ndarray, ins_pos: np.
 
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
               g2: np.ndarray, piece: np.ndarray, table: RoundingTable,
-              tr: Transitions | None = None, a_t: np.ndarray | None = None) -> Path:
+              extras: list | None = None) -> Path:
     """The rounded path: lines shortened, roundings inserted after segments ``a``
     (a tangent arc, or the two pieces of a clothoid pair), spans moved.
 
@@ -857,11 +900,13 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         Clothoid pair (else tangent arc).
     piece : numpy.ndarray, shape (r,)
         Length of each clothoid piece, mm (used where ``g2``).
-    tr : Transitions, optional
-        G645's tangential transitions after segments ``a_t``
-        (:mod:`reference.rounding_tangential`): each inserted one shortens its line and
-        its arc by its own trims (the arc's angle shifts, so it stays the exact arc) and
-        inserts :data:`reference.core.transition.PIECES` rows.
+    extras : list of tuple, optional
+        Other insertions ``(a_x, trim_in, trim_out, rows, n_rows)``: after segments
+        ``a_x``, the segment before shortened at its end by ``trim_in`` and the one after
+        at its start by ``trim_out`` (an arc's start angle moves, so it stays the exact
+        arc), ``n_rows`` packed ``rows`` each (G645's tangential transitions,
+        :mod:`reference.rounding_tangential`; fillets at corners next to arcs,
+        :mod:`reference.rounding_arcs`).
     """
     m = path.n_segments
     trim_start, trim_end = _window_trims(path, a, d)
@@ -869,19 +914,21 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     n_ins[a] = np.where(g2, 2, 1)
     corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
-    if tr is not None and (tr.reason == 0).any():
-        done = tr.reason == 0
-        at = a_t[done]
-        trim_end[at] += tr.trim_in[done]
-        trim_start[at + 1] += tr.trim_out[done]
-        n_ins[at] = PIECES
-        # rows in path order: corners' and transitions' rows sorted by their segment
-        a_all = np.concatenate((a, at))
-        cnt = np.concatenate((np.where(g2, 2, 1), np.full(at.size, PIECES)))
+    if extras:
+        a_all, cnt = [a], [np.where(g2, 2, 1)]
+        for at, t_in, t_out, rows, n_rows in extras:
+            trim_end[at] += t_in
+            trim_start[at + 1] += t_out
+            n_ins[at] = n_rows
+            a_all.append(at)
+            cnt.append(np.full(at.size, n_rows))
+            arcs = {key: np.concatenate((val, rows[key])) for key, val in arcs.items()}
+        # rows in path order: every insertion's rows sorted by its segment
+        a_all, cnt = np.concatenate(a_all), np.concatenate(cnt)
         rank = np.empty(a_all.size, dtype=np.int64)
         rank[np.argsort(a_all, kind="stable")] = np.arange(a_all.size)
         order = np.argsort(np.repeat(rank, cnt), kind="stable")
-        arcs = {key: np.concatenate((val, tr.rows[key]))[order] for key, val in arcs.items()}
+        arcs = {key: val[order] for key, val in arcs.items()}
         a = np.sort(a_all)
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then

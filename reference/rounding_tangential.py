@@ -95,7 +95,7 @@ class Transitions:
 
 def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                            accel: np.ndarray, centripetal_share: float,
-                           jerk_share: float) -> Transitions:
+                           jerk_share: float, time_loss) -> Transitions:
     """Decide and size G645's rounding at tangential transitions after segments ``a``.
 
     Parameters
@@ -111,6 +111,9 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     centripetal_share, jerk_share : float
         Shares of the axis acceleration and jerk granted to the curvature terms (the
         corner rounding's estimate, so both parts decide alike).
+    time_loss : callable
+        :func:`reference.rounding.corner_time_loss`, the corner rounding's estimate of
+        the time a transition costs (passed in: that module imports this one).
 
     Returns
     -------
@@ -171,10 +174,11 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
         # the arc's own path-jerk limit rho_i v^3 / R^2 <= share J_i
         v_j = _jerk_speed(lim, 1.0 / (Ro * Ro), moving[o], wr[o], jerk_share)
         sub = np.zeros(k, bool)
-        sub[o] = ~(v_g64[o] < np.minimum(v_prog, np.minimum(v_c, v_j)))
+        v_arc = np.minimum(v_prog, np.minimum(v_c, v_j))
+        sub[o] = ~(v_g64[o] < v_arc)
         decide(sub, "G64 passes the curvature jump without reduction")
         keep = reason[o] < 0
-        o, v_prog, v_c = o[keep], v_prog[keep], v_c[keep]
+        o, v_prog, v_c, v_arc = o[keep], v_prog[keep], v_c[keep], v_arc[keep]
     if o.size:
         Ro = R[o]
         tol = np.array([machine.settings_of(ax).path_trans_pos_tol_mm for ax in path.axes])
@@ -209,8 +213,21 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
                           jerk_share)
         v_round[o] = np.minimum(np.minimum(v_prog, np.minimum(v_c, v_j)),
                                 np.minimum(sh.piece, sh.ramp) / t_ipo)
+        # 5.2 group 2 "rounding would slow the program down", 5.8 "insert only if this
+        # beats the non-rounded limit": the corner rounding's time estimate, each side
+        # ramping to its own speed (the line to the programmed one, the arc to its own
+        # limit) from the transition speed; the rounding is passed at v_round over its
+        # length and replaces line_trim of the line and L/2 of the arc
+        la = line_arc[o]
+        v_line, acc, jerk = v_prog, *_path_dynamics(lim, along[o])
+        v_in, v_out = np.where(la, v_line, v_arc), np.where(la, v_arc, v_line)
+        cut_in = np.where(la, sh.line_trim, sh.arc_trim)
+        cut_out = np.where(la, sh.arc_trim, sh.line_trim)
+        loss_round = time_loss(v_in, v_out, v_round[o], acc, acc, jerk, jerk, sh.length,
+                               cut_in, cut_out)
+        loss_g64 = time_loss(v_in, v_out, v_g64[o], acc, acc, jerk, jerk, 0.0, 0.0)
         sub[:] = False
-        sub[o] = ~(v_round[o] > v_g64[o])
+        sub[o] = ~((v_round[o] > v_g64[o]) & (loss_round < loss_g64))
         decide(sub, "rounding would be slower than G64")
         shape = _scatter_shape(sh, o, k)
     reason[reason < 0] = REASON_CODE["rounded"]
@@ -252,6 +269,15 @@ def _jerk_speed(lim: AxisArrays, q3: np.ndarray, moving: np.ndarray, w: np.ndarr
     with np.errstate(divide="ignore", invalid="ignore"):
         return row_min(np.where(moving, np.cbrt(share * lim.j_max[None, :]
                                                 / (w * q3[:, None])), np.inf))
+
+
+def _path_dynamics(lim: AxisArrays, along: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Path acceleration and jerk along the common tangent ``min_i A_i / |t_i|``,
+    ``min_i J_i / |t_i|``, mm/s^2 and mm/s^3, shape (k,) each (the transitions are SOFT)."""
+    t = np.abs(along)
+    with np.errstate(divide="ignore"):
+        return (row_min(np.where(t > 0, lim.a_max[None, :] / t, np.inf)),
+                row_min(np.where(t > 0, lim.j_max[None, :] / t, np.inf)))
 
 
 def _zero_shape(k: int) -> TransitionShape:

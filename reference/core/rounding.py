@@ -50,7 +50,7 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "rounding not parameterised (ADISPOS = 0)",                       # 9  5.2 group 3
     "rounding not parameterised (tolerance 0)",                       # 10 5.2 group 3
     "tangential transition",                                          # 11
-    "arc transition: rounding not modelled yet",                      # 12 model limit
+    "corner between two arcs: rounding not modelled yet",             # 12 model limit
     "non-geometry axes move: rounding not modelled yet",              # 13 model limit
     "G644 SMOOTHING_MODE digit not documented",                       # 14 6xxx..9xxx
     # G645 at tangential transitions with a curvature jump (5.7, 6.3)
@@ -58,6 +58,10 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "G64 passes the curvature jump without reduction",                # 16 5.7 [M], 5.8
     "tangential transition between arcs: rounding not modelled yet",  # 17 model limit
     "tangential transition into a helix or spiral: rounding not modelled yet",  # 18
+    # corners next to arcs (reference.rounding_arcs): model limits
+    "corner next to a helix or spiral, or out of the arc's plane: rounding not modelled "
+    "yet",                                                            # 19
+    "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet",  # 20
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
 
@@ -249,5 +253,101 @@ def fillet_pieces(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.ndar
     }
 
 
-__all__ = ["REASON_CODE", "ROUNDING_REASONS", "RoundingTable", "axis_deviation_limit",
-           "deflection_angle", "distance_for_deviation", "fillet_pieces"]
+@dataclass(frozen=True, slots=True, eq=False)
+class ArcFillet:
+    """Tangent arcs of radius ``r`` between a line and a circle, in the plane of the
+    circle, per corner (shape (k,) or (k, 2)); see :func:`line_circle_fillet`.
+
+    Attributes
+    ----------
+    valid : numpy.ndarray of bool
+        The fillet exists, leaves the line before the corner and meets the circle after
+        it, turning by less than pi.
+    line_trim, arc_trim : numpy.ndarray
+        Length of the line and arc length of the circle it replaces, mm.
+    centre, start, end : numpy.ndarray, shape (k, 2)
+        Its centre, its start on the line and its end on the circle (plane coordinates,
+        the corner at the origin), mm.
+    sweep : numpy.ndarray
+        Angle it turns, rad.
+    deviation : numpy.ndarray, shape (k, 2)
+        ``C - M``: the corner minus the fillet's point nearest to it, mm.
+    """
+
+    valid: np.ndarray
+    line_trim: np.ndarray
+    arc_trim: np.ndarray
+    centre: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    sweep: np.ndarray
+    deviation: np.ndarray
+
+
+def _cross2(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+
+
+def _perp(u: np.ndarray) -> np.ndarray:
+    return np.column_stack((-u[:, 1], u[:, 0]))
+
+
+def line_circle_fillet(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                       radius: np.ndarray, sense: np.ndarray) -> ArcFillet:
+    """The tangent arc of radius ``r`` rounding the corner between a line and a circle.
+
+    Plane coordinates (the circle's plane), the corner ``C`` at the origin: the line
+    ends at ``C`` with unit direction ``t``; the circle (centre ``c``, radius ``R``,
+    ``sense`` +1 counter-clockwise, -1 clockwise) starts at ``C``. The rounding turns
+    towards ``s = sign(t x t_c)`` (``t_c`` the circle's tangent at ``C``), so the fillet's
+    centre lies on the line offset by ``r`` to that side, ``O = x t + r n`` (``n = s
+    perp(t)``), and on the circle of radius ``rho`` about ``c``: ``R - r`` where the
+    fillet turns the way the circle does (inside it), ``R + r`` otherwise. ``|x t + w|
+    = rho`` with ``w = r n - c`` is a quadratic in ``x``; of its roots the one that
+    tends to 0 with ``r`` (``|c| = R``: the corner is on the circle) is taken, written
+    without cancellation as ``(|w|^2 - rho^2) / q`` with ``q = -(t.w) - sign(t.w)
+    sqrt(disc)``. The fillet leaves the line at ``x t`` (``x < 0``) and meets the circle
+    at ``c + R (O - c) / |O - c|``.
+
+    Parameters
+    ----------
+    r : numpy.ndarray, shape (k,)
+        Fillet radii, mm (> 0).
+    t, centre : numpy.ndarray, shape (k, 2)
+    radius, sense : numpy.ndarray, shape (k,)
+
+    Returns
+    -------
+    ArcFillet
+    """
+    tc = sense[:, None] * _perp(-centre) / radius[:, None]    # circle's tangent at C
+    s = np.sign(_cross2(t, tc))
+    n = s[:, None] * _perp(t)
+    inside = s == sense
+    rho = np.where(inside, radius - r, radius + r)
+    w = r[:, None] * n - centre
+    tw = row_dots(t, w)
+    ww = row_dots(w, w)
+    disc = tw * tw - ww + rho * rho
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q = -tw - np.where(tw >= 0, 1.0, -1.0) * np.sqrt(np.maximum(disc, 0.0))
+        x = (ww - rho * rho) / q
+        O = x[:, None] * t + r[:, None] * n
+        u = O - centre
+        u = u / row_norms(u)[:, None]
+        end = centre + radius[:, None] * u
+        # arc length from C to the end along the circle's sense
+        a0 = -centre
+        ang = sense * np.arctan2(_cross2(a0, end - centre), row_dots(a0, end - centre))
+        te = sense[:, None] * _perp(end - centre) / radius[:, None]
+        sweep = s * np.arctan2(_cross2(t, te), row_dots(t, te))
+        dc = -O                                               # C - O
+        near = O + r[:, None] * dc / row_norms(dc)[:, None]
+    valid = ((disc >= 0) & (x < 0) & (ang > 0) & (sweep > 0) & (rho > 0)
+             & np.isfinite(x) & (s != 0))
+    return ArcFillet(valid, -x, radius * ang, O, x[:, None] * t, end, sweep, -near)
+
+
+__all__ = ["ArcFillet", "REASON_CODE", "ROUNDING_REASONS", "RoundingTable",
+           "axis_deviation_limit", "deflection_angle", "distance_for_deviation",
+           "fillet_pieces", "line_circle_fillet"]
