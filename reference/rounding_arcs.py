@@ -38,11 +38,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
 from .core.limits import AxisArrays
-from .core.rounding import REASON_CODE, ArcFillet, line_circle_fillet
+from .core.rounding import (REASON_CODE, ArcFillet, fillet_deviation,
+                            fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
+                            line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL, TANGENT_TOL_RAD
 from .machine import Machine
@@ -56,9 +59,19 @@ _ROUNDING = KIND_CODES.index("rounding")
 #: real block lets a fillet through.
 R_MIN_MM = 1e-9
 R_MAX_MM = 1e7
-#: Bisection steps on ``log r`` over those 16 decades: 2^-64 of the range, a relative
-#: error in ``r`` of about 2e-18 (below float64 resolution: the last steps change nothing).
-BISECTIONS = 64
+#: Absolute tolerance of the root in ``log r`` (tolerance modes): a relative error in
+#: ``r``, so in the deviation used, of 1e-11.
+ROOT_XATOL = 1e-11
+#: Half-width of the first bracket around the estimated root, in ``log r`` (a factor 2).
+NARROW_BRACKET = float(np.log(2.0))
+#: ``log`` of the tolerance ratio where the fillet does not exist (larger radii): far
+#: above 0, so the root search stays below it.
+NO_FILLET_LOG_RATIO = 50.0
+#: The closed-form radii of the clamp and of ADIS are shrunk by this (relative), so that
+#: round-off cannot put a replaced length above its limit: the closed forms and the
+#: fillet they invert agree to 2.6e-12 (relative, 2000 seeded corners down to 0.005
+#: degrees, tests/reference/test_rounding_arcs.py); 40 times that.
+CLOSED_FORM_MARGIN = 1e-10
 
 #: How each corner's limit is found (the codes of :func:`reference.rounding._distances`).
 HOW_NONE, HOW_ADIS, HOW_TOL, HOW_RADIUS, HOW_FREQ, HOW_DYN = 0, 1, 2, 3, 4, 5
@@ -188,40 +201,61 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         ho = how[o]
         E1o, E2o = E1[o], E2[o]
 
-        def ratios(rr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            """(mode ratio, clamp ratio) at radii ``rr``: at most 1 where kept."""
-            f = line_circle_fillet(rr, t2d[o], centre[o], R[o], sense[o])
-            dev = E1o * f.deviation[:, :1] + E2o * f.deviation[:, 1:]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tol_r = np.maximum(row_norms(dev) / (cont * g0),
-                                   row_max_safe(np.abs(dev) / (tol * g0[:, None])))
-                m = np.select([ho == HOW_ADIS, ho == HOW_TOL, ho == HOW_RADIUS],
-                              [np.maximum(f.line_trim, f.arc_trim) / dist, tol_r, rr / rad],
-                              np.inf)
-                cl = np.maximum(f.line_trim / cap_line[o], f.arc_trim / cap_arc[o])
-            bad = ~f.valid
-            return np.where(bad, np.inf, m), np.where(bad, np.inf, cl)
-
-        lo = np.full(o.size, np.log(R_MIN_MM))
-        hi = np.full(o.size, np.log(R_MAX_MM))
-        for _ in range(BISECTIONS):
-            mid = 0.5 * (lo + hi)
-            m, cl = ratios(np.exp(mid))
-            ok = np.maximum(m, cl) <= 1.0
-            lo = np.where(ok, mid, lo)
-            hi = np.where(ok, hi, mid)
-        ro = np.exp(lo)
-        # RND/RNDM: the programmed radius itself where it fits
-        m, cl = ratios(np.where(ho == HOW_RADIUS, rad, ro))
-        ro = np.where((ho == HOW_RADIUS) & (np.maximum(m, cl) <= 1.0), rad, ro)
-        m, cl = ratios(ro)
-        clamped[o] = cl >= m
-        fil = line_circle_fillet(ro, t2d[o], centre[o], R[o], sense[o])
+        geo = (t2d[o], centre[o], R[o], sense[o])
+        # the replaced lengths grow with r: the largest r within a length on each side
+        # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
+        # round-off of the closed form cannot put a trim above its limit
+        with np.errstate(invalid="ignore"):
+            r_cap = np.fmin(_positive(fillet_radius_for_line_trim(cap_line[o], *geo)),
+                            _positive(fillet_radius_for_arc_trim(cap_arc[o], *geo)))
+            r_adis = np.fmin(_positive(fillet_radius_for_line_trim(dist, *geo)),
+                             _positive(fillet_radius_for_arc_trim(dist, *geo)))
+        r_cap *= 1.0 - CLOSED_FORM_MARGIN
+        r_adis *= 1.0 - CLOSED_FORM_MARGIN
+        ro = np.select([ho == HOW_ADIS, ho == HOW_RADIUS], [r_adis, rad], np.inf)
+        ro = np.fmin(ro, r_cap)
+        # tolerances: the root of log(ratio) in log r below the clamp (the deviation
+        # grows with r), bracketed (Chandrupatla's method, scipy)
+        tl = np.flatnonzero(ho == HOW_TOL)
+        if tl.size:
+            n_ax = E1o.shape[1]
+            cols = (*geo[0][tl].T, *geo[1][tl].T, geo[2][tl], geo[3][tl], *E1o[tl].T,
+                    *E2o[tl].T, *(tol[tl] * g0[tl, None]).T, cont[tl] * g0[tl])
+            hi = np.log(np.where(np.isfinite(r_cap[tl]), r_cap[tl], R_MAX_MM))
+            lo = np.full(tl.size, np.log(R_MIN_MM))
+            f_hi = _log_tol_ratio(hi, *cols, n_axes=n_ax)
+            top = f_hi <= 0.0
+            ro[tl] = np.where(top, r_cap[tl], 0.0)
+            # a narrow bracket first: the deviation grows about like r, so log(ratio)
+            # has slope about 1 in log r and the root is near hi - f(hi); where that
+            # bracket does not hold, the whole range
+            guess = np.where(np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO), hi - f_hi, hi)
+            lo_n = np.maximum(guess - NARROW_BRACKET, lo)
+            hi_n = np.minimum(guess + NARROW_BRACKET, hi)
+            narrow = ((_log_tol_ratio(lo_n, *cols, n_axes=n_ax) < 0.0)
+                      & (_log_tol_ratio(hi_n, *cols, n_axes=n_ax) > 0.0))
+            lo = np.where(narrow, lo_n, lo)
+            hi = np.where(narrow, hi_n, hi)
+            sol = np.flatnonzero(~top & (_log_tol_ratio(lo, *cols, n_axes=n_ax) < 0.0))
+            if sol.size:
+                res = find_root(lambda x, *c: _log_tol_ratio(x, *c, n_axes=n_ax),
+                                (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
+                                tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
+                xl, xr = res.bracket
+                fl, _ = res.f_bracket
+                ro[tl[sol]] = np.exp(np.where(fl <= 0.0, xl, np.minimum(xl, xr)))
+        ro = np.where(np.isfinite(ro), ro, 0.0)
+        clamped[o] = ro >= r_cap
+        fil = line_circle_fillet(np.where(ro > 0, ro, 1.0), *geo)
         r[o] = ro
         length = ro * fil.sweep
+        # the closed forms assume the branch that shrinks to the corner: the fillet
+        # found must exist and keep both lengths
+        keeps = ((fil.line_trim <= cap_line[o]) & (fil.arc_trim <= cap_arc[o])
+                 & ((ho != HOW_ADIS) | (np.maximum(fil.line_trim, fil.arc_trim) <= dist)))
         sub = np.zeros(k, bool)
-        sub[o] = (~(np.maximum(m, cl) <= 1.0) | ~fil.valid
-                  | ~(length > MIN_SEGMENT_LENGTH_MM) | ~(ro > R_MIN_MM * 2))
+        sub[o] = (~keeps | ~fil.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
+                  | ~(ro > R_MIN_MM * 2))
         decide(sub, "rounding distance too small")
 
     o2 = np.flatnonzero(reason < 0)
@@ -316,6 +350,30 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], la, ka[ins])
     return ArcCorners(reason, trim_in, trim_out, radius_out, length_out, dev_out,
                       clamped & (reason == 0), v_g64, v_round, rows)
+
+
+def _log_tol_ratio(x: np.ndarray, tx, ty, cx, cy, radius, sense, *rest,
+                   n_axes: int) -> np.ndarray:
+    """``log`` of the largest tolerance ratio of the fillets of radius ``exp(x)`` (per
+    axis ``|C_i - M_i| / tol_i``, contour ``|C - M| / tol``), elementwise over 1-d
+    columns (:func:`scipy.optimize.elementwise.find_root` passes the active ones);
+    :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist."""
+    e1 = np.stack(rest[:n_axes], axis=1)
+    e2 = np.stack(rest[n_axes:2 * n_axes], axis=1)
+    tol = np.stack(rest[2 * n_axes:3 * n_axes], axis=1)
+    cont = rest[3 * n_axes]
+    dev2, ok = fillet_deviation(np.exp(x), np.column_stack((tx, ty)),
+                                np.column_stack((cx, cy)), radius, sense)
+    dev = e1 * dev2[:, :1] + e2 * dev2[:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.maximum(row_norms(dev) / cont, row_max_safe(np.abs(dev) / tol))
+        return np.where(ok, np.log(np.maximum(ratio, 1e-300)), NO_FILLET_LOG_RATIO)
+
+
+def _positive(r: np.ndarray) -> np.ndarray:
+    """Radii from the closed forms, ``inf`` where there is none (not positive, ``nan``:
+    that length never limits)."""
+    return np.where(r > 0, r, np.inf)
 
 
 def row_max_safe(x: np.ndarray) -> np.ndarray:

@@ -322,16 +322,10 @@ def line_circle_fillet(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
     """
     tc = sense[:, None] * _perp(-centre) / radius[:, None]    # circle's tangent at C
     s = np.sign(_cross2(t, tc))
-    n = s[:, None] * _perp(t)
-    inside = s == sense
-    rho = np.where(inside, radius - r, radius + r)
-    w = r[:, None] * n - centre
-    tw = row_dots(t, w)
-    ww = row_dots(w, w)
-    disc = tw * tw - ww + rho * rho
+    n, iota = _corner_frame(t, centre, radius, sense)
+    rho = radius - iota * r
+    x, disc = _line_offset(r, t, n, iota, centre, radius)
     with np.errstate(invalid="ignore", divide="ignore"):
-        q = -tw - np.where(tw >= 0, 1.0, -1.0) * np.sqrt(np.maximum(disc, 0.0))
-        x = (ww - rho * rho) / q
         O = x[:, None] * t + r[:, None] * n
         u = O - centre
         u = u / row_norms(u)[:, None]
@@ -348,6 +342,90 @@ def line_circle_fillet(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
     return ArcFillet(valid, -x, radius * ang, O, x[:, None] * t, end, sweep, -near)
 
 
+def _corner_frame(t: np.ndarray, centre: np.ndarray, radius: np.ndarray,
+                  sense: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` (unit normal of the line towards the fillet's centre) and ``iota`` (+1 where
+    the fillet lies inside the circle, -1 outside) of :func:`line_circle_fillet`."""
+    tc = sense[:, None] * _perp(-centre) / radius[:, None]
+    s = np.sign(_cross2(t, tc))
+    return s[:, None] * _perp(t), np.where(s == sense, 1.0, -1.0)
+
+
+def _line_offset(r: np.ndarray, t: np.ndarray, n: np.ndarray, iota: np.ndarray,
+                 centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where the fillet of radius ``r`` leaves the line (``x``, the root of
+    :func:`line_circle_fillet` that tends to 0 with ``r``) and the discriminant.
+
+    ``|x t + w|^2 = rho^2`` with ``w = r n - c``, ``rho = R - iota r``: ``x^2 + 2 (t.w) x +
+    |w|^2 - rho^2 = 0``, where ``|w|^2 - rho^2 = iota r R |iota n + u0|^2`` (``|c| = R``,
+    ``u0 = -c / R``: written so, without the cancellation of ``R^2``); the small root is
+    ``(|w|^2 - rho^2) / q``, ``q = -(t.w) - sign(t.w) sqrt(disc)``.
+    """
+    u0 = -centre / radius[:, None]
+    half = iota[:, None] * n + u0
+    c0 = iota * r * radius * row_dots(half, half)
+    tw = r * row_dots(t, n) - row_dots(t, centre)
+    disc = tw * tw - c0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q = -tw - np.where(tw >= 0, 1.0, -1.0) * np.sqrt(np.maximum(disc, 0.0))
+        return c0 / q, disc
+
+
+def fillet_radius_for_line_trim(trim: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                                radius: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`line_circle_fillet` that replaces ``trim`` of the
+    line, closed form, mm, shape (k,).
+
+    Its centre is ``O = P + r n`` with ``P = -trim t`` and ``|O - c| = R - iota r``;
+    squared, the ``r^2`` terms cancel: ``r = (R^2 - |P - c|^2) / (2 (n.(P - c) + iota R))``.
+    Written without cancellation (``|c| = R``, ``n.t = 0``, ``u0 = -c / R`` the radial
+    at ``C``): ``R^2 - |P - c|^2 = -trim (trim - 2 R t.u0)`` and ``n.(P - c) + iota R =
+    iota R |iota n + u0|^2 / 2``.
+    """
+    n, iota = _corner_frame(t, centre, radius, sense)
+    u0 = -centre / radius[:, None]
+    num = -trim * (trim - 2.0 * radius * row_dots(t, u0))
+    half = iota[:, None] * n + u0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return num / (iota * radius * row_dots(half, half))
+
+
+def fillet_radius_for_arc_trim(trim: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                               radius: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`line_circle_fillet` that replaces the arc length
+    ``trim`` of the circle, closed form, mm, shape (k,).
+
+    It touches the circle at ``T``, ``trim / R`` along the circle from ``C``, with its
+    centre ``O = c + (R - iota r) u`` (``u`` the unit radial at ``T``) at distance ``r``
+    from the line: ``n.O = r``, so ``r = n.T / (1 + iota n.u)``; without cancellation
+    ``n.T = R n.(u - u0)`` with ``u - u0 = -2 sin^2(a/2) u0 + sin(a) perp(u0)`` (``a``
+    the angle turned) and ``1 + iota n.u = |iota n + u|^2 / 2``.
+    """
+    n, iota = _corner_frame(t, centre, radius, sense)
+    a = sense * trim / radius
+    u0 = -centre / radius[:, None]                      # radial at C
+    du = (-2.0 * np.sin(a / 2.0) ** 2)[:, None] * u0 + np.sin(a)[:, None] * _perp(u0)
+    half = iota[:, None] * n + u0 + du
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 2.0 * radius * row_dots(n, du) / row_dots(half, half)
+
+
+def fillet_deviation(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                     radius: np.ndarray, sense: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``C - M`` of the fillets of radius ``r`` (:attr:`ArcFillet.deviation`), shape
+    (k, 2), and whether they exist with their start before the corner, shape (k,): the
+    cheap part of :func:`line_circle_fillet` for a search over ``r``."""
+    n, iota = _corner_frame(t, centre, radius, sense)
+    rho = radius - iota * r
+    x, disc = _line_offset(r, t, n, iota, centre, radius)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        O = x[:, None] * t + r[:, None] * n
+        dist = row_norms(O)
+        dev = -O * (1.0 - r / dist)[:, None]
+    return dev, (disc >= 0) & (x < 0) & (rho > 0) & np.isfinite(x)
+
+
 __all__ = ["ArcFillet", "REASON_CODE", "ROUNDING_REASONS", "RoundingTable",
            "axis_deviation_limit", "deflection_angle", "distance_for_deviation",
-           "fillet_pieces", "line_circle_fillet"]
+           "fillet_deviation", "fillet_pieces", "fillet_radius_for_arc_trim",
+           "fillet_radius_for_line_trim", "line_circle_fillet"]

@@ -194,3 +194,43 @@ def test_arc_corners_keep_the_limits_and_do_not_slow_the_program(mfile, mode, ac
         assert check_profile(path, mach.limits, res.profile).ok(BOUND_SETS[res.bound_set])
         times[m] = res.time_s
     assert times[mode] <= times["G64"] * (1 + 1e-9)
+
+
+def test_line_circle_fillet_is_tangent_to_both_on_random_corners():
+    """Hand geometry on 2000 seeded corners (line direction, circle centre and sense,
+    radius): where the fillet exists its centre is r from the line and R -+ r from the
+    circle's centre, it leaves the line before the corner and ends on the circle, and
+    its radius at either end is normal to the element it touches (tangency)."""
+    from reference.core.rounding import (fillet_radius_for_arc_trim,
+                                         fillet_radius_for_line_trim, line_circle_fillet)
+    rng = np.random.default_rng(3)
+    k = 2000
+    ang = rng.uniform(0, 2 * np.pi, k)
+    t = np.column_stack((np.cos(ang), np.sin(ang)))
+    R = rng.uniform(0.5, 50.0, k)
+    beta = rng.uniform(0, 2 * np.pi, k)                  # C on the circle: c = -R u0
+    c = -R[:, None] * np.column_stack((np.cos(beta), np.sin(beta)))
+    sense = rng.choice((-1.0, 1.0), k)
+    r = rng.uniform(0.01, 0.3, k) * R
+    f = line_circle_fillet(r, t, c, R, sense)
+    v = f.valid
+    assert v.mean() > 0.3
+    n_dist = np.abs(t[v, 0] * f.centre[v, 1] - t[v, 1] * f.centre[v, 0])
+    np.testing.assert_allclose(n_dist, r[v], rtol=1e-9, atol=1e-12)
+    oc = np.linalg.norm(f.centre[v] - c[v], axis=1)
+    assert np.all(np.minimum(np.abs(oc - (R[v] - r[v])), np.abs(oc - (R[v] + r[v])))
+                  <= 1e-9 * R[v])
+    np.testing.assert_allclose(np.linalg.norm(f.end[v] - c[v], axis=1), R[v], rtol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", f.start[v] - f.centre[v], t[v]), 0.0,
+                               atol=1e-9 * R[v].max())
+    assert np.all(np.einsum("ij,ij->i", f.start[v], t[v]) < 0)      # before the corner
+    # the end: fillet radius and circle radius on one line through both centres
+    a = f.end[v] - f.centre[v]
+    b = f.end[v] - c[v]
+    np.testing.assert_allclose(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], 0.0,
+                               atol=1e-9 * R[v].max() ** 2)
+    # the closed-form radii invert the replaced lengths
+    np.testing.assert_allclose(fillet_radius_for_line_trim(f.line_trim[v], t[v], c[v], R[v],
+                                                           sense[v]), r[v], rtol=1e-11)
+    np.testing.assert_allclose(fillet_radius_for_arc_trim(f.arc_trim[v], t[v], c[v], R[v],
+                                                          sense[v]), r[v], rtol=1e-11)
