@@ -241,9 +241,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                 res = find_root(lambda x, *c: _log_tol_ratio(x, *c, n_axes=n_ax),
                                 (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
                                 tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
-                xl, xr = res.bracket
-                fl, _ = res.f_bracket
-                ro[tl[sol]] = np.exp(np.where(fl <= 0.0, xl, np.minimum(xl, xr)))
+                # the bracket's lower end keeps f <= 0: within the tolerance
+                ro[tl[sol]] = np.exp(res.bracket[0])
         ro = np.where(np.isfinite(ro), ro, 0.0)
         clamped[o] = ro >= r_cap
         fil = line_circle_fillet(np.where(ro > 0, ro, 1.0), *geo)
@@ -253,6 +252,9 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         # found must exist and keep both lengths
         keeps = ((fil.line_trim <= cap_line[o]) & (fil.arc_trim <= cap_arc[o])
                  & ((ho != HOW_ADIS) | (np.maximum(fil.line_trim, fil.arc_trim) <= dist)))
+        if tl.size:
+            keeps[tl] &= _log_tol_ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *cols,
+                                        n_axes=n_ax) <= 0.0
         sub = np.zeros(k, bool)
         sub[o] = (~keeps | ~fil.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
                   | ~(ro > R_MIN_MM * 2))

@@ -131,10 +131,8 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     arc_line = (kind_a == _ARC) & (kind_b == _LINE)
     arc = np.where(line_arc, b, a)
     line = np.where(line_arc, a, b)
-    decide((kind_a == _ARC) & (kind_b == _ARC),
+    decide(~(line_arc | arc_line),
            "tangential transition between arcs: rounding not modelled yet")
-    decide(~(line_arc | arc_line), "tangential transition between arcs: rounding not "
-           "modelled yet")
     circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
               & ~(np.abs(path.d.take(arc, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
     decide(~circle, "tangential transition into a helix or spiral: rounding not "

@@ -231,9 +231,15 @@ def test_v_g64_is_the_curvature_jump_rule_by_hand():
     ("G17 G90 G641 ADIS=1 SOFT F6000\n" + LINE_ARC_LINE, {}, "tangential transition"),
 ])
 def test_no_transition_and_why(text, mach, why):
-    path = build_path(parse_text(text), machine(mach))
+    """Each case named per transition, in the planner trace and in the block rows'
+    decision (issue 13: "each named in the trace and in the block rows")."""
+    prog, m = parse_text(text), machine(mach)
+    path = build_path(prog, m)
     assert reasons(path) == [why, why]
     assert not np.any(path.kind == ROUNDING)
+    note = dict((e.stage, e.note) for e in plan(prog, m, path=path).trace)["rounding"]
+    assert why in note
+    assert set(path.rounding.decision_by_block().values()) == {f"none: {why}"}
 
 
 def test_model_limits_are_named():
