@@ -47,12 +47,18 @@ from .core.rounding import (REASON_CODE, ArcFillet, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
                             line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
-from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL, TANGENT_TOL_RAD
+from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
 _ARC = KIND_CODES.index("arc")
 _ROUNDING = KIND_CODES.index("rounding")
+
+#: A line counts as lying in its arc's plane when its direction leaves the plane by at
+#: most this (the sine of the angle): the fillet is built in the plane and starts on the
+#: line's projection, at most ``OFF_PLANE_MAX`` times the replaced length (at most half
+#: the block) off the line, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
+OFF_PLANE_MAX = 1e-9
 
 #: Fillet radii are searched in ``[R_MIN_MM, R_MAX_MM]`` (log scale): below a nanometre
 #: a rounding is "too small" anyway (MIN_SEGMENT_LENGTH_MM), above 10 m no clamp of a
@@ -156,12 +162,12 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     line = np.where(line_arc, a, b)
     E1, E2 = path.e1.take(arc, axis=0), path.e2.take(arc, axis=0)
     t_line = path.d.take(line, axis=0)
-    # the line in the arc's plane: its component off the plane below sin(TANGENT_TOL)
+    # the line in the arc's plane (OFF_PLANE_MAX)
     off = row_norms(t_line - row_dots(t_line, E1)[:, None] * E1
                     - row_dots(t_line, E2)[:, None] * E2)
     circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
               & ~(np.abs(path.d.take(arc, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
-    decide(~circle | ~(off <= TANGENT_TOL_RAD),
+    decide(~circle | ~(off <= OFF_PLANE_MAX),
            "corner next to a helix or spiral, or out of the arc's plane: rounding not "
            "modelled yet")
     how = targets["how"]
