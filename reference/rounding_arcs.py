@@ -66,10 +66,11 @@ OFF_PLANE_MAX = 1e-9
 R_MIN_MM = 1e-9
 R_MAX_MM = 1e7
 #: Absolute tolerance of the root in ``log r`` (tolerance modes): a relative error in
-#: ``r``, so in the deviation used, of 1e-11.
+#: ``r``, so in the deviation used, of 1e-11 (the radius kept lies up to two of these
+#: inside the tolerance).
 ROOT_XATOL = 1e-11
-#: Half-width of the first bracket around the estimated root, in ``log r`` (a factor 2).
-NARROW_BRACKET = float(np.log(2.0))
+#: Secant steps in ``log r`` before the bracketed search (tolerance modes).
+SECANT_STEPS = 5
 #: ``log`` of the tolerance ratio where the fillet does not exist (larger radii): far
 #: above 0, so the root search stays below it.
 NO_FILLET_LOG_RATIO = 50.0
@@ -232,23 +233,36 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             f_hi = _log_tol_ratio(hi, *cols, n_axes=n_ax)
             top = f_hi <= 0.0
             ro[tl] = np.where(top, r_cap[tl], 0.0)
-            # a narrow bracket first: the deviation grows about like r, so log(ratio)
-            # has slope about 1 in log r and the root is near hi - f(hi); where that
-            # bracket does not hold, the whole range
-            guess = np.where(np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO), hi - f_hi, hi)
-            lo_n = np.maximum(guess - NARROW_BRACKET, lo)
-            hi_n = np.minimum(guess + NARROW_BRACKET, hi)
-            narrow = ((_log_tol_ratio(lo_n, *cols, n_axes=n_ax) < 0.0)
-                      & (_log_tol_ratio(hi_n, *cols, n_axes=n_ax) > 0.0))
-            lo = np.where(narrow, lo_n, lo)
-            hi = np.where(narrow, hi_n, hi)
-            sol = np.flatnonzero(~top & (_log_tol_ratio(lo, *cols, n_axes=n_ax) < 0.0))
+            # the deviation grows about like r, so f = log(ratio) is nearly linear in
+            # log r: secant steps from hi and hi - f(hi) reach the root to round-off in
+            # a few steps; kept where they end inside the tolerance and within
+            # ROOT_XATOL of the root (f in [-ROOT_XATOL, 0]), the others go to the
+            # bracketed search below
+            ok = np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top
+            x0, f0 = hi, np.where(ok, f_hi, 1.0)
+            x = np.where(ok, hi - f0, hi)
+            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
+            for _ in range(SECANT_STEPS):
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    slope = (f_x - f0) / (x - x0)
+                move = ok & np.isfinite(slope) & (slope > 0) & (f_x != 0.0)
+                x0, f0 = x, f_x
+                x = np.where(move, np.minimum(x - f_x / np.where(move, slope, 1.0), hi), x)
+                f_x = np.where(move, _log_tol_ratio(x, *cols, n_axes=n_ax), f_x)
+            # half ROOT_XATOL inside the tolerance: r = exp(x) and log(r) differ by
+            # round-off, which must not carry the kept radius across the limit
+            x = x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0
+            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
+            done = ok & (f_x <= 0.0) & (f_x >= -2.0 * ROOT_XATOL)
+            ro[tl[done]] = np.exp(x[done])
+            sol = np.flatnonzero(~top & ~done & (_log_tol_ratio(lo, *cols, n_axes=n_ax) < 0.0))
             if sol.size:
                 res = find_root(lambda x, *c: _log_tol_ratio(x, *c, n_axes=n_ax),
                                 (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
                                 tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
-                # the bracket's lower end keeps f <= 0: within the tolerance
-                ro[tl[sol]] = np.exp(res.bracket[0])
+                # the bracket's lower end keeps f <= 0: within the tolerance (half
+                # ROOT_XATOL further inside, as above)
+                ro[tl[sol]] = np.exp(res.bracket[0] - ROOT_XATOL / 2.0)
         ro = np.where(np.isfinite(ro), ro, 0.0)
         clamped[o] = ro >= r_cap
         fil = line_circle_fillet(np.where(ro > 0, ro, 1.0), *geo)
