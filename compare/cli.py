@@ -150,6 +150,8 @@ def _write_rounding(out, program, table) -> None:
     lines = {b.index: b.line for b in program.blocks}
     out.write(f"rounding: {int(table.inserted.sum())} of {table.n} corners in G641..G645 "
               "rounded (shape: arc = tangent arc, G2 = clothoid pair, curvature continuous; "
+              "G2 transition = G645 at a tangential line-arc transition, d = length of the "
+              "line replaced; "
               "radius_mm = smallest radius); d = distance of the rounding's ends from the corner, "
               "dev = largest distance of the rounded path from the corner, F_G64 / F_round "
               "= speed through the corner under G64 / through the rounding (model "
@@ -159,7 +161,8 @@ def _write_rounding(out, program, table) -> None:
     for i in range(table.n):
         corner = f"{lines[int(table.block[i])]}/{lines[int(table.next_block[i])]}"
         if table.inserted[i]:
-            what = "rounded (" + ("G2" if table.g2[i] else "arc") + ")"
+            what = "rounded (" + ("G2 transition" if table.tangential[i] else
+                                  "G2" if table.g2[i] else "arc") + ")"
             if table.blocks_spanned[i] > 2:
                 what += (f" across lines {lines[int(table.first_block[i])]}.."
                          f"{lines[int(table.last_block[i])]} (short blocks)")

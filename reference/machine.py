@@ -88,6 +88,7 @@ _AXIS_KEYS: dict[str, _Key] = {
     "LOOKAH_FREQUENCY": _Key((int, float), "Hz", 0.0, 1000.0, "MD32440", 1e-2),
     "PATH_TRANS_JERK_LIM": _Key((int, float), "m/s^3", 0.0, 1e5, "MD32432", 1e-3),
     "COMPRESS_POS_TOL": _Key((int, float), "mm", 0.0, 100.0, "MD33100", 1e-6),
+    "PATH_TRANS_POS_TOL": _Key((int, float), "mm", 0.0, 100.0, "MD33120", 1e-6),
     "EPS_TLIFT_TANG_STEP": _Key((int, float), "deg", 0.0, 180.0, "MD37400", 1e-3),
     "POSCTRL_GAIN": _Key((int, float), "(m/min)/mm", 0.0, 100.0, "MD32200", 1e-3),
     "STOP_LIMIT_FINE": _Key((int, float), "mm", 0.0, 10.0, "MD36010", 1e-6),
@@ -120,6 +121,10 @@ class AxisSettings:
     ----------
     compress_pos_tol_mm : float
         MD33100 COMPRESS_POS_TOL, mm (degrees for rotary axes).
+    path_trans_pos_tol_mm : float
+        MD33120 PATH_TRANS_POS_TOL, mm (degrees for rotary axes): the deviation G645 may
+        use to round a tangential transition with a curvature jump (spec 5.7: "used
+        only at tangential transitions"). Default 0.005 [M].
     eps_tlift_deg : float
         MD37400 EPS_TLIFT_TANG_STEP, degrees.
     kv_per_s : float
@@ -144,6 +149,7 @@ class AxisSettings:
     """
 
     compress_pos_tol_mm: float = 0.01
+    path_trans_pos_tol_mm: float = 0.005
     eps_tlift_deg: float = 5.0
     kv_per_s: float = 1.0 * 1000.0 / 60.0
     stop_fine_mm: float = 0.01
@@ -417,6 +423,7 @@ def machine_from_dict(data: dict[str, Any], source: str = "<dict>") -> Machine:
             rotary=rotary))
         settings.append((ax, AxisSettings(
             compress_pos_tol_mm=float(tbl.get("COMPRESS_POS_TOL", 0.01)),
+            path_trans_pos_tol_mm=float(tbl.get("PATH_TRANS_POS_TOL", 0.005)),
             eps_tlift_deg=float(tbl.get("EPS_TLIFT_TANG_STEP", 5.0)),
             kv_per_s=float(tbl.get("POSCTRL_GAIN", 1.0)) * 1000.0 / 60.0,
             stop_fine_mm=float(tbl.get("STOP_LIMIT_FINE", 0.01)),

@@ -23,8 +23,16 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    block only (named first: it is a path stop too), a stop at the break (exact stop,
    auxiliary output before motion, M0, a positioning axis, ...), a block without path
    motion between, a change of acceleration mode (BRISK/SOFT);
-3. model limits of this version: only line-to-line corners of geometry axes are rounded
-   (arc transitions and corners where other axes move are passed as under G64, named);
+3. transitions next to an arc: a tangential one (line into arc, arc into line) is
+   rounded by G645 only ("G645 also inserts rounding" at "tangential transitions with a
+   curvature jump", 5.7), decided and sized apart
+   (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
+   pairs that takes up the classical shift and a curvature ramp onto the arc,
+   :mod:`reference.core.transition`); other modes name it "tangential transition".
+   A corner between a line and a circular arc is rounded by a tangent fillet
+   (:func:`reference.rounding_arcs.arc_corners`, sized by the same mode parameters).
+   Model limits of this version: corners between two arcs, next to helices, and
+   corners where non-geometry axes move are passed as under G64, named;
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
 
    * G641: ``d = ADIS`` (G1/G2/G3), ``ADISPOS`` (G0), the smaller if one block is G0;
@@ -65,7 +73,10 @@ Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions with curvature jumps is not modelled; a window
+G645's rounding of tangential transitions, and the rounding of corners next to arcs,
+are modelled between a line and a circle only (arc into arc, helices and spirals are
+named and passed as G64; a corner next to an arc gets a tangent arc, G1, also under
+SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
@@ -87,6 +98,8 @@ from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junct
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
 from .nc.program import Program
+from .rounding_arcs import arc_corners
+from .rounding_tangential import PIECES, tangential_transitions
 
 #: Group-10 modes that round corners.
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
@@ -137,6 +150,8 @@ _MODE_DTYPE = "U8"
 
 _LINE = KIND_CODES.index("line")
 _ROUNDING = KIND_CODES.index("rounding")
+#: Reason placeholder of G645 tangential transitions while the corners are decided.
+_PENDING = 10 ** 6
 
 
 def _digit(value: int, place: int) -> int:
@@ -231,14 +246,26 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     decide(path.stop[brk], "stop between the blocks")
     decide(kb - ka > 1, "block without path motion between")
     decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
-    # --- model limits of this version ------------------------------------------------
-    decide(~is_line, "arc transition: rounding not modelled yet")
+    # --- transitions next to an arc: a tangential one is G645's to round (5.7,
+    # :mod:`reference.rounding_tangential`), any other mode passes it as G64 does; a
+    # corner next to an arc is a model limit of this version
+    tang_arc = np.zeros(a.size, bool)
+    near_arc = np.flatnonzero(~is_line & (reason < 0))
+    if near_arc.size:
+        tang_arc[near_arc] = is_tangential(*_junction_tangents(path, a[near_arc]), FEASIBLE)
     other = np.zeros(a.size, bool)
     if not geo.all():
         other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
             row_max(np.abs(db[:, ~geo])) > MOVING_AXIS_TOL)
     decide(other, "non-geometry axes move: rounding not modelled yet")
+    decide(tang_arc & (mode_arr != "G645"), "tangential transition")
+    trans = np.flatnonzero(tang_arc & (reason < 0))
+    reason[trans] = _PENDING              # decided below, apart from the corners
+    arc_corner = ~is_line & ~tang_arc
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
+    if near_arc.size:                     # at corners next to arcs: the arcs' tangents
+        t1, t2 = t1.copy(), t2.copy()
+        t1[near_arc], t2[near_arc] = _junction_tangents(path, a[near_arc])
     decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
 
     # --- the rounding's shape (5.8, 5.9): under SOFT the axis motion in the rounding
@@ -247,8 +274,12 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     # radius) the tangent arc
     theta = deflection_angle(t1, t2)
     g2 = (attrs["accel"][ka] == "SOFT") & np.isin(mode_arr, ROUNDING_MODES)
-    d, multi = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta, g2,
-                          decide)
+    d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta,
+                                   g2, decide)
+    # corners next to arcs: decided and sized apart (reference.rounding_arcs), after the
+    # mode's parameters were checked above
+    arcc = np.flatnonzero(arc_corner & (reason < 0))
+    reason[arcc] = _PENDING
     # clamp (5.3, the G644 excerpt): c times the shorter participating block; where the
     # mode rounds across short blocks, the participating "block" on each side is the
     # straight chain of blocks the window may cover (:func:`_straight_chains`)
@@ -296,31 +327,72 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                    ) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
-    ins = reason == 0
+    ins = reason == 0                     # corners rounded (transitions are still pending)
     zero = np.where(ins, 1.0, 0.0)
+    dist, length, dev, rad = d * zero, shape.length * zero, shape.deviation * zero, \
+        shape.radius * zero
+    clamped, g2_out = clamped & ins, g2 & ins
+    tr = None
+    if trans.size:
+        tr = tangential_transitions(path, machine, a[trans], ka[trans],
+                                    attrs["accel"][ka[trans]], CENTRIPETAL_SHARE,
+                                    JERK_VELOCITY_SHARE, corner_time_loss)
+        reason[trans] = tr.reason
+        done = (tr.reason == 0).astype(np.float64)
+        dist[trans] = np.maximum(tr.trim_in, tr.trim_out)
+        length[trans] = tr.shape.length * done
+        dev[trans] = tr.shape.deviation * done
+        rad[trans] = tr.shape.radius * done
+        clamped[trans] = tr.clamped
+        g2_out[trans] = tr.reason == 0
+        v64[trans], v_round[trans] = tr.v_g64, tr.v_round
+    ac = None
+    if arcc.size:
+        ac = arc_corners(path, machine, a[arcc], ka[arcc], mode_arr[arcc], t1[arcc],
+                         t2[arcc], {key: val[arcc] for key, val in targets.items()},
+                         attrs["accel"][ka[arcc]], CENTRIPETAL_SHARE, JERK_VELOCITY_SHARE,
+                         corner_time_loss)
+        reason[arcc] = ac.reason
+        dist[arcc] = np.maximum(ac.trim_in, ac.trim_out)
+        length[arcc], dev[arcc], rad[arcc] = ac.length, ac.deviation, ac.radius
+        clamped[arcc] = ac.clamped
+        g2_out[arcc] = False
+        v64[arcc], v_round[arcc] = ac.v_g64, ac.v_round
+    tangential = np.zeros(a.size, bool)
+    tangential[trans] = True
     table = RoundingTable(
         block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
-        distance_mm=d * zero, length_mm=shape.length * zero,
-        deviation_mm=shape.deviation * zero, radius_mm=shape.radius * zero,
-        clamped=clamped & ins, v_g64=v64, v_round=v_round, g2=g2 & ins,
+        distance_mm=dist, length_mm=length, deviation_mm=dev, radius_mm=rad,
+        clamped=clamped, v_g64=v64, v_round=v_round, g2=g2_out,
         first_block=np.where(ins, path.block[first], ka).astype(np.int64),
-        last_block=np.where(ins, path.block[last], kb).astype(np.int64))
-    if not ins.any():                     # nothing to insert: same path, with the table
+        last_block=np.where(ins, path.block[last], kb).astype(np.int64),
+        tangential=tangential)
+    if not (reason == 0).any():           # nothing to insert: same path, with the table
         keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
                 "blocks", "source", "dradius", "sharpness")
         return Path(rounding=table, **{f: getattr(path, f) for f in keep})
+    extras = []
+    for part, at in ((tr, trans), (ac, arcc)):
+        if part is not None and (part.reason == 0).any():
+            done = part.reason == 0
+            n_rows = PIECES if part is tr else 1
+            extras.append((a[at[done]], part.trim_in[done],
+                           part.trim_out[done], part.rows, n_rows))
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],
-                     table)
+                     table, extras)
 
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
                t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, decide
-               ) -> tuple[np.ndarray, np.ndarray]:
+               ) -> tuple[np.ndarray, np.ndarray, dict]:
     """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
-    and whether the corner's window may reach across short blocks (G642/G645 with a
-    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,)."""
+    whether the corner's window may reach across short blocks (G642/G645 with a
+    tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
+    the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
+    (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
+    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -359,10 +431,11 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.where(is_adis, dist, d)
     # tolerance type (5.4): per-axis MD33100 on the axes it applies to, contour tolerance
     is_tol = how == TOL
+    tol_k = np.full((k, path.n_axes), np.inf)
+    g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
     if is_tol.any():
         tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
-        g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
         dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
         d_dev = np.where(g2, _clothoid_distance(theta, np.maximum(dev, 0.0)),
@@ -377,7 +450,16 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
                                    theta[dyn], g2[dyn], how[dyn] == FREQ)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
-    return np.where(np.isfinite(d), d, 0.0), multi
+    targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
+               "radius": radius}
+    return np.where(np.isfinite(d), d, 0.0), multi, targets
+
+
+def _junction_tangents(path: Path, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tangents at the end of segments ``a`` and at the start of ``a + 1``, shape (k, n)
+    each (arcs included)."""
+    s = path.s_breaks[a + 1]
+    return path.evaluate(s, segment=a)[1], path.evaluate(s, segment=a + 1)[1]
 
 
 def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
@@ -571,7 +653,8 @@ def _max_dir_error(path: Path, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray
 def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
                      a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
                      j_out: np.ndarray, inserted: np.ndarray | float,
-                     replaced: np.ndarray | float) -> np.ndarray:
+                     replaced: np.ndarray | float,
+                     replaced_out: np.ndarray | float | None = None) -> np.ndarray:
     """Time a corner passed at ``v_corner`` costs against passing it at the programmed
     speeds, s: the decision's estimate of "rounding would slow the program down"
     (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
@@ -604,6 +687,10 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
         Rounding length ``l``, mm (0 for G64).
     replaced : numpy.ndarray or float
         Length cut from each line, mm (the tangent distance ``d``; 0 for G64).
+    replaced_out : numpy.ndarray or float, optional
+        Length cut from the segment after, where it differs from ``replaced`` (then cut
+        from the segment before only): G645's tangential transitions replace more of
+        the line than of the arc.
 
     Returns
     -------
@@ -614,13 +701,14 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
     inserted = np.asarray(inserted, dtype=np.float64)
     total = np.zeros(np.shape(v))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for v_p, a, j in ((v_in, a_in, j_in), (v_out, a_out, j_out)):
+        cut_out = replaced if replaced_out is None else replaced_out
+        for v_p, a, j, cut in ((v_in, a_in, j_in, replaced), (v_out, a_out, j_out, cut_out)):
             dv = np.maximum(v_p - v, 0.0)
             reach = dv * j >= a * a
             T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
             T = np.where(dv > 0, T, 0.0)
             total = total + np.where(np.isfinite(v_p) & (v_p > 0),
-                                     T * dv / (2.0 * v_p) - np.asarray(replaced) / v_p, 0.0)
+                                     T * dv / (2.0 * v_p) - np.asarray(cut) / v_p, 0.0)
         total = total + np.where(inserted > 0, inserted / v, 0.0)
     # a stop costs its ramps; only a rounding passed at no speed would never end
     return np.where((v > 0) | ~(inserted > 0), total, np.inf)
@@ -760,11 +848,13 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
     ``d - (distance from the corner)``, which is exactly ``d`` at the corner's own two
     segments (the one-block case keeps its exact trims).
     """
+    trim_start = np.zeros(path.n_segments)
+    trim_end = np.zeros(path.n_segments)
+    if a.size == 0:
+        return trim_start, trim_end
     sb = path.s_breaks
     s0, s1 = sb[:-1], sb[1:]
     corner = sb[a + 1]
-    trim_start = np.zeros(path.n_segments)
-    trim_end = np.zeros(path.n_segments)
     # window whose corner is at or before the segment's start, and whose reach covers it
     i = np.searchsorted(corner, s0, side="right") - 1
     hit = i >= 0
@@ -793,7 +883,8 @@ def _interleave(rows: np.ndarray, pos: np.ndarray, ins: np.ndarray, ins_pos: np.
 
 
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
-              g2: np.ndarray, piece: np.ndarray, table: RoundingTable) -> Path:
+              g2: np.ndarray, piece: np.ndarray, table: RoundingTable,
+              extras: list | None = None) -> Path:
     """The rounded path: lines shortened, roundings inserted after segments ``a``
     (a tangent arc, or the two pieces of a clothoid pair), spans moved.
 
@@ -809,23 +900,46 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         Clothoid pair (else tangent arc).
     piece : numpy.ndarray, shape (r,)
         Length of each clothoid piece, mm (used where ``g2``).
+    extras : list of tuple, optional
+        Other insertions ``(a_x, trim_in, trim_out, rows, n_rows)``: after segments
+        ``a_x``, the segment before shortened at its end by ``trim_in`` and the one after
+        at its start by ``trim_out`` (an arc's start angle moves, so it stays the exact
+        arc), ``n_rows`` packed ``rows`` each (G645's tangential transitions,
+        :mod:`reference.rounding_tangential`; fillets at corners next to arcs,
+        :mod:`reference.rounding_arcs`).
     """
     m = path.n_segments
     trim_start, trim_end = _window_trims(path, a, d)
+    n_ins = np.zeros(m, dtype=np.int64)
+    n_ins[a] = np.where(g2, 2, 1)
+    corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
+    arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
+    if extras:
+        a_all, cnt = [a], [np.where(g2, 2, 1)]
+        for at, t_in, t_out, rows, n_rows in extras:
+            trim_end[at] += t_in
+            trim_start[at + 1] += t_out
+            n_ins[at] = n_rows
+            a_all.append(at)
+            cnt.append(np.full(at.size, n_rows))
+            arcs = {key: np.concatenate((val, rows[key])) for key, val in arcs.items()}
+        # rows in path order: every insertion's rows sorted by its segment
+        a_all, cnt = np.concatenate(a_all), np.concatenate(cnt)
+        rank = np.empty(a_all.size, dtype=np.int64)
+        rank[np.argsort(a_all, kind="stable")] = np.arange(a_all.size)
+        order = np.argsort(np.repeat(rank, cnt), kind="stable")
+        arcs = {key: val[order] for key, val in arcs.items()}
+        a = np.sort(a_all)
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
     # meet tangentially and the line is dropped; a line inside a window that reaches
     # across short blocks (:func:`_across_blocks`) is covered whole and dropped too
     keep = length > MIN_SEGMENT_LENGTH_MM
-    n_ins = np.zeros(m, dtype=np.int64)
-    n_ins[a] = np.where(g2, 2, 1)
     count = keep.astype(np.int64) + n_ins
     first = np.concatenate(([0], np.cumsum(count)))          # new index of old seg's pieces
     total = int(first[-1])
     n = path.n_axes
-    corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
-    arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
-    # rows of the inserted segments: after the kept part of segment a, one or two each
+    # rows of the inserted segments: after the kept part of segment a, n_ins[a] each
     base = first[:-1][a] + keep[a]
     k_ins = n_ins[a]
     arc_pos = np.repeat(base, k_ins) + (np.arange(int(k_ins.sum()))
@@ -833,8 +947,10 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     kept = np.flatnonzero(keep)
     line_pos = first[:-1][kept]
     new = {}
-    # shortened lines (a trimmed arc never occurs: only line-line corners are rounded)
+    # shortened segments: lines, and arcs at G645 transitions (circles: the start angle
+    # moves by omega times the trim, the radius, centre and plane stay)
     origin = path.origin + path.d * trim_start[:, None]
+    theta0 = path.theta0 + path.omega * trim_start
     for key in ("origin", "e1", "e2", "d"):
         src = origin if key == "origin" else getattr(path, key)
         new[key] = _interleave(src.take(kept, axis=0), line_pos, arcs[key], arc_pos,
@@ -844,11 +960,12 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
                        ("block", np.int64), ("kind", np.int8), ("dradius", np.float64),
                        ("sharpness", np.float64)):
         arr = np.zeros(total, dtype=dtype)
-        src = length if key == "length" else getattr(path, key)
+        src = {"length": length, "theta0": theta0}.get(key)
+        src = getattr(path, key) if src is None else src
         arr[line_pos] = src[keep]
         arr[arc_pos] = arcs[key]
         new[key] = arr
-    per = np.repeat(np.arange(a.size), np.where(g2, 2, 1))  # corner of each inserted row
+    per = np.repeat(np.arange(a.size), k_ins)               # corner of each inserted row
     feed = np.zeros(total)
     feed[line_pos] = path.feed[keep]
     feed[arc_pos] = np.minimum(path.feed[a], path.feed[a + 1])[per]

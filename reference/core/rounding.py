@@ -50,9 +50,18 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "rounding not parameterised (ADISPOS = 0)",                       # 9  5.2 group 3
     "rounding not parameterised (tolerance 0)",                       # 10 5.2 group 3
     "tangential transition",                                          # 11
-    "arc transition: rounding not modelled yet",                      # 12 model limit
+    "corner between two arcs: rounding not modelled yet",             # 12 model limit
     "non-geometry axes move: rounding not modelled yet",              # 13 model limit
     "G644 SMOOTHING_MODE digit not documented",                       # 14 6xxx..9xxx
+    # G645 at tangential transitions with a curvature jump (5.7, 6.3)
+    "curvature jump allowed under BRISK (acceleration step)",         # 15 6.3
+    "G64 passes the curvature jump without reduction",                # 16 5.7 [M], 5.8
+    "tangential transition between arcs: rounding not modelled yet",  # 17 model limit
+    "tangential transition into a helix or spiral: rounding not modelled yet",  # 18
+    # corners next to arcs (reference.rounding_arcs): model limits
+    "corner next to a helix or spiral, or out of the arc's plane: rounding not modelled "
+    "yet",                                                            # 19
+    "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet",  # 20
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
 
@@ -90,6 +99,12 @@ class RoundingTable:
         ``next_block`` unless the window reaches across short blocks (G642/G645), in
         which case the blocks strictly between ``first_block`` and ``block`` (and
         between ``next_block`` and ``last_block``) are covered by the rounding whole.
+    tangential : numpy.ndarray of bool, shape (k,)
+        The transition is tangential with a curvature jump (G645 at a line-arc
+        transition, :mod:`reference.core.transition`); for these ``distance_mm`` is the
+        length replaced of the line, ``deviation_mm`` the largest distance from the
+        programmed contour, ``radius_mm`` the arc's radius (the rounding's smallest),
+        ``v_g64`` the curvature-jump limit (6.3). Rounded ones have ``g2`` set.
     """
 
     block: np.ndarray
@@ -106,6 +121,7 @@ class RoundingTable:
     g2: np.ndarray
     first_block: np.ndarray
     last_block: np.ndarray
+    tangential: np.ndarray
 
     @property
     def n(self) -> int:
@@ -237,5 +253,179 @@ def fillet_pieces(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.ndar
     }
 
 
-__all__ = ["REASON_CODE", "ROUNDING_REASONS", "RoundingTable", "axis_deviation_limit",
-           "deflection_angle", "distance_for_deviation", "fillet_pieces"]
+@dataclass(frozen=True, slots=True, eq=False)
+class ArcFillet:
+    """Tangent arcs of radius ``r`` between a line and a circle, in the plane of the
+    circle, per corner (shape (k,) or (k, 2)); see :func:`line_circle_fillet`.
+
+    Attributes
+    ----------
+    valid : numpy.ndarray of bool
+        The fillet exists, leaves the line before the corner and meets the circle after
+        it, turning by less than pi.
+    line_trim, arc_trim : numpy.ndarray
+        Length of the line and arc length of the circle it replaces, mm.
+    centre, start, end : numpy.ndarray, shape (k, 2)
+        Its centre, its start on the line and its end on the circle (plane coordinates,
+        the corner at the origin), mm.
+    sweep : numpy.ndarray
+        Angle it turns, rad.
+    deviation : numpy.ndarray, shape (k, 2)
+        ``C - M``: the corner minus the fillet's point nearest to it, mm.
+    """
+
+    valid: np.ndarray
+    line_trim: np.ndarray
+    arc_trim: np.ndarray
+    centre: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    sweep: np.ndarray
+    deviation: np.ndarray
+
+
+def _cross2(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+
+
+def _perp(u: np.ndarray) -> np.ndarray:
+    return np.column_stack((-u[:, 1], u[:, 0]))
+
+
+def line_circle_fillet(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                       radius: np.ndarray, sense: np.ndarray) -> ArcFillet:
+    """The tangent arc of radius ``r`` rounding the corner between a line and a circle.
+
+    Plane coordinates (the circle's plane), the corner ``C`` at the origin: the line
+    ends at ``C`` with unit direction ``t``; the circle (centre ``c``, radius ``R``,
+    ``sense`` +1 counter-clockwise, -1 clockwise) starts at ``C``. The rounding turns
+    towards ``s = sign(t x t_c)`` (``t_c`` the circle's tangent at ``C``), so the fillet's
+    centre lies on the line offset by ``r`` to that side, ``O = x t + r n`` (``n = s
+    perp(t)``), and on the circle of radius ``rho`` about ``c``: ``R - r`` where the
+    fillet turns the way the circle does (inside it), ``R + r`` otherwise. ``|x t + w|
+    = rho`` with ``w = r n - c`` is a quadratic in ``x``; of its roots the one that
+    tends to 0 with ``r`` (``|c| = R``: the corner is on the circle) is taken, written
+    without cancellation as ``(|w|^2 - rho^2) / q`` with ``q = -(t.w) - sign(t.w)
+    sqrt(disc)``. The fillet leaves the line at ``x t`` (``x < 0``) and meets the circle
+    at ``c + R (O - c) / |O - c|``.
+
+    Parameters
+    ----------
+    r : numpy.ndarray, shape (k,)
+        Fillet radii, mm (> 0).
+    t, centre : numpy.ndarray, shape (k, 2)
+    radius, sense : numpy.ndarray, shape (k,)
+
+    Returns
+    -------
+    ArcFillet
+    """
+    tc = sense[:, None] * _perp(-centre) / radius[:, None]    # circle's tangent at C
+    s = np.sign(_cross2(t, tc))
+    n, iota = _corner_frame(t, centre, radius, sense)
+    rho = radius - iota * r
+    x, disc = _line_offset(r, t, n, iota, centre, radius)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        O = x[:, None] * t + r[:, None] * n
+        u = O - centre
+        u = u / row_norms(u)[:, None]
+        end = centre + radius[:, None] * u
+        # arc length from C to the end along the circle's sense
+        a0 = -centre
+        ang = sense * np.arctan2(_cross2(a0, end - centre), row_dots(a0, end - centre))
+        te = sense[:, None] * _perp(end - centre) / radius[:, None]
+        sweep = s * np.arctan2(_cross2(t, te), row_dots(t, te))
+        dc = -O                                               # C - O
+        near = O + r[:, None] * dc / row_norms(dc)[:, None]
+    valid = ((disc >= 0) & (x < 0) & (ang > 0) & (sweep > 0) & (rho > 0)
+             & np.isfinite(x) & (s != 0))
+    return ArcFillet(valid, -x, radius * ang, O, x[:, None] * t, end, sweep, -near)
+
+
+def _corner_frame(t: np.ndarray, centre: np.ndarray, radius: np.ndarray,
+                  sense: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` (unit normal of the line towards the fillet's centre) and ``iota`` (+1 where
+    the fillet lies inside the circle, -1 outside) of :func:`line_circle_fillet`."""
+    tc = sense[:, None] * _perp(-centre) / radius[:, None]
+    s = np.sign(_cross2(t, tc))
+    return s[:, None] * _perp(t), np.where(s == sense, 1.0, -1.0)
+
+
+def _line_offset(r: np.ndarray, t: np.ndarray, n: np.ndarray, iota: np.ndarray,
+                 centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where the fillet of radius ``r`` leaves the line (``x``, the root of
+    :func:`line_circle_fillet` that tends to 0 with ``r``) and the discriminant.
+
+    ``|x t + w|^2 = rho^2`` with ``w = r n - c``, ``rho = R - iota r``: ``x^2 + 2 (t.w) x +
+    |w|^2 - rho^2 = 0``, where ``|w|^2 - rho^2 = iota r R |iota n + u0|^2`` (``|c| = R``,
+    ``u0 = -c / R``: written so, without the cancellation of ``R^2``); the small root is
+    ``(|w|^2 - rho^2) / q``, ``q = -(t.w) - sign(t.w) sqrt(disc)``.
+    """
+    u0 = -centre / radius[:, None]
+    half = iota[:, None] * n + u0
+    c0 = iota * r * radius * row_dots(half, half)
+    tw = r * row_dots(t, n) - row_dots(t, centre)
+    disc = tw * tw - c0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q = -tw - np.where(tw >= 0, 1.0, -1.0) * np.sqrt(np.maximum(disc, 0.0))
+        return c0 / q, disc
+
+
+def fillet_radius_for_line_trim(trim: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                                radius: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`line_circle_fillet` that replaces ``trim`` of the
+    line, closed form, mm, shape (k,).
+
+    Its centre is ``O = P + r n`` with ``P = -trim t`` and ``|O - c| = R - iota r``;
+    squared, the ``r^2`` terms cancel: ``r = (R^2 - |P - c|^2) / (2 (n.(P - c) + iota R))``.
+    Written without cancellation (``|c| = R``, ``n.t = 0``, ``u0 = -c / R`` the radial
+    at ``C``): ``R^2 - |P - c|^2 = -trim (trim - 2 R t.u0)`` and ``n.(P - c) + iota R =
+    iota R |iota n + u0|^2 / 2``.
+    """
+    n, iota = _corner_frame(t, centre, radius, sense)
+    u0 = -centre / radius[:, None]
+    num = -trim * (trim - 2.0 * radius * row_dots(t, u0))
+    half = iota[:, None] * n + u0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return num / (iota * radius * row_dots(half, half))
+
+
+def fillet_radius_for_arc_trim(trim: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                               radius: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`line_circle_fillet` that replaces the arc length
+    ``trim`` of the circle, closed form, mm, shape (k,).
+
+    It touches the circle at ``T``, ``trim / R`` along the circle from ``C``, with its
+    centre ``O = c + (R - iota r) u`` (``u`` the unit radial at ``T``) at distance ``r``
+    from the line: ``n.O = r``, so ``r = n.T / (1 + iota n.u)``; without cancellation
+    ``n.T = R n.(u - u0)`` with ``u - u0 = -2 sin^2(a/2) u0 + sin(a) perp(u0)`` (``a``
+    the angle turned) and ``1 + iota n.u = |iota n + u|^2 / 2``.
+    """
+    n, iota = _corner_frame(t, centre, radius, sense)
+    a = sense * trim / radius
+    u0 = -centre / radius[:, None]                      # radial at C
+    du = (-2.0 * np.sin(a / 2.0) ** 2)[:, None] * u0 + np.sin(a)[:, None] * _perp(u0)
+    half = iota[:, None] * n + u0 + du
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 2.0 * radius * row_dots(n, du) / row_dots(half, half)
+
+
+def fillet_deviation(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                     radius: np.ndarray, sense: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``C - M`` of the fillets of radius ``r`` (:attr:`ArcFillet.deviation`), shape
+    (k, 2), and whether they exist with their start before the corner, shape (k,): the
+    cheap part of :func:`line_circle_fillet` for a search over ``r``."""
+    n, iota = _corner_frame(t, centre, radius, sense)
+    rho = radius - iota * r
+    x, disc = _line_offset(r, t, n, iota, centre, radius)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        O = x[:, None] * t + r[:, None] * n
+        dist = row_norms(O)
+        dev = -O * (1.0 - r / dist)[:, None]
+    return dev, (disc >= 0) & (x < 0) & (rho > 0) & np.isfinite(x)
+
+
+__all__ = ["ArcFillet", "REASON_CODE", "ROUNDING_REASONS", "RoundingTable",
+           "axis_deviation_limit", "deflection_angle", "distance_for_deviation",
+           "fillet_deviation", "fillet_pieces", "fillet_radius_for_arc_trim",
+           "fillet_radius_for_line_trim", "line_circle_fillet"]

@@ -29,9 +29,17 @@ PROGRAMS = {
     "g645_soft_zigzag": "G90 G645 CTOL=0.05 SOFT F4000\nG1 X0 Y0\nX20 Y4\nX40 Y0\nX60 Y4\n"
                         "X80 Y0\nM30\n",
     "g641_soft_adis": "G90 G641 ADIS=1 SOFT F5000\nG1 X0 Y0\nX25\nX50 Y8\nX75 Y8 Z-3\nM30\n",
+    # G645 at tangential line-arc transitions (spec 5.7; rounded where the curvature
+    # jump slows G64: on the default machine) and a corner (a clothoid pair)
+    # corners next to arcs: tangent fillets (G641 ADIS, RND)
+    "g641_line_arc_corner": "G90 G641 ADIS=0.5 BRISK F3000\nG1 X0 Y0\nX20\nG2 X30 Y0 I5 J0\n"
+                            "G1 X30 Y-20\nG3 X40 Y-20 I5 J0\nG1 X40 Y10 RND=1\n"
+                            "G2 X50 Y10 I5 J0\nG1 X60 Y5\nM30\n",
+    "g645_soft_line_arc": "G90 G645 CTOL=0.05 SOFT F6000\nG1 X0 Y0\nX20\nG3 X30 Y10 I0 J10\n"
+                          "G1 Y30\nX31 Y50\nM30\n",
 }
 #: Programs whose roundings are clothoid pairs on every bundled machine (checked below).
-G2 = ("g642_soft_shallow", "g645_soft_zigzag", "g641_soft_adis")
+G2 = ("g642_soft_shallow", "g645_soft_zigzag", "g641_soft_adis", "g645_soft_line_arc")
 
 
 @pytest.mark.parametrize("machine", sorted(MACHINES))
@@ -53,10 +61,19 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
     assert lb <= ub <= lb * (1 + 2e-3) + 1e-12
     assert not ref["violations"], ref["violations"]
     assert t_ref >= lb
+    if name == "g641_line_arc_corner":      # fillets at corners next to arcs inserted
+        t = build_path(parse_file(prog), load_machine(str(mfile))).rounding
+        assert int(np.sum(t.inserted & ~t.tangential)) >= 2
     if name in G2:
         path = build_path(parse_file(prog), load_machine(str(mfile)))
-        assert path.rounding.g2[path.rounding.inserted].all()
-        assert np.count_nonzero(path.sharpness) == 2 * int(path.rounding.inserted.sum()) > 0
+        t = path.rounding
+        assert t.g2[t.inserted].all()
+        # two clothoid pieces per corner, five per G645 tangential transition
+        n_pieces = 2 * int(np.sum(t.inserted & ~t.tangential)) + 5 * int(
+            np.sum(t.inserted & t.tangential))
+        assert np.count_nonzero(path.sharpness) == n_pieces > 0
+        if name == "g645_soft_line_arc" and machine == "default":
+            assert int(np.sum(t.inserted & t.tangential)) == 2
 
 
 def test_inspect_lists_the_rounding_per_corner_and_why_none(tmp_path: Path, capsys) -> None:

@@ -17,3 +17,36 @@ def polyline(n: int, seed: int) -> str:
         y += step * np.sin(heading)
         out.append(f"X{x:.4f} Y{y:.4f}")
     return "\n".join(out) + "\nM30\n"
+
+
+
+def line_arc_chain(n: int, seed: int, kink_deg: float = 0.0) -> str:
+    """``n`` seeded blocks alternating a line of 1..5 mm and an arc tangent to it (radius
+    1..20 mm, turning 10..120 degrees, either way), each line tangent to the arc before
+    it: a CAM-like contour of tangential line-arc transitions (body only, ``G1``/``G2``/
+    ``G3`` words with the centre as ``I J``, 12 decimals so that the transitions are
+    tangential to far below the planner's 1e-7 rad, then ``M30``). With ``kink_deg > 0``
+    each line leaves its arc at a corner of ``kink_deg/2 .. kink_deg`` degrees, either
+    way (arc-line corners; the arcs still start tangent to their lines)."""
+    rng = np.random.default_rng(seed)
+    heading, x, y, out = 0.0, 0.0, 0.0, []
+    for i in range(n):
+        if i % 2 == 0:
+            if kink_deg > 0 and i:
+                heading += (np.radians(rng.uniform(kink_deg / 2, kink_deg))
+                            * rng.choice((-1.0, 1.0)))
+            step = rng.uniform(1.0, 5.0)
+            x += step * np.cos(heading)
+            y += step * np.sin(heading)
+            out.append(f"G1 X{x:.12f} Y{y:.12f}")
+            continue
+        r = rng.uniform(1.0, 20.0)
+        turn = np.radians(rng.uniform(10.0, 120.0)) * rng.choice((-1.0, 1.0))
+        side = np.sign(turn)                        # +1: counter-clockwise (G3)
+        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
+        i_, j_ = cx - x, cy - y
+        heading += turn
+        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
+        word = "G3" if side > 0 else "G2"
+        out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
+    return "\n".join(out) + "\nM30\n"

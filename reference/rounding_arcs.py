@@ -1,0 +1,440 @@
+"""Corner rounding, part: corners between a line and a circular arc (G641..G645, RND/RNDM).
+
+The rounding of a corner next to an arc is the tangent arc of radius ``r`` between the
+line and the circle (:func:`reference.core.rounding.line_circle_fillet`, exact closed
+form for a given ``r``): "RND inserts a tangent circle" and the rounding "replaces the
+area near the original angular transition" (5.1). The arc is shortened by the arc
+length the fillet replaces (its start angle moves, so it stays the exact arc), the line
+by its tangent length; both lengths differ, unlike at a line-line corner.
+
+The radius by mode is the largest ``r`` that keeps every limit of the mode, found by
+bisection on ``log r`` (the trims, the deviation and ``r`` itself grow with ``r`` on the
+branch that shrinks to the corner; past that branch the fillet does not exist and the
+limit counts as broken):
+
+* RND/RNDM: ``r <= R_prog`` (the programmed radius exactly where nothing else limits);
+* G641 / ADIS digits: both trims ``<= ADIS`` (ADISPOS for G0, 5.3: "the earliest point
+  before the block end where rounding may start, and the latest point after it");
+* tolerance modes (G642, G643, G645 at corners, G644 0xxx/4xxx): per axis
+  ``|C_i - M_i| <= tol_i`` and ``|C - M| <=`` the contour tolerance where one applies
+  (``M`` the fillet's point nearest the corner ``C``, as at line-line corners), G0
+  tolerances times MD20560;
+* the block-length clamp on both sides (``c`` times the line, ``c`` times the arc's
+  length, 5.3).
+
+Model limits, named: the fillet is G1 (curvature jumps at its ends; under SOFT the
+curvature-jump rule of 6.3 caps the speed there, as it does for a BRISK-shaped
+rounding), where the line-line corners get a clothoid pair under SOFT; corners between
+two arcs, next to a helix or spiral, or whose line leaves the arc's plane, and G644's
+dynamic digits (2xxx, 3xxx) at arc corners are passed as under G64.
+
+Speeds as at line-line corners (:mod:`reference.rounding`): G641/G642/G645 round only
+where G64 must slow down (overload factor, 4.3); every mode but RND/RNDM only where the
+corner's time estimate favours the rounding (5.2 group 2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize.elementwise import find_root
+
+from .core.arrays import row_dots, row_min, row_norms
+from .core.geometry import KIND_CODES, Path
+from .core.limits import AxisArrays
+from .core.rounding import (REASON_CODE, ArcFillet, fillet_deviation,
+                            fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
+                            line_circle_fillet)
+from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
+from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
+from .machine import Machine
+
+_LINE = KIND_CODES.index("line")
+_ARC = KIND_CODES.index("arc")
+_ROUNDING = KIND_CODES.index("rounding")
+
+#: A line counts as lying in its arc's plane when its direction leaves the plane by at
+#: most this (the sine of the angle): the fillet is built in the plane and starts on the
+#: line's projection, at most ``OFF_PLANE_MAX`` times the replaced length (at most half
+#: the block) off the line, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
+OFF_PLANE_MAX = 1e-9
+
+#: Fillet radii are searched in ``[R_MIN_MM, R_MAX_MM]`` (log scale): below a nanometre
+#: a rounding is "too small" anyway (MIN_SEGMENT_LENGTH_MM), above 10 m no clamp of a
+#: real block lets a fillet through.
+R_MIN_MM = 1e-9
+R_MAX_MM = 1e7
+#: Absolute tolerance of the root in ``log r`` (tolerance modes): a relative error in
+#: ``r``, so in the deviation used, of 1e-11 (the radius kept lies up to two of these
+#: inside the tolerance).
+ROOT_XATOL = 1e-11
+#: Secant steps in ``log r`` before the bracketed search (tolerance modes).
+SECANT_STEPS = 5
+#: ``log`` of the tolerance ratio where the fillet does not exist (larger radii): far
+#: above 0, so the root search stays below it.
+NO_FILLET_LOG_RATIO = 50.0
+#: The closed-form radii of the clamp and of ADIS are shrunk by this (relative), so that
+#: round-off cannot put a replaced length above its limit: the closed forms and the
+#: fillet they invert agree to 2.6e-12 (relative, 2000 seeded corners down to 0.005
+#: degrees, tests/reference/test_rounding_arcs.py); 40 times that.
+CLOSED_FORM_MARGIN = 1e-10
+
+#: How each corner's limit is found (the codes of :func:`reference.rounding._distances`).
+HOW_NONE, HOW_ADIS, HOW_TOL, HOW_RADIUS, HOW_FREQ, HOW_DYN = 0, 1, 2, 3, 4, 5
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ArcCorners:
+    """Decisions at corners next to arcs, shape (k,) each.
+
+    Attributes
+    ----------
+    reason : numpy.ndarray of int
+        :data:`reference.core.rounding.ROUNDING_REASONS` code (0 = rounded).
+    trim_in, trim_out : numpy.ndarray
+        Length replaced of the segment before and after, mm (0 where none).
+    radius, length, deviation : numpy.ndarray
+        Fillet radius, its length, ``|C - M|``, mm (0 where none).
+    clamped : numpy.ndarray of bool
+        The block-length clamp decided the radius.
+    v_g64, v_round : numpy.ndarray
+        Corner speed under G64 and through the fillet, mm/s (``nan``: not evaluated).
+    rows : dict
+        Packed rows of the inserted fillets (one each), in corner order.
+    """
+
+    reason: np.ndarray
+    trim_in: np.ndarray
+    trim_out: np.ndarray
+    radius: np.ndarray
+    length: np.ndarray
+    deviation: np.ndarray
+    clamped: np.ndarray
+    v_g64: np.ndarray
+    v_round: np.ndarray
+    rows: dict
+
+
+def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
+                mode: np.ndarray, t1: np.ndarray, t2: np.ndarray, targets: dict,
+                accel: np.ndarray, centripetal_share: float, jerk_share: float,
+                time_loss) -> ArcCorners:
+    """Decide and size the rounding of corners after segments ``a`` (one of ``a``,
+    ``a + 1`` an arc, the corner not tangential).
+
+    Parameters
+    ----------
+    path : Path
+    machine : Machine
+    a, ka : numpy.ndarray of int, shape (k,)
+        Segment before each corner and its block.
+    mode : numpy.ndarray of str, shape (k,)
+        Mode governing each corner (``"G641"`` .. ``"G645"``, ``"RND"``, ``"RNDM"``).
+    t1, t2 : numpy.ndarray, shape (k, n)
+        Tangents at the corner.
+    targets : dict
+        Per corner, from :func:`reference.rounding._distances`: ``how`` (HOW_ codes),
+        ``dist`` (ADIS/ADISPOS, mm), ``contour`` (contour tolerance, mm, ``inf``: none),
+        ``axis_tol`` (per-axis tolerance, shape (k, n), mm, ``inf``: none), ``g0``
+        (tolerance factor), ``radius`` (programmed radius, mm).
+    accel : numpy.ndarray of str, shape (k,)
+    centripetal_share, jerk_share : float
+        The corner rounding's shares of the axis acceleration and jerk.
+    time_loss : callable
+        :func:`reference.rounding.corner_time_loss`.
+
+    Returns
+    -------
+    ArcCorners
+    """
+    k = a.size
+    b = a + 1
+    reason = np.full(k, -1, dtype=np.int64)
+
+    def decide(mask: np.ndarray, why: str) -> None:
+        reason[(reason < 0) & mask] = REASON_CODE[why]
+
+    kind_a, kind_b = path.kind[a], path.kind[b]
+    line_arc = (kind_a == _LINE) & (kind_b == _ARC)
+    arc_line = (kind_a == _ARC) & (kind_b == _LINE)
+    decide(~(line_arc | arc_line), "corner between two arcs: rounding not modelled yet")
+    arc = np.where(line_arc, b, a)
+    line = np.where(line_arc, a, b)
+    E1, E2 = path.e1.take(arc, axis=0), path.e2.take(arc, axis=0)
+    t_line = path.d.take(line, axis=0)
+    # the line in the arc's plane (OFF_PLANE_MAX)
+    off = row_norms(t_line - row_dots(t_line, E1)[:, None] * E1
+                    - row_dots(t_line, E2)[:, None] * E2)
+    circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
+              & ~(np.abs(path.d.take(arc, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+    decide(~circle | ~(off <= OFF_PLANE_MAX),
+           "corner next to a helix or spiral, or out of the arc's plane: rounding not "
+           "modelled yet")
+    how = targets["how"]
+    decide((how == HOW_FREQ) | (how == HOW_DYN),
+           "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet")
+
+    # plane coordinates: the corner at the origin, the construction traversed from the
+    # line into the arc (arc into line: backwards)
+    R = path.radius[arc]
+    w = path.omega[arc]
+    at = np.where(line_arc, 0.0, path.length[arc])
+    phi = path.theta0[arc] + w * at
+    radial = np.column_stack((np.cos(phi), np.sin(phi)))      # plane coords
+    corner = path.origin.take(arc, axis=0) + R[:, None] * (
+        E1 * radial[:, :1] + E2 * radial[:, 1:])
+    t2d = np.column_stack((row_dots(t_line, E1), row_dots(t_line, E2)))
+    t2d /= np.where(row_norms(t2d) > 0, row_norms(t2d), 1.0)[:, None]
+    t2d = np.where(line_arc[:, None], t2d, -t2d)
+    centre = -R[:, None] * radial
+    sense = np.where(line_arc, np.sign(w), -np.sign(w))
+    c = machine.channel.rounding_length_clamp
+    cap_line = c * path.length[line]
+    cap_arc = c * path.length[arc]
+
+    v_g64 = np.full(k, np.nan)
+    v_round = np.full(k, np.nan)
+    r = np.zeros(k)
+    fil = None
+    o = np.flatnonzero(reason < 0)
+    clamped = np.zeros(k, bool)
+    if o.size:
+        tol = targets["axis_tol"][o]
+        cont = targets["contour"][o]
+        g0 = targets["g0"][o]
+        dist = targets["dist"][o]
+        rad = targets["radius"][o]
+        ho = how[o]
+        E1o, E2o = E1[o], E2[o]
+
+        geo = (t2d[o], centre[o], R[o], sense[o])
+        # the replaced lengths grow with r: the largest r within a length on each side
+        # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
+        # round-off of the closed form cannot put a trim above its limit
+        with np.errstate(invalid="ignore"):
+            r_cap = np.fmin(_positive(fillet_radius_for_line_trim(cap_line[o], *geo)),
+                            _positive(fillet_radius_for_arc_trim(cap_arc[o], *geo)))
+            r_adis = np.fmin(_positive(fillet_radius_for_line_trim(dist, *geo)),
+                             _positive(fillet_radius_for_arc_trim(dist, *geo)))
+        r_cap *= 1.0 - CLOSED_FORM_MARGIN
+        r_adis *= 1.0 - CLOSED_FORM_MARGIN
+        ro = np.select([ho == HOW_ADIS, ho == HOW_RADIUS], [r_adis, rad], np.inf)
+        ro = np.fmin(ro, r_cap)
+        # tolerances: the root of log(ratio) in log r below the clamp (the deviation
+        # grows with r), bracketed (Chandrupatla's method, scipy)
+        tl = np.flatnonzero(ho == HOW_TOL)
+        if tl.size:
+            n_ax = E1o.shape[1]
+            cols = (*geo[0][tl].T, *geo[1][tl].T, geo[2][tl], geo[3][tl], *E1o[tl].T,
+                    *E2o[tl].T, *(tol[tl] * g0[tl, None]).T, cont[tl] * g0[tl])
+            hi = np.log(np.where(np.isfinite(r_cap[tl]), r_cap[tl], R_MAX_MM))
+            lo = np.full(tl.size, np.log(R_MIN_MM))
+            f_hi = _log_tol_ratio(hi, *cols, n_axes=n_ax)
+            top = f_hi <= 0.0
+            ro[tl] = np.where(top, r_cap[tl], 0.0)
+            # the deviation grows about like r, so f = log(ratio) is nearly linear in
+            # log r: secant steps from hi and hi - f(hi) reach the root to round-off in
+            # a few steps; kept where they end inside the tolerance and within
+            # ROOT_XATOL of the root (f in [-ROOT_XATOL, 0]), the others go to the
+            # bracketed search below
+            ok = np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top
+            x0, f0 = hi, np.where(ok, f_hi, 1.0)
+            x = np.where(ok, hi - f0, hi)
+            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
+            for _ in range(SECANT_STEPS):
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    slope = (f_x - f0) / (x - x0)
+                move = ok & np.isfinite(slope) & (slope > 0) & (f_x != 0.0)
+                x0, f0 = x, f_x
+                x = np.where(move, np.minimum(x - f_x / np.where(move, slope, 1.0), hi), x)
+                f_x = np.where(move, _log_tol_ratio(x, *cols, n_axes=n_ax), f_x)
+            # half ROOT_XATOL inside the tolerance: r = exp(x) and log(r) differ by
+            # round-off, which must not carry the kept radius across the limit
+            x = x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0
+            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
+            done = ok & (f_x <= 0.0) & (f_x >= -2.0 * ROOT_XATOL)
+            ro[tl[done]] = np.exp(x[done])
+            sol = np.flatnonzero(~top & ~done & (_log_tol_ratio(lo, *cols, n_axes=n_ax) < 0.0))
+            if sol.size:
+                res = find_root(lambda x, *c: _log_tol_ratio(x, *c, n_axes=n_ax),
+                                (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
+                                tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
+                # the bracket's lower end keeps f <= 0: within the tolerance (half
+                # ROOT_XATOL further inside, as above)
+                ro[tl[sol]] = np.exp(res.bracket[0] - ROOT_XATOL / 2.0)
+        ro = np.where(np.isfinite(ro), ro, 0.0)
+        clamped[o] = ro >= r_cap
+        fil = line_circle_fillet(np.where(ro > 0, ro, 1.0), *geo)
+        r[o] = ro
+        length = ro * fil.sweep
+        # the closed forms assume the branch that shrinks to the corner: the fillet
+        # found must exist and keep both lengths
+        keeps = ((fil.line_trim <= cap_line[o]) & (fil.arc_trim <= cap_arc[o])
+                 & ((ho != HOW_ADIS) | (np.maximum(fil.line_trim, fil.arc_trim) <= dist)))
+        if tl.size:
+            keeps[tl] &= _log_tol_ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *cols,
+                                        n_axes=n_ax) <= 0.0
+        sub = np.zeros(k, bool)
+        sub[o] = (~keeps | ~fil.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
+                  | ~(ro > R_MIN_MM * 2))
+        decide(sub, "rounding distance too small")
+
+    o2 = np.flatnonzero(reason < 0)
+    lim = machine.limits.for_axes(path.axes)
+    t_ipo = machine.limits.t_ipo_s
+    sel = np.searchsorted(o, o2) if o.size else np.zeros(0, np.int64)
+    if o2.size:
+        f = _take(fil, sel)
+        ro = r[o2]
+        E1o, E2o = E1[o2], E2[o2]
+        rho = np.sqrt(E1o ** 2 + E2o ** 2)             # each axis' weight in the plane
+        moving = rho > 0
+        wr = np.where(moving, rho, 1.0)
+        v_g64[o2] = junction_speed_cap(t1[o2], t2[o2], lim.jump, FEASIBLE)[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            v_axis = np.minimum(row_min(lim.v_max[None, :] / np.abs(t1[o2])),
+                                row_min(lim.v_max[None, :] / np.abs(t2[o2])))
+            v_prog = np.minimum(np.minimum(path.feed[a[o2]], path.feed[b[o2]]), v_axis)
+            v_c = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
+                                                   * ro[:, None] / wr), np.inf))
+            v_j = row_min(np.where(moving, np.cbrt(jerk_share * lim.j_max[None, :]
+                                                   * (ro * ro)[:, None] / wr), np.inf))
+            Ra = R[o2]
+            v_arc = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
+                                                     * Ra[:, None] / wr), np.inf))
+            v_arc = np.where(accel[o2] == "SOFT", np.minimum(v_arc, row_min(np.where(
+                moving, np.cbrt(jerk_share * lim.j_max[None, :] * (Ra * Ra)[:, None] / wr),
+                np.inf))), v_arc)
+        length = ro * f.sweep
+        soft = accel[o2] == "SOFT"
+        # centripetal, one IPO cycle per inserted block (5.3), the feed; under SOFT the
+        # path jerk on the fillet (third path derivative 1/r^2) and the curvature jumps
+        # at its ends
+        vr = np.minimum(np.minimum(v_prog, v_c), length / t_ipo)
+        if soft.any():
+            vr = np.where(soft, np.minimum(vr, v_j), vr)
+            # 6.3: the fillet's curvature vector jumps from the line's 0 at one end and
+            # to the arc's at the other (q'' = (centre - P) / radius^2)
+            def world(v2):
+                return E1o * v2[:, :1] + E2o * v2[:, 1:]
+            k_fs = world((f.centre - f.start) / (ro * ro)[:, None])
+            k_fe = world((f.centre - f.end) / (ro * ro)[:, None])
+            k_ae = world((centre[o2] - f.end) / (Ra * Ra)[:, None])
+            zero = np.zeros_like(k_fs)
+            v_k = np.minimum(
+                curvature_jump_speed_cap(zero, k_fs, lim.path_trans_jerk, t_ipo),
+                curvature_jump_speed_cap(k_fe, k_ae, lim.path_trans_jerk, t_ipo))
+            vr = np.where(soft, np.minimum(vr, v_k), vr)
+        v_round[o2] = vr
+        sub = np.zeros(k, bool)
+        ovl = np.isin(mode[o2], ("G641", "G642", "G645")) & (
+            not machine.channel.ignore_ovl_factor_for_adis)
+        sub[o2] = ovl & (v_g64[o2] >= v_prog)
+        decide(sub, "G64 passes the corner without reduction (overload factor)")
+        # the time estimate of the line-line corners, each side ramping to its own
+        # speed (an arc side to its own limit), the fillet passed at v_round
+        la = line_arc[o2]
+        v_line = v_prog
+        v_in = np.where(la, v_line, np.minimum(v_line, v_arc))
+        v_out = np.where(la, np.minimum(v_line, v_arc), v_line)
+        with np.errstate(divide="ignore"):
+            acc_in = row_min(lim.a_max[None, :] / np.abs(t1[o2]))
+            acc_out = row_min(lim.a_max[None, :] / np.abs(t2[o2]))
+            j_in = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t1[o2])), np.inf)
+            j_out = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t2[o2])), np.inf)
+        cut_in = np.where(la, f.line_trim, f.arc_trim)
+        cut_out = np.where(la, f.arc_trim, f.line_trim)
+        radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
+        sub[:] = False
+        sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
+                              cut_in, cut_out)
+                    < time_loss(v_in, v_out, v_g64[o2], acc_in, acc_out, j_in, j_out,
+                                0.0, 0.0)) & ~radius_mode
+        decide(sub, "rounding would be slower than G64")
+
+    reason[reason < 0] = REASON_CODE["rounded"]
+    ins = np.flatnonzero(reason == 0)
+    trim_in = np.zeros(k)
+    trim_out = np.zeros(k)
+    radius_out = np.zeros(k)
+    length_out = np.zeros(k)
+    dev_out = np.zeros(k)
+    rows = {}
+    if ins.size:
+        f = _take(fil, np.searchsorted(o, ins))
+        la = line_arc[ins]
+        trim_in[ins] = np.where(la, f.line_trim, f.arc_trim)
+        trim_out[ins] = np.where(la, f.arc_trim, f.line_trim)
+        radius_out[ins] = r[ins]
+        length_out[ins] = r[ins] * f.sweep
+        dev_out[ins] = row_norms(f.deviation)
+        rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], la, ka[ins])
+    return ArcCorners(reason, trim_in, trim_out, radius_out, length_out, dev_out,
+                      clamped & (reason == 0), v_g64, v_round, rows)
+
+
+def _log_tol_ratio(x: np.ndarray, tx, ty, cx, cy, radius, sense, *rest,
+                   n_axes: int) -> np.ndarray:
+    """``log`` of the largest tolerance ratio of the fillets of radius ``exp(x)`` (per
+    axis ``|C_i - M_i| / tol_i``, contour ``|C - M| / tol``), elementwise over 1-d
+    columns (:func:`scipy.optimize.elementwise.find_root` passes the active ones);
+    :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist."""
+    e1 = np.stack(rest[:n_axes], axis=1)
+    e2 = np.stack(rest[n_axes:2 * n_axes], axis=1)
+    tol = np.stack(rest[2 * n_axes:3 * n_axes], axis=1)
+    cont = rest[3 * n_axes]
+    dev2, ok = fillet_deviation(np.exp(x), np.column_stack((tx, ty)),
+                                np.column_stack((cx, cy)), radius, sense)
+    dev = e1 * dev2[:, :1] + e2 * dev2[:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.maximum(row_norms(dev) / cont, row_max_safe(np.abs(dev) / tol))
+        return np.where(ok, np.log(np.maximum(ratio, 1e-300)), NO_FILLET_LOG_RATIO)
+
+
+def _positive(r: np.ndarray) -> np.ndarray:
+    """Radii from the closed forms, ``inf`` where there is none (not positive, ``nan``:
+    that length never limits)."""
+    return np.where(r > 0, r, np.inf)
+
+
+def row_max_safe(x: np.ndarray) -> np.ndarray:
+    """Row maxima of (k, n) ratios, ``nan`` (0/0 on a standing axis) counted as 0."""
+    return np.max(np.where(np.isnan(x), 0.0, x), axis=1) if x.shape[1] else np.zeros(
+        x.shape[0])
+
+
+def _take(f: ArcFillet, i: np.ndarray) -> ArcFillet:
+    return ArcFillet(*(getattr(f, name)[i] for name in ArcFillet.__slots__))
+
+
+def _fillet_rows(corner: np.ndarray, E1: np.ndarray, E2: np.ndarray, f: ArcFillet,
+                 r: np.ndarray, forward: np.ndarray, block: np.ndarray) -> dict:
+    """Packed rows of the fillets (one circle each, ``d = 0``): ``e1`` the unit radial
+    at the construction's start, ``e2`` its direction of travel there, ``omega = 1/r``;
+    an arc-into-line fillet is that circle traversed backwards (``theta0 = sweep``,
+    ``omega = -1/r``)."""
+    def world(v2):
+        return E1 * v2[:, :1] + E2 * v2[:, 1:]
+
+    k = r.size
+    start_dir = f.start / np.where(row_norms(f.start) > 0, row_norms(f.start), 1.0)[:, None]
+    # direction of travel at the construction's start: along the line towards the
+    # corner, i.e. -start / |start| (the start is at x t with x < 0)
+    return {
+        "origin": corner + world(f.centre),
+        "e1": world((f.start - f.centre) / r[:, None]),
+        "e2": world(-start_dir),
+        "d": np.zeros_like(corner),
+        "radius": r.copy(),
+        "omega": np.where(forward, 1.0, -1.0) / r,
+        "theta0": np.where(forward, 0.0, f.sweep),
+        "length": r * f.sweep,
+        "block": np.asarray(block, np.int64),
+        "kind": np.full(k, _ROUNDING, dtype=np.int8),
+        "dradius": np.zeros(k),
+        "sharpness": np.zeros(k),
+    }
+
+
+__all__ = ["ArcCorners", "arc_corners"]
