@@ -141,8 +141,10 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     prof_h = with_holds(best.profile, path, holds)
     freq_decides = best.name.startswith("fir") or best.time_scale > 1.0
     active = (("frequency",) * len(jerk.active)) if freq_decides else jerk.active
-    causes = [("frequency" if freq_decides and b.n_segments > 0 else r.cause)
-              for b, r in zip(path.blocks, jerk.blocks)] if jerk.blocks else []
+    jerk_cause = [r.cause for r in jerk.blocks] if len(jerk.blocks) == len(path.blocks) \
+        else ["none" if b.n_segments > 0 else b.stop_reason for b in path.blocks]
+    causes = [("frequency" if freq_decides and b.n_segments > 0 else c_)
+              for b, c_ in zip(path.blocks, jerk_cause)]
     hold = None
     if path.blocks:
         idx = np.array([b.block for b in path.blocks], dtype=np.int64)
