@@ -292,6 +292,7 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
     corners = _corners(path)
     lines = program_lines
     split = _split_inserted(path, limits, ref_prof, opt_prof, jerk_ref, jerk_opt)
+    row_lb = _row_lower_bounds(path, oracle.segment_lower_bounds_s)
     decided = path.rounding.decision_by_block() if path.rounding is not None else {}
     rows = []
     for i, sp in enumerate(spans):
@@ -327,7 +328,8 @@ def compare_profiles(path: Path, limits: MachineLimits, reference: Side,
                 source=src.strip(), corner=corn, s_start=s_start,
                 ratio_reference=float(r_ref[i]), ratio_oracle=float(r_opt[i]),
                 stop_reason=stop, note=note, hold_cause=hold_cause if hld > 0 else "",
-                rounding=decided.get(sp.block, "") if corn is None else ""))
+                rounding=decided.get(sp.block, "") if corn is None else "",
+                lb_oracle_s=hld + row_lb(s_start, length)))
 
     all_notes = list(notes)
     if not set(BOUND_SETS[reference.bound_set]) <= set(BOUND_SETS.get(oracle.bounds, ())):
@@ -384,6 +386,23 @@ def _check_certificate(path: Path, profile: Profile, report: ConstraintReport,
             f"lower bound {lb:.9g} s")
 
 
+def _row_lower_bounds(path: Path, seg_lb: np.ndarray | None):
+    """``f(s_start, length)``: the sum of the per-segment lower bounds ``seg_lb`` (s) over
+    the segments whose middle lies in the row's span ``[s_start, s_start + length]``
+    (rows are unions of whole segments); ``nan`` without per-segment bounds."""
+    if seg_lb is None or len(seg_lb) != path.n_segments:
+        return lambda s0, length: math.nan
+    mid = path.s_breaks[:-1] + 0.5 * path.length
+    cum = np.concatenate(([0.0], np.cumsum(np.asarray(seg_lb, dtype=np.float64))))
+
+    def f(s0: float, length: float) -> float:
+        if not (length > 0):
+            return 0.0
+        lo, hi = np.searchsorted(mid, [s0, s0 + length])
+        return float(cum[hi] - cum[lo])
+    return f
+
+
 def _block_cause(label: str, span: BlockSpan | None = None) -> str:
     """A block's limit label in the shared vocabulary (see
     :func:`reference.core.causes.normalise_cause`)."""
@@ -399,7 +418,8 @@ def oracle_result(solution: OptimalSolution, bounds: str = "acc") -> OracleResul
                         upper_bound_s=float(solution.upper_bound_s), bounds=bounds,
                         solve_time_s=float(solution.total_time_s),
                         grid_points=int(solution.grid_points), causes=causes or None,
-                        holds=solution.holds)
+                        holds=solution.holds,
+                        segment_lower_bounds_s=solution.segment_lower_bounds_s)
 
 
 def reference_side(plan: ReferencePlan) -> Side:

@@ -33,7 +33,7 @@ __all__ = ["CSV_COLUMNS", "JSON_INF", "blocks_csv", "comparison_dict", "dumps", 
 
 #: Block-row columns of the CSV report, in order.
 CSV_COLUMNS = ("block", "line", "label", "kind", "corner", "length_mm", "t_reference_s",
-               "t_oracle_s", "hold_s", "hold_cause", "gap_s", "gap_rel", "v_entry_reference", "v_exit_reference",
+               "t_oracle_s", "lb_oracle_s", "hold_s", "hold_cause", "gap_s", "gap_rel", "v_entry_reference", "v_exit_reference",
                "v_peak_reference", "v_entry_oracle", "v_exit_oracle", "v_peak_oracle",
                "limit_reference", "limit_oracle", "ratio_reference", "ratio_oracle",
                "stop_reason", "rounding", "note", "source")
@@ -73,6 +73,8 @@ def _row_dict(r: ComparedBlock) -> dict:
         d["note"] = r.note
     if r.rounding:
         d["rounding"] = r.rounding
+    if math.isfinite(r.lb_oracle_s):
+        d["lb_oracle_s"] = r.lb_oracle_s
     return d
 
 

@@ -85,6 +85,9 @@ class OracleResult:
         Active constraint per block as the oracle reports it.
     holds : Holds
         The imposed holds contained in ``profile`` and in both bounds.
+    segment_lower_bounds_s : numpy.ndarray, shape (m,), optional
+        Certified per-segment lower bounds of the motion time, s (where the method
+        gives them: ``jerk``).
     """
 
     status: str
@@ -96,6 +99,7 @@ class OracleResult:
     grid_points: int = 0
     causes: Mapping[int, str] | None = None
     holds: Holds = NO_HOLDS
+    segment_lower_bounds_s: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,6 +134,10 @@ class ComparedBlock:
         ``"rounded"`` or ``"none: <reason>"``, the rounding stage's decision
         (:meth:`reference.core.rounding.RoundingTable.decision_by_block`); ``""``
         otherwise and on inserted rows.
+    lb_oracle_s : float
+        Certified lower bound of the row's time, s (its hold plus the oracle's
+        per-segment lower bounds of the segments in the row); ``nan`` where the oracle
+        gives none. The planner's time is never below it.
 
     The flat names of the JSON and CSV contract (``t_reference_s``, ``v_exit_oracle``,
     ``limit_reference``, ``hold_s``, ...) are properties reading the two rows.
@@ -146,6 +154,7 @@ class ComparedBlock:
     note: str = ""
     hold_cause: str = ""
     rounding: str = ""
+    lb_oracle_s: float = math.nan
 
     # identity and the contract's flat names
     block = property(lambda self: self.reference.block, doc="Block index.")

@@ -261,7 +261,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
           backend_options: Mapping[str, object] | None = None,
           max_grid: int = DEFAULT_MAX_GRID, max_iterations: int = DEFAULT_MAX_ITERATIONS,
           initial_intervals: int | None = None,
-          progress: ProgressFn | None = None, holds: Holds | None = None) -> OptimalSolution:
+          progress: ProgressFn | None = None, holds: Holds | None = None,
+          nlp_backend: str = "ipopt") -> OptimalSolution:
     """Minimum-time motion along ``path`` with a certified lower and a verified upper bound.
 
     The imposed holds (dwell, exact-stop settle) are no planning decision: the motion is
@@ -309,6 +310,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         The imposed holds (:func:`reference.holds.imposed_holds`, the same the heuristic
         was given). Default: the dwells of ``path.blocks`` only (no machine data here to
         compute exact-stop settle times).
+    nlp_backend : {"ipopt", "scp"}
+        ``bounds="jerk"`` only: the solver of the upper bound's NLP
+        (:mod:`optimal.jerk.backends`; ``backend`` is the inner ``acc`` solve's).
 
     Returns
     -------
@@ -354,13 +358,18 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
                           tol=tol,
                           holds=holds, progress=progress)
     if bounds == "jerk":
+        from .jerk.backends import NLP_BACKENDS
+        if nlp_backend not in NLP_BACKENDS:
+            raise ValueError(f"nlp_backend = {nlp_backend!r}: unknown "
+                             f"(known: {', '.join(NLP_BACKENDS)})")
         # the jerk oracle (optimal.jerk) runs this acc oracle inside, given as a function
         from .jerk import solve_jerk
         # (backend, its options and the grid limits apply to that inner acc solve)
         acc_solve = partial(solve, backend=backend, backend_options=backend_options,
                             max_grid=max_grid, max_iterations=max_iterations)
         return solve_jerk(path, limits, acc_solve=acc_solve, tol=tol, progress=progress,
-                          holds=holds, **({} if initial_intervals is None
+                          holds=holds, nlp_backend=nlp_backend,
+                          **({} if initial_intervals is None
                                           else {"initial_intervals": initial_intervals}))
     solve_fn = get_backend(backend)
     if holds is None:

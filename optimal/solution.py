@@ -89,6 +89,11 @@ class OptimalSolution:
         The imposed holds in ``profile`` and in both bounds (as given to :func:`solve`).
     bounds : str
         The bound set solved (``"acc"`` or ``"jerk"``, :data:`BOUND_SETS` keys).
+    segment_lower_bounds_s : numpy.ndarray, shape (m,), optional
+        Certified per-segment lower bounds, s: every motion of the bound set spends at
+        least this long moving through each segment (holds excluded), so their sums
+        over any set of segments bound that part of the program. ``None`` when the
+        method gives none (``acc``: its bound is global).
     """
 
     status: SolveStatus
@@ -117,6 +122,7 @@ class OptimalSolution:
     message: str = ""
     holds: Holds = NO_HOLDS
     bounds: str = "acc"
+    segment_lower_bounds_s: np.ndarray | None = None
 
     @property
     def hold_s(self) -> float:

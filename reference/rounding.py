@@ -35,7 +35,9 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      replaces both for the geometry axes (5.7); digit 4: ``d`` as G641. Both blocks G0:
      tolerances times MD20560 G0_TOLERANCE_FACTOR (5.7);
    * G644 (thousands digit): 0xxx/4xxx MD33100 per axis, 1xxx/5xxx ADIS/ADISPOS
-     (CTOL ignored, 5.6); 2xxx/3xxx not modelled yet (named);
+     (CTOL ignored, 5.6); 2xxx the rounding lasts one period of the lowest
+     LOOKAH_FREQUENCY at the programmed speed, 3xxx the smallest rounding the axes pass
+     at the programmed speed (:func:`_dynamic_distance`); other digits named;
    * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
      radius ``R`` is what RND defines; no speed check: it is contour, not smoothing);
    * a tolerance gives ``d = e / tan(theta/4)`` for the arc and ``d = e d_1(theta) /
@@ -109,6 +111,16 @@ CHAIN_MEET_MM = 1e-10
 #: ``PlannerParameters.arc_jerk_velocity_share`` (a test keeps the two equal), for the
 #: same reason as :data:`CENTRIPETAL_SHARE`.
 JERK_VELOCITY_SHARE = 0.5
+
+#: G644 with SMOOTHING_MODE 2xxx: the rounding motion lasts at least this many periods of
+#: the lowest LOOKAH_FREQUENCY of the axes with a velocity jump at the corner. The B1
+#: excerpt: "the rounding area is defined so that no frequencies in excess of the
+#: specified maximum can occur while the rounding motion is in progress"; spec 5.8:
+#: "T_i >= 1/f_i ... Whether Siemens uses 1/f or 1/(2f) is unknown; make it a parameter"
+#: (a module constant: the path must not depend on a plan's parameters, see
+#: :data:`CENTRIPETAL_SHARE`). One period: an axis velocity change over ``T`` excites
+#: frequencies up to about ``1/T``.
+G644_FREQUENCY_PERIODS = 1.0
 
 #: Programmed rounding radii (RND non-modal, RNDM modal): a tangent arc of that radius.
 _RADIUS_MODES = ("RND", "RNDM")
@@ -212,7 +224,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     # auxiliary output before motion, positioning axes...): a geometry-axis change is a
     # path stop as well (reference.prepare), and the trace should name it as such
     is_line = (path.kind[a] == _LINE) & (path.kind[b] == _LINE)
-    da, db = path.d[a], path.d[b]
+    da, db = path.d.take(a, axis=0), path.d.take(b, axis=0)     # rows, as d[a], faster
     geo_a = np.where(path.kind[a] == _LINE, row_norms(da[:, geo]) > MOVING_AXIS_TOL, True)
     geo_b = np.where(path.kind[b] == _LINE, row_norms(db[:, geo]) > MOVING_AXIS_TOL, True)
     decide((geo_a != geo_b) & (kb - ka <= 1), "geometry axes move in one block only")
@@ -262,9 +274,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         soft = attrs["accel"][ka[o]] == "SOFT"
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
         a1, a2 = np.abs(t1[o]), np.abs(t2[o])
+        v_in, v_out = _programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o])
         with np.errstate(divide="ignore"):
-            v_in = np.minimum(path.feed[a[o]], row_min(lim.v_max[None, :] / a1))
-            v_out = np.minimum(path.feed[b[o]], row_min(lim.v_max[None, :] / a2))
             acc_in = row_min(lim.a_max[None, :] / a1)
             acc_out = row_min(lim.a_max[None, :] / a2)
             j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
@@ -318,14 +329,14 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     radius = attrs["radius"][ka]
     # how each corner's distance is found: ADIS, TOL (MD33100 per axis and maybe a
     # contour tolerance), RADIUS (RND/RNDM) or NONE (not modelled)
-    NONE, ADIS, TOL, RADIUS = 0, 1, 2, 3
+    NONE, ADIS, TOL, RADIUS, FREQ, DYN = 0, 1, 2, 3, 4, 5
     how = np.full(k, NONE, dtype=np.int8)
     contour = np.full(k, np.inf)
     use_axis_tol = np.ones(k, bool)
     how[np.isin(mode, _RADIUS_MODES)] = RADIUS
     how[mode == "G641"] = ADIS
     dig644 = _digit(sm, 3)
-    how[mode == "G644"] = ADIS if dig644 in (1, 5) else TOL if dig644 in (0, 4) else NONE
+    how[mode == "G644"] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
         sel = mode == md
         dig = _digit(sm, place)
@@ -359,9 +370,93 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
-    decide(how == NONE, "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")
+    # G644 2xxx (frequency) and 3xxx (maximum dynamics): sized by the path velocity
+    dyn = np.flatnonzero((how == FREQ) | (how == DYN))
+    if dyn.size:
+        d[dyn] = _dynamic_distance(path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn],
+                                   theta[dyn], g2[dyn], how[dyn] == FREQ)
+    decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
     return np.where(np.isfinite(d), d, 0.0), multi
+
+
+def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
+                       t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Programmed path speed of the lines before and after corners (feed and the axis
+    velocities along each line), mm/s, shape (k,) each."""
+    with np.errstate(divide="ignore"):
+        v_in = np.minimum(path.feed[a], row_min(lim.v_max[None, :] / np.abs(t1)))
+        v_out = np.minimum(path.feed[b], row_min(lim.v_max[None, :] / np.abs(t2)))
+    return v_in, v_out
+
+
+def _plane_weights(t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normal of the corner's plane towards ``t2`` and each axis's weight in that
+    plane ``rho_i = sqrt(n_i^2 + t1_i^2)`` (a curvature ``kappa`` in the plane moves axis
+    ``i`` with at most ``rho_i kappa v^2``), shape (k, n) each."""
+    normal = t2 - row_dots(t2, t1)[:, None] * t1
+    normal /= row_norms(normal)[:, None]
+    return normal, np.sqrt(normal ** 2 + t1 ** 2)
+
+
+def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray,
+                      t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, g2: np.ndarray,
+                      freq: np.ndarray) -> np.ndarray:
+    """Tangent distance of G644 with SMOOTHING_MODE 3xxx (``freq`` False) or 2xxx
+    (``freq`` True), before the block-length clamp, mm, shape (k,).
+
+    Both are sized by "the current path velocity" (B1 excerpt), here the programmed speed
+    ``v`` of the slower line (:func:`_programmed_speeds`):
+
+    * 3xxx, "any axis that has a velocity jump at a corner traverses around the corner
+      with the maximum possible dynamic response ... neither the maximum deviations nor
+      the rounding distance are checked": the smallest rounding the axes pass at ``v``
+      with the dynamics the heuristic grants a curved segment (the rules of
+      :func:`_rounding_speed`, so that the rounding is passed at ``v``: centripetal
+      ``rho_i kappa v^2 <= CENTRIPETAL_SHARE A_i``; under SOFT also the jerk
+      ``rho_i |q3| v^3 <= JERK_VELOCITY_SHARE J_i``, ``q3`` the third path derivative;
+      one IPO cycle per piece, ``piece >= v T_ipo``). Tangent arc: ``R = max(1 / K_a,
+      v T_ipo / theta)``, ``d = R tan(theta/2)``. Clothoid pair of piece ``L``:
+      ``kappa_max = theta / L`` and ``|q3| = theta sqrt(1 + theta^2) / L^2``, so
+      ``L = max(theta / K_a, sqrt(theta sqrt(1 + theta^2) / K_j), v T_ipo)``,
+      ``d = L d_1(theta)``; ``K_a = min_i share A_i / (rho_i v^2)``, ``K_j = min_i
+      share J_i / (rho_i v^3)``.
+    * 2xxx, "the rounding distance is limited to a minimum value, which results from the
+      maximum permissible excitation frequency and the current path velocity": the
+      rounding lasts ``T = G644_FREQUENCY_PERIODS / f`` at ``v`` (``f`` the lowest
+      LOOKAH_FREQUENCY of the axes whose velocity jumps, ``|t2_i - t1_i| > 0``), so its
+      length is ``v T``: arc ``R = v T / theta``; clothoid pair ``L = v T / 2``.
+
+    Both then take the block-length clamp like every mode ("any further limitations are
+    also effective ... the rounding distance cannot exceed half the length of the
+    original participating blocks").
+    """
+    lim = machine.limits.for_axes(path.axes)
+    t_ipo = machine.limits.t_ipo_s
+    v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
+    v = np.minimum(v_in, v_out)
+    _, rho = _plane_weights(t1, t2)
+    moving = rho > 0
+    w = np.where(moving, rho, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k_a = row_min(np.where(moving, CENTRIPETAL_SHARE * lim.a_max[None, :]
+                               / (w * (v * v)[:, None]), np.inf))
+        k_j = row_min(np.where(moving, JERK_VELOCITY_SHARE * lim.j_max[None, :]
+                               / (w * (v * v * v)[:, None]), np.inf))
+        # 3xxx: the arc's radius, the clothoid pair's piece length
+        r_dyn = np.maximum(1.0 / k_a, v * t_ipo / theta)
+        l_dyn = np.maximum(np.maximum(theta / k_a,
+                                      np.sqrt(theta * np.sqrt(1.0 + theta * theta) / k_j)),
+                           v * t_ipo)
+        # 2xxx: the rounding's duration at v
+        jump = np.abs(t2 - t1) > 0
+        f = row_min(np.where(jump, lim.frequency_hz[None, :], np.inf))
+        length = v * G644_FREQUENCY_PERIODS / f
+        radius = np.where(freq, length / theta, r_dyn)
+        piece = np.where(freq, length / 2.0, l_dyn)
+        d_1, _ = clothoid_pair_shape(np.clip(theta, 1e-300, None))
+        d = np.where(g2, piece * d_1, radius * np.tan(theta / 2.0))
+    return np.where(np.isfinite(d), d, 0.0)
 
 
 def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -594,9 +689,7 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _S
     """
     kappa, sharp, piece = shape.kappa[o], shape.sharp[o], shape.piece[o]
     clo = sharp > 0
-    normal = t2 - row_dots(t2, t1)[:, None] * t1
-    normal /= row_norms(normal)[:, None]
-    rho = np.sqrt(normal ** 2 + t1 ** 2)            # plane weight of each axis
+    normal, rho = _plane_weights(t1, t2)            # plane weight of each axis
     with np.errstate(divide="ignore", invalid="ignore"):
         a_c = CENTRIPETAL_SHARE * lim.a_max[None, :]
         w = np.where(rho > 0, rho, 1.0)
@@ -686,6 +779,19 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
     return trim_start, trim_end
 
 
+def _interleave(rows: np.ndarray, pos: np.ndarray, ins: np.ndarray, ins_pos: np.ndarray,
+                total: int) -> np.ndarray:
+    """(total, n) array with ``rows`` at rows ``pos`` and ``ins`` at rows ``ins_pos``
+    (together every row once), written column by column: numpy scatters 1-d columns
+    faster than whole rows (about 25 ns a row), the values are the same."""
+    out = np.empty((total, rows.shape[1]))
+    for j in range(rows.shape[1]):
+        col = out[:, j]
+        col[pos] = rows[:, j]
+        col[ins_pos] = ins[:, j]
+    return out
+
+
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
               g2: np.ndarray, piece: np.ndarray, table: RoundingTable) -> Path:
     """The rounded path: lines shortened, roundings inserted after segments ``a``
@@ -717,23 +823,22 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     first = np.concatenate(([0], np.cumsum(count)))          # new index of old seg's pieces
     total = int(first[-1])
     n = path.n_axes
-    corner = path.origin[a] + path.d[a] * path.length[a][:, None]
+    corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
     # rows of the inserted segments: after the kept part of segment a, one or two each
     base = first[:-1][a] + keep[a]
     k_ins = n_ins[a]
     arc_pos = np.repeat(base, k_ins) + (np.arange(int(k_ins.sum()))
                                         - np.repeat(np.cumsum(k_ins) - k_ins, k_ins))
-    line_pos = first[:-1][keep]
+    kept = np.flatnonzero(keep)
+    line_pos = first[:-1][kept]
     new = {}
-    for key in ("origin", "e1", "e2", "d"):
-        arr = np.zeros((total, n))
-        src = getattr(path, key)
-        arr[line_pos] = src[keep]
-        arr[arc_pos] = arcs[key]
-        new[key] = arr
     # shortened lines (a trimmed arc never occurs: only line-line corners are rounded)
-    new["origin"][line_pos] += path.d[keep] * trim_start[keep][:, None]
+    origin = path.origin + path.d * trim_start[:, None]
+    for key in ("origin", "e1", "e2", "d"):
+        src = origin if key == "origin" else getattr(path, key)
+        new[key] = _interleave(src.take(kept, axis=0), line_pos, arcs[key], arc_pos,
+                               total)
     for key, dtype in (("radius", np.float64), ("omega", np.float64),
                        ("theta0", np.float64), ("length", np.float64),
                        ("block", np.int64), ("kind", np.int8), ("dradius", np.float64),

@@ -251,18 +251,9 @@ def break_accelerations(path: Path, lim: AxisArrays, t_ipo: float, a_cap: float,
                                        lim.path_trans_jerk), lim.j_max[None, :])
     gamma = jstep * t_ipo + dk * np.maximum(np.asarray(b_break), 0.0)[:, None]
     # step = t_out a_r + t_in x with x = -a_l (>= 0 and a_r >= 0 at a stop)
-    a_in = _max_fixed_rows(t_in, t_out, gamma, a_cap, path.stop)
-    a_out = _max_fixed_rows(t_out, t_in, gamma, a_cap, path.stop)
+    a_in = _max_fixed(t_in, t_out, gamma, a_cap, path.stop)
+    a_out = _max_fixed(t_out, t_in, gamma, a_cap, path.stop)
     return a_in, a_out
-
-
-def _max_fixed_rows(f, g, gamma, z_max, w_nonneg):
-    """:func:`_max_fixed` with one allowance vector per row (``gamma`` shape (k, n))."""
-    out = np.empty(f.shape[0])
-    for key in np.unique(gamma, axis=0, return_inverse=True)[1].reshape(-1)[:0]:
-        pass
-    # rows share the allowance only by chance: solve them in one vectorised bisection
-    return _max_fixed(f, g, gamma, z_max, w_nonneg) if out.size else out
 
 
 def _ramp(p: np.ndarray, vb: np.ndarray, a_s: np.ndarray, A: np.ndarray, J: np.ndarray

@@ -2,15 +2,20 @@
 
 Pipeline:
 
-1. the ``acc`` oracle on the same path (its lower bound is valid here too, and its final
-   grid carries the per-segment ``acc`` relaxation of :mod:`optimal.jerk.lower`);
-2. the certified lower bound (:func:`optimal.jerk.lower.jerk_lower_bound`);
-3. the jerk NLP on a piece-aware grid (:mod:`optimal.jerk.upper`): solve, verify with
-   ``check_profile``, time-scale; while the gap is above ``tol`` and a finer grid still
-   can close the gap (extrapolated from the last rounds), solve again on a grid with
-   every interval halved;
-4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met``
-   with both (valid) bounds; ``solver_error`` when IPOPT never produced a verified
+1. the ``acc`` oracle on the same path (its lower bound is valid here too, its optimum
+   says where the speed changes, and its relaxation bounds the speeds);
+2. per-segment floors (:func:`optimal.jerk.lower.jerk_lower_bound`), valid for every
+   jerk-feasible motion segment by segment (also the per-block lower bounds);
+3. the first grid (:func:`jerk_grid`): equal intervals per segment, graded toward the
+   segment ends where the ``acc`` optimum changes speed;
+4. rounds on that grid: the convex relaxation (:mod:`optimal.jerk.relaxation`, the
+   lower bound) and the jerk NLP (:mod:`optimal.jerk.upper`: solve, exact profile,
+   ``check_profile``, time scaling: the upper bound); then both are refined together
+   where the verified profile spends more time than the relaxation
+   (:func:`_refine_marks`), until the gap is met, the grid budget or the round budget
+   ends;
+5. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met``
+   with both (valid) bounds; ``solver_error`` when the NLP never produced a verified
    profile (then only the lower bound is reported, the upper bound is ``inf``).
 
 Units: mm, s.
@@ -58,7 +63,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
                max_rounds: int = DEFAULT_JERK_MAX_ROUNDS,
                initial_intervals: int = DEFAULT_JERK_INITIAL_INTERVALS,
                progress: ProgressFn | None = None, holds: Holds | None = None,
-               acc_tol: float | None = None) -> OptimalSolution:
+               acc_tol: float | None = None, nlp_backend: str = "ipopt") -> OptimalSolution:
     """Minimum-time motion under the ``jerk`` bound set, with a certified bracket.
 
     Constraints: those of ``acc`` plus per-axis jerk
@@ -87,6 +92,9 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         Imposed holds (default: the dwells of ``path.blocks``).
     acc_tol : float, optional
         Gap requested from the inner ``acc`` solve (default ``min(tol / 4, 2e-3)``).
+    nlp_backend : {"ipopt", "scp"}
+        Solver of the upper bound's NLP (:mod:`optimal.jerk.backends`; ``scp`` is the
+        cross-check: same optimum, about 12x slower, measured in ``bench_jerk.py``).
 
     Returns
     -------
@@ -139,7 +147,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             relax_note = f" (the relaxation ended {rel.status} on {grid_l.n_points} points)"
             tau_l = t_acc
         tr = time.perf_counter()
-        r = upper_bound_round(path, limits, grid_u, None if best is None else best.profile)
+        r = upper_bound_round(path, limits, grid_u, None if best is None else best.profile,
+                              nlp_backend)
         t_build += r.nlp.build_time_s
         t_solve += r.nlp.solve_time_s
         t_check += time.perf_counter() - tr - r.nlp.build_time_s - r.nlp.solve_time_s
@@ -177,11 +186,11 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             upper_bound_s=math.inf, objective_s=math.inf, gap=math.inf, time_scale=1.0,
             segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
             blocks=(), grid=acc.grid, active=(), grid_points=int(acc.grid.size),
-            iterations=rounds, backend="ipopt", build_time_s=t_build,
+            iterations=rounds, backend=nlp_backend, build_time_s=t_build,
             solve_time_s=t_solve, check_time_s=t_check, bound_time_s=t_bound,
             total_time_s=time.perf_counter() - t_start, dwell_s=_dwell_part(holds),
             history=tuple(history), message=f"jerk NLP failed: {msg}", holds=holds,
-            bounds="jerk")
+            bounds="jerk", segment_lower_bounds_s=floors)
     prof_h = with_holds(best.profile, path, holds)
     labels = active_labels(best)
     g = best.problem.grid
@@ -200,10 +209,11 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         objective_s=best.objective_s + hold_t, gap=gap, time_scale=best.time_scale,
         segment_times_s=prof_h.segment_times(path), block_times_s=prof_h.block_times(path),
         blocks=rows, grid=g.s, active=labels, grid_points=g.n_points, iterations=rounds,
-        backend="ipopt", build_time_s=t_build, solve_time_s=t_solve, check_time_s=t_check,
+        backend=nlp_backend, build_time_s=t_build, solve_time_s=t_solve,
+        check_time_s=t_check,
         bound_time_s=t_bound, total_time_s=time.perf_counter() - t_start,
         dwell_s=_dwell_part(holds), report=best.report, history=tuple(history),
-        message=message, holds=holds, bounds="jerk")
+        message=message, holds=holds, bounds="jerk", segment_lower_bounds_s=floors)
 
 
 def _refine_marks(d: np.ndarray, target_s: float) -> tuple[np.ndarray, int]:

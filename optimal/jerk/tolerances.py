@@ -59,15 +59,16 @@ MIN_INTERVAL_TIME_REL = 1e-9
 #: ``J T_ipo`` in the checker's RATIO_TOL; anything larger is repaired by time scaling.
 IPOPT_TOL = 1e-9
 
-#: IPOPT's barrier-parameter strategies, tried in turn, each with its iteration cap.
-#: Measured on the corpus and the examples (SOFT default machine, 13 programs, one run
-#: each): monotone first took 193 s in all, adaptive first 277 s; adaptive wandered with
-#: growing regularisation for 200 iterations on the 250 mm/min raster
-#: (sin_cead_loop.mpf: monotone 79 iterations) and needed 371 on long arcs at the feed
-#: (sin_cead_arc.mpf: 171), and was faster on two programs only (by 0.2 s and 1.7 s).
-#: A solve that fails both is reported as a solver failure (with the valid lower bound),
-#: never as a result.
-MU_STRATEGIES = (("monotone", 500), ("adaptive", 200))
+#: IPOPT's attempts, tried in turn until one succeeds: ``(barrier strategy, iteration
+#: cap, expand)``; ``expand`` solves on the scalar (SX) expansion of the MX graph, which
+#: costs ten times the build time but follows a different, sometimes better, path.
+#: Measured on the corpus and the examples (SOFT default machine, 13 programs): monotone
+#: first took 193 s in all against 277 s for adaptive first (adaptive wandered for 200
+#: iterations on a 250 mm/min raster that monotone solves in 79, and needed 371 on long
+#: arcs at the feed against 171); on sin_cead_arc.mpf monotone on the MX graph failed
+#: where the SX graph took 171 iterations. A solve that fails every attempt is reported
+#: as a solver failure (with the valid lower bound), never as a result.
+MU_STRATEGIES = (("monotone", 300, False), ("monotone", 500, True), ("adaptive", 200, False))
 
 #: Fraction of the acc optimum's speed used as the warm start (a slower start is closer
 #: to jerk feasibility, so IPOPT's restoration phase is rarely needed).
@@ -83,6 +84,10 @@ JERK_LB_ROUNDOFF_REL = 1e-9
 #: aims at; the last decades to 1e-8 cost a third of the iterations (measured on the
 #: square and the demo, 52 against 35).
 RELAX_SOLVER_TOL = 1e-6
+
+#: Clarabel's iteration cap for the relaxation (it takes 20-40 on the corpus; a run that
+#: needs more has stalled and gives no bound, the per-segment floors remain).
+RELAX_SOLVER_MAX_ITER = 200
 
 #: Relative margin taken off the relaxation's objective (the smaller of Clarabel's primal
 #: and dual values, less also their own relative difference) before it is reported as a

@@ -33,7 +33,7 @@ from ..backends import get_backend
 from ..grid import Grid
 from ..problem import build_grid_problem
 from ..status import SolveStatus
-from .backends import NlpResult, solve_nlp
+from .backends import NlpResult, get_nlp_backend
 from .tolerances import WARM_START_SPEED_FRACTION
 from .transcription import JerkProblem, build_jerk_problem
 
@@ -209,7 +209,8 @@ def profile_times_at(prof: Profile, s: np.ndarray) -> np.ndarray:
 
 
 def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
-                      start: Profile | None = None) -> UpperResult:
+                      start: Profile | None = None, nlp_backend: str = "ipopt"
+                      ) -> UpperResult:
     """Solve the jerk NLP on ``grid`` and verify its profile (see the module docstring).
 
     Parameters
@@ -222,6 +223,8 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
         NLP grid.
     start : Profile, optional
         A verified profile from a coarser grid to start from (see :func:`warm_start`).
+    nlp_backend : {"ipopt", "scp"}
+        NLP solver (:mod:`optimal.jerk.backends`).
 
     Returns
     -------
@@ -230,11 +233,11 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
     lim = limits.for_axes(path.axes)
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
     c0, a0, dt0 = warm_start(path, lim, grid, problem, start)
-    nlp = solve_nlp(problem, c0, a0, dt0)
+    nlp = get_nlp_backend(nlp_backend)(problem, c0, a0, dt0)
     empty = np.zeros(grid.n_intervals)
     if not nlp.success:
         return UpperResult(False, None, 1.0, np.inf, None, nlp, problem, empty,
-                           f"IPOPT: {nlp.message} after {nlp.iterations} iterations")
+                           f"{nlp_backend}: {nlp.message} after {nlp.iterations} iterations")
     block = path.block[grid.segment]
     prof = exact_profile(problem, nlp.c, nlp.a, nlp.a_end, nlp.dt, block)
     report = check_profile(path, limits, prof)

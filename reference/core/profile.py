@@ -307,7 +307,11 @@ class Profile:
         interval."""
         cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
         cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
-        cuts = cuts[~np.isin(cuts, self.s)]
+        # drop the cuts on a knot: the knots are non-decreasing, so the knot at or after
+        # each cut is found by bisection (the same set as ``np.isin(cuts, self.s)``,
+        # without sorting the knots again)
+        at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
+        cuts = cuts[self.s[at] != cuts]
         if cuts.size == 0 or self.n_intervals == 0:
             return None
         tc = self.time_at(cuts)
@@ -405,7 +409,10 @@ class Profile:
             prof = self.split_at(path.s_breaks)
         else:
             segments = np.asarray(segments, dtype=np.int64)
-            prof = self.split_at(path.s_breaks[np.union1d(segments, segments + 1)])
+            ends = np.zeros(path.n_segments + 1, dtype=bool)     # their breaks, sorted
+            ends[segments] = True
+            ends[segments + 1] = True
+            prof = self.split_at(path.s_breaks[ends])
         moving = prof.s[1:] > prof.s[:-1]
         mid = 0.5 * (prof.s[:-1] + prof.s[1:])
         seg = path.segment_index(mid)

@@ -52,7 +52,7 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "tangential transition",                                          # 11
     "arc transition: rounding not modelled yet",                      # 12 model limit
     "non-geometry axes move: rounding not modelled yet",              # 13 model limit
-    "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet",                # 14 model limit
+    "G644 SMOOTHING_MODE digit not documented",                       # 14 6xxx..9xxx
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
 

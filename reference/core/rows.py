@@ -77,6 +77,18 @@ class BlockMotion:
     v_peak: np.ndarray
 
 
+def interval_peak_speeds(prof: Profile) -> np.ndarray:
+    """Largest speed inside each interval of ``prof``: at its knots or where the
+    acceleration crosses zero inside it (``v`` is quadratic in time), mm/s, shape (K,)."""
+    h = np.diff(prof.t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ts = np.where(prof.j != 0, -prof.a / np.where(prof.j != 0, prof.j, 1.0), -1.0)
+    inside = (ts > 0) & (ts < h)
+    ts = np.where(inside, ts, 0.0)
+    v_in = np.where(inside, prof.v[:-1] + prof.a * ts + prof.j * ts ** 2 / 2, 0.0)
+    return np.maximum(np.maximum(prof.v[:-1], prof.v[1:]), v_in)
+
+
 def block_motion(path: Path, profile: Profile) -> BlockMotion:
     """Time, entry, exit and peak path speed of a profile in every block span.
 
@@ -106,13 +118,7 @@ def block_motion(path: Path, profile: Profile) -> BlockMotion:
     k_arr = np.clip(np.searchsorted(prof.s, s1, side="left"), 0, prof.s.size - 1)
     v_entry, v_exit = prof.v[k_dep], prof.v[k_arr]
     # peak: knots and stationary points of v inside each interval, per block
-    h = np.diff(prof.t)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ts = np.where(prof.j != 0, -prof.a / np.where(prof.j != 0, prof.j, 1.0), -1.0)
-    inside = (ts > 0) & (ts < h)
-    ts = np.where(inside, ts, 0.0)
-    v_in = np.where(inside, prof.v[:-1] + prof.a * ts + prof.j * ts ** 2 / 2, 0.0)
-    v_int = np.maximum(np.maximum(prof.v[:-1], prof.v[1:]), v_in) if K else np.zeros(0)
+    v_int = interval_peak_speeds(prof) if K else np.zeros(0)
     n_blocks = int(idx.max()) + 1
     peak = np.zeros(n_blocks)
     if K:
@@ -216,13 +222,7 @@ def stretch_motion(profile: Profile, s0: np.ndarray, s1: np.ndarray) -> BlockMot
     v0 = profile.state(t0)[1]
     v1 = profile.state(t1)[1]
     prof = profile.split_at(np.concatenate((s0, s1)))
-    h = np.diff(prof.t)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ts = np.where(prof.j != 0, -prof.a / np.where(prof.j != 0, prof.j, 1.0), -1.0)
-    inside = (ts > 0) & (ts < h)
-    ts = np.where(inside, ts, 0.0)
-    v_in = np.where(inside, prof.v[:-1] + prof.a * ts + prof.j * ts ** 2 / 2, 0.0)
-    v_int = np.maximum(np.maximum(prof.v[:-1], prof.v[1:]), v_in)
+    v_int = interval_peak_speeds(prof)
     mid = 0.5 * (prof.s[:-1] + prof.s[1:])
     piece = np.searchsorted(s0, mid, side="right") - 1
     ok = (piece >= 0) & (prof.s[1:] > prof.s[:-1])

@@ -17,6 +17,11 @@ At 1,000, 2,000 and 5,000 grid intervals (and the scaling exponent of ours):
 Rows print both wall times and ``ours / plain`` (below 1: ours is faster), then the
 bracket of ``optimal.solve(bounds="jerk")`` at its default settings.
 
+Then the SCP cross-check backend (:mod:`optimal.jerk.backends.scp`) against the IPOPT
+backend on the same transcription and warm start, at 1,000 and 5,000 intervals: wall
+time ratio ``scp / ipopt`` and objective ratio ``T scp / T ipopt`` (Clarabel subproblems;
+OSQP subproblems at 1,000 only, they need thousands of ADMM iterations each).
+
 copp (the ``copp-py`` package, TOPP3-SOCP) has its own rows at equal nodes in
 ``bench_copp.py``.
 """
@@ -37,13 +42,16 @@ import casadi as ca  # noqa: E402
 import optimal  # noqa: E402
 from optimal.backends import get_backend  # noqa: E402
 from optimal.grid import initial_grid  # noqa: E402
-from optimal.jerk.upper import upper_bound_round  # noqa: E402
+from optimal.jerk.backends import ipopt, scp  # noqa: E402
+from optimal.jerk.transcription import build_jerk_problem  # noqa: E402
+from optimal.jerk.upper import upper_bound_round, warm_start  # noqa: E402
 from optimal.problem import build_grid_problem, common_node_caps  # noqa: E402
 from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
 
 SIZES = (1000, 2000, 5000)
+SCP_SIZES = ((1000, ("clarabel", "osqp")), (5000, ("clarabel",)))
 
 
 def stadium_gcode(R: float = 20.0, L: float = 80.0, laps: int = 2, F: float = 15000.0):
@@ -95,6 +103,28 @@ def plain_nlp(path, limits, grid):
     return secs, T, str(solver.stats().get("return_status"))
 
 
+def scp_rows(path, limits) -> None:
+    """SCP vs IPOPT on the same grid NLP and warm start (wall time of the solve only)."""
+    lim = limits.for_axes(path.axes)
+    print(f"{'N':>6} {'subproblem':>10} {'scp s':>8} {'ipopt s':>8} {'time ratio':>10} "
+          f"{'T ratio - 1':>12}  scp: iterations, message")
+    for n, subs in SCP_SIZES:
+        grid = initial_grid(path, n)
+        problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
+        start = warm_start(path, lim, grid, problem)
+        t0 = time.perf_counter()
+        ref = ipopt.solve_nlp(problem, *start)
+        t_ref = time.perf_counter() - t0
+        for sub in subs:
+            t0 = time.perf_counter()
+            r = scp.solve_nlp(problem, *start, subproblem=sub)
+            t_scp = time.perf_counter() - t0
+            ratio = float(np.sum(r.dt) / np.sum(ref.dt))
+            print(f"{grid.n_intervals:>6} {sub:>10} {t_scp:8.2f} {t_ref:8.2f} "
+                  f"{t_scp / t_ref:10.2f} {ratio - 1:12.2e}  {r.iterations}, {r.message}"
+                  f"{'' if ref.success else '; IPOPT: ' + ref.message}", flush=True)
+
+
 def main() -> int:
     machine = load_machine()
     path = build_path(parse_text(stadium_gcode(), "stadium.mpf"), machine)
@@ -117,6 +147,7 @@ def main() -> int:
               f"{r.nlp.solve_time_s:.2f}, {r.nlp.iterations}; {status}", flush=True)
     slope = np.polyfit(np.log(sizes), np.log(ours_s), 1)[0]
     print(f"ours: time ~ N^{slope:.2f} over N = {sizes[0]}..{sizes[-1]}")
+    scp_rows(path, limits)
     t0 = time.perf_counter()
     sol = optimal.solve(path, limits, bounds="jerk", tol=1e-2)
     secs = time.perf_counter() - t0

@@ -33,7 +33,6 @@ import sys
 import time
 from pathlib import Path as FsPath
 
-import numpy as np
 
 HERE = FsPath(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
@@ -47,20 +46,7 @@ from reference.prepare import build_path  # noqa: E402
 TARGET = 1.30
 sys.path.insert(0, str(HERE.parent / "reference"))
 from corpus_sinumerik import short_segments_g642  # noqa: E402
-
-
-def polyline(n: int, seed: int = 13) -> str:
-    """``n`` G1 lines with seeded lengths and turns (body only, no mode words)."""
-    rng = np.random.default_rng(seed)
-    heading, x, y = 0.0, 0.0, 0.0
-    out = []
-    for _ in range(n):
-        heading += np.radians(rng.uniform(5.0, 120.0)) * rng.choice((-1.0, 1.0))
-        step = rng.uniform(0.5, 5.0)
-        x += step * np.cos(heading)
-        y += step * np.sin(heading)
-        out.append(f"X{x:.4f} Y{y:.4f}")
-    return "\n".join(out) + "\nM30\n"
+from seeded_programs import polyline  # noqa: E402
 
 
 def timed(text: str, machine, repeat: int = 5):
@@ -114,7 +100,7 @@ def row(label: str, n: int, base, rounded) -> tuple[float, float]:
 def main(argv=None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     n = 2000 if "--quick" in argv else 10000
-    body = polyline(n)
+    body = polyline(n, 13)
     machine = load_machine()
     worst = worst_pl = 0.0
     for accel in ("BRISK", "SOFT"):

@@ -91,6 +91,7 @@ class FakeSolution:
     bounds: str = "acc"
     blocks: tuple = ()
     holds: Holds = NO_HOLDS
+    segment_lower_bounds_s: object = None
 
 
 def fake_plan(path: Path, limits: MachineLimits, scale: float = 0.7,

@@ -1,5 +1,5 @@
-"""Rounded paths on every bundled machine: compare exits 0/1, the oracle is optimal
-within its bracket on the same rounded path, the heuristic keeps its limits and is never
+"""Rounded paths on every bundled machine: compare exits 0/1, the ``acc`` oracle (a
+relaxation of both machines' own bound sets) is optimal within its bracket on the same rounded path, the heuristic keeps its limits and is never
 faster than the certified lower bound (issue 13 item 3)."""
 
 from __future__ import annotations
@@ -11,7 +11,8 @@ import pytest
 
 import numpy as np
 
-from compare import cli
+from compare import cli, compare_program
+from compare.export import comparison_dict
 from reference.machine import load_machine
 from reference.nc import parse_file
 from reference.prepare import build_path
@@ -42,7 +43,7 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
     mfile = _machine_file(tmp_path, machine, prog.name)
     out = tmp_path / "r.json"
     rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report",
-                   "--quiet", "--json", str(out)])
+                   "--quiet", "--json", str(out), "--bounds", "acc"])
     err = capsys.readouterr().err
     assert rc in (0, 1), err
     doc = json.loads(out.read_text())
@@ -101,12 +102,9 @@ def test_clothoid_roundings_keep_the_jerk_certificate(name: str, machine: str,
     prog = tmp_path / f"{name}.mpf"
     prog.write_text(PROGRAMS[name])
     mfile = _machine_file(tmp_path, machine, prog.name)
-    out = tmp_path / "r.json"
-    rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report", "--quiet",
-                   "--bounds", "jerk", "--json", str(out)])
-    err = capsys.readouterr().err
-    assert rc in (0, 1), err
-    doc = json.loads(out.read_text())
+    # a 3 % bracket: the certificate is the point here, not the bracket's width (the
+    # default 1 % takes five rounds on g641_soft_adis, 1.5 % reached)
+    doc = comparison_dict(compare_program(str(prog), str(mfile), bounds="jerk", tol=0.03))
     ora, ref = doc["oracle"], doc["reference"]
     assert ora["status"] in ("optimal", "gap_not_met"), ora
     assert not ref["violations"], ref["violations"]

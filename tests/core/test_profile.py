@@ -45,6 +45,21 @@ def test_split_at_keeps_the_motion():
     assert np.all(np.isin([1.0, 7.5, 20.0], cut.s))
 
 
+def test_cuts_on_knots_are_dropped_as_isin_drops_them():
+    """``split_at`` ignores cuts on existing knots (its docstring); the bisection that
+    finds them must drop exactly what ``numpy.isin`` over the knots drops, holds (equal
+    neighbouring knots) included."""
+    prof = Profile.from_phases([1.0, 1.0, 2.0, 1.0, 1.0], [10, -10, 0, 10, -10], [0] * 5)
+    rng = np.random.default_rng(3)
+    cuts = np.concatenate((prof.s, rng.uniform(0.0, prof.s[-1], 40), [5.0, 10.0]))
+    k, tc, sc = prof._cuts(cuts)
+    ref = np.unique(cuts)
+    ref = ref[(ref > prof.s[0]) & (ref < prof.s[-1])]
+    ref = ref[~np.isin(ref, prof.s)]
+    np.testing.assert_array_equal(np.sort(sc), ref)
+    assert not np.isin(sc, prof.s).any()
+
+
 def test_block_times_sum_to_duration_and_hold_goes_to_dwell_block():
     pts = np.array([[0, 0, 0], [10, 0, 0], [20, 0, 0]], float)
     spans = (BlockSpan(0, 1, "", "G1", 0.0, 10.0, 0, 1),

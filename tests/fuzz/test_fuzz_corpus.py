@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from fuzz_harness import assert_clean, run_cli
+from fuzz_harness import COMPARE_ARGS, assert_clean, run_cli
 
 pytestmark = pytest.mark.fuzz
 
@@ -132,7 +132,7 @@ def test_corpus_mutant(original, seed):
         prog.write_bytes(data)
         for command in ("inspect", "plan", "compare"):
             argv = [command, str(prog), "--quiet"] + (
-                ["--no-report"] if command == "compare" else [])
+                ["--no-report", *COMPARE_ARGS] if command == "compare" else [])
             if prog.suffix == ".ngc":
                 argv += ["--machine", "linuxcnc_xyz"]
             assert_clean(run_cli(argv), [prog])

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from fuzz_harness import KNOWN_BUGS, assert_clean, run_cli
+from fuzz_harness import COMPARE_ARGS, KNOWN_BUGS, assert_clean, run_cli
 
 pytestmark = pytest.mark.fuzz
 
@@ -41,8 +41,8 @@ def test_found_case(name, text, command):
     with tempfile.TemporaryDirectory() as tmp:
         prog = Path(tmp) / name
         prog.write_text(text)
-        argv = [command, str(prog), "--quiet"] + (["--no-report"] if command == "compare"
-                                                  else [])
+        argv = [command, str(prog), "--quiet"] + (["--no-report", *COMPARE_ARGS]
+                                                  if command == "compare" else [])
         assert_clean(run_cli(argv), [prog])
 
 

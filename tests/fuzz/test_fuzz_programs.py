@@ -25,7 +25,7 @@ import pytest
 from hypothesis import event, given, reject
 from hypothesis import strategies as st
 
-from fuzz_harness import assert_clean, known_bug, run_cli
+from fuzz_harness import COMPARE_ARGS, assert_clean, known_bug, run_cli
 from fuzz_strategies import machine_texts, programs
 
 pytestmark = pytest.mark.fuzz
@@ -48,7 +48,7 @@ def _commands(prog: Path, machine: str | None) -> list[list[str]]:
     extra = ["--machine", machine] if machine else []
     return [["inspect", str(prog), "--quiet", *extra],
             ["plan", str(prog), "--quiet", *extra],
-            ["compare", str(prog), "--quiet", "--no-report", *extra]]
+            ["compare", str(prog), "--quiet", "--no-report", *COMPARE_ARGS, *extra]]
 
 
 def _judge(outcome, files: list[Path]) -> None:

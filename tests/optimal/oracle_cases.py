@@ -179,3 +179,20 @@ def toppra_solve(path, limits, gridpoints):
     v = sd[:-1] + sd[1:]
     T = float(np.sum(2 * np.diff(gridpoints) / v))
     return T, sd, t1 - t0, t2 - t1
+
+
+def ruckig_line_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) -> float:
+    """ruckig's time-optimal straight move of length ``L`` mm from rest to rest under
+    ``V`` mm/s, ``A`` mm/s^2 and ``J`` mm/s^3, starting with acceleration ``a_s`` and
+    ending with ``-a_s`` (the rulebook's one-cycle step at the path ends: the
+    surroundings rest), s. The independent reference of the jerk tests (ruckig is a
+    test dependency; the caller skips without it)."""
+    import ruckig
+    otg = ruckig.Ruckig(1)
+    inp = ruckig.InputParameter(1)
+    traj = ruckig.Trajectory(1)
+    inp.current_position, inp.target_position = [0.0], [L]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
+    inp.current_acceleration, inp.target_acceleration = [a_s], [-a_s]
+    otg.calculate(inp, traj)
+    return traj.duration

@@ -71,7 +71,7 @@ ruckig = pytest.importorskip("ruckig")
 
 from copp_cases import (BREAK_PAIR, line_into_arc, s_bends, solve_copp,  # noqa: E402
                         stadium)
-from oracle_cases import line_path  # noqa: E402
+from oracle_cases import line_path, ruckig_line_time  # noqa: E402
 
 pytestmark = pytest.mark.xdist_group("copp")
 
@@ -131,16 +131,6 @@ def oracle(name: str, end_steps: bool):
                          initial_intervals=N_ORACLE)
 
 
-def ruckig_time(L, V, A, J) -> float:
-    otg = ruckig.Ruckig(1)
-    inp = ruckig.InputParameter(1)
-    traj = ruckig.Trajectory(1)
-    inp.current_position, inp.target_position = [0.0], [L]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
-    otg.calculate(inp, traj)
-    return traj.duration
-
-
 # ------------------------------------------------------------ the wrapper, independently
 @pytest.mark.parametrize("end", [[100.0, 0, 0], [60.0, 30.0, 20.0], [2.0, 0, 0]],
                          ids=["x100", "diagonal", "short2"])
@@ -155,7 +145,7 @@ def test_copp_on_a_line_matches_ruckig(end):
     t = np.abs(np.asarray(end, float)) / np.linalg.norm(end)
     a = lim.for_axes(p.axes)
     on = t > 0
-    exact = ruckig_time(float(np.linalg.norm(end)), float(np.min(a.v_max[on] / t[on])),
+    exact = ruckig_line_time(float(np.linalg.norm(end)), float(np.min(a.v_max[on] / t[on])),
                         float(np.min(a.a_max[on] / t[on])), float(np.min(a.j_max[on] / t[on])))
     t1 = solve_copp(p, lim, N_LINE).time_s
     r2 = solve_copp(p, lim, 2 * N_LINE)
@@ -172,7 +162,7 @@ def test_without_the_ramp_node_copp_underuses_the_jerk_near_rest():
     have ``s'''`` proportional to ``s'``), and the finer grid does not help."""
     lim = default_limits()
     p = line_path([[0.0, 0.0, 0.0], [100.0, 0.0, 0.0]])
-    exact = ruckig_time(100.0, 500.0, 2000.0, 40000.0)
+    exact = ruckig_line_time(100.0, 500.0, 2000.0, 40000.0)
     with_node = solve_copp(p, lim, 2 * N_LINE).time_s
     without = solve_copp(p, lim, 2 * N_LINE, ramp_nodes=False).time_s
     assert with_node - exact < 1e-4 * exact

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import optimal
-from oracle_cases import GEO3, XYZ, line_path
+from oracle_cases import GEO3, XYZ, line_path, ruckig_line_time
 from reference.core import AxisLimits, MachineLimits, path_from_pieces
 from reference.core.errors import MachineDataError
 from reference.core.geometry import arc_segment
@@ -46,24 +46,13 @@ def jerk_machine(v, a, j, *, ovl=1.2) -> MachineLimits:
     return MachineLimits(tuple(AxisLimits(n, v, a, j, ovl) for n in XYZ), T_IPO)
 
 
-def ruckig_time(L, V, A, J, a_s=0.0) -> float:
-    otg = ruckig.Ruckig(1)
-    inp = ruckig.InputParameter(1)
-    traj = ruckig.Trajectory(1)
-    inp.current_position, inp.target_position = [0.0], [L]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
-    inp.current_acceleration, inp.target_acceleration = [a_s], [-a_s]
-    otg.calculate(inp, traj)
-    return traj.duration
-
-
 def test_closed_form_matches_ruckig():
     rng = np.random.default_rng(7)
     for i in range(300):
         L = 10 ** rng.uniform(-1, 3)
         V, A, J = 10 ** rng.uniform(1, 3), 10 ** rng.uniform(2, 4), 10 ** rng.uniform(3, 6)
         a_s = min(A, J * T_IPO) if i % 2 else 0.0
-        ref = ruckig_time(L, V, A, J, a_s)
+        ref = ruckig_line_time(L, V, A, J, a_s)
         assert rest_to_rest_time(L, V, A, J, a_s) == pytest.approx(ref, rel=CLOSED_FORM_RTOL)
 
 
@@ -73,7 +62,7 @@ def test_single_line_brackets_ruckig(L):
     lim = jerk_machine(V, A, J)
     p = line_path([[0, 0, 0], [L, 0, 0]])
     sol = optimal.solve(p, lim, bounds="jerk", tol=TOL, initial_intervals=N0)
-    exact = ruckig_time(L, V, A, J, J * T_IPO)
+    exact = ruckig_line_time(L, V, A, J, J * T_IPO)
     assert sol.lower_bound_s <= exact * (1 + BRACKET_SLACK)
     assert sol.upper_bound_s >= exact * (1 - BRACKET_SLACK)
     assert sol.status == optimal.SolveStatus.OPTIMAL
@@ -95,7 +84,7 @@ def test_exact_stop_polyline_is_a_sum_of_ruckig_moves():
     p = line_path(pts, stops=("start", "exact", "exact", "end"))
     sol = optimal.solve(p, lim, bounds="jerk", tol=TOL, initial_intervals=N0)
     # at a right-angle stop each axis' step involves one side only: a_s = J T_ipo
-    exact = sum(ruckig_time(L, V, A, J, J * T_IPO) for L in (12.0, 5.0, 10.0))
+    exact = sum(ruckig_line_time(L, V, A, J, J * T_IPO) for L in (12.0, 5.0, 10.0))
     assert sol.lower_bound_s <= exact * (1 + BRACKET_SLACK)
     assert sol.upper_bound_s >= exact * (1 - BRACKET_SLACK)
     assert sol.status == optimal.SolveStatus.OPTIMAL

@@ -17,21 +17,9 @@ import reference.planner.engine as engine
 from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_text
 from reference.planner.profiles import UnitProfiles
+from seeded_programs import polyline
 
 MACHINES = ("default", "linuxcnc_xyz")
-
-
-def polyline(n: int, seed: int = 5) -> str:
-    """``n`` seeded lines of 0.5..5 mm with turns of 5..120 degrees (body only)."""
-    rng = np.random.default_rng(seed)
-    heading, x, y, out = 0.0, 0.0, 0.0, []
-    for _ in range(n):
-        heading += np.radians(rng.uniform(5.0, 120.0)) * rng.choice((-1.0, 1.0))
-        step = rng.uniform(0.5, 5.0)
-        x += step * np.cos(heading)
-        y += step * np.sin(heading)
-        out.append(f"X{x:.4f} Y{y:.4f}")
-    return "\n".join(out) + "\nM30\n"
 
 
 def with_smoothing(name: str, factor: float):
@@ -49,9 +37,9 @@ def with_smoothing(name: str, factor: float):
 
 PROGRAMS = {
     # short bumps on the lines between roundings (BRISK), several rounds
-    "rounded BRISK": "G90 G642 CTOL=0.02 BRISK F6000\nG1 X0 Y0\nG1 " + polyline(400),
-    "rounded SOFT": "G90 G645 CTOL=0.02 SOFT F6000\nG1 X0 Y0\nG1 " + polyline(400),
-    "G64 BRISK": "G90 G64 BRISK F6000\nG1 X0 Y0\nG1 " + polyline(400),
+    "rounded BRISK": "G90 G642 CTOL=0.02 BRISK F6000\nG1 X0 Y0\nG1 " + polyline(400, 5),
+    "rounded SOFT": "G90 G645 CTOL=0.02 SOFT F6000\nG1 X0 Y0\nG1 " + polyline(400, 5),
+    "G64 BRISK": "G90 G64 BRISK F6000\nG1 X0 Y0\nG1 " + polyline(400, 5),
     # alternating feeds: many short bumps that merge over the rounds
     "alternating feeds": "G90 G64 BRISK\n" + "\n".join(
         f"G1 X{i + 1}.0 F{6000 if i % 2 else 5400}" for i in range(100)) + "\nM30\n",

@@ -439,8 +439,8 @@ def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
     ("G644 ADIS=0.4", 5000, ("distance", 0.4)),
     # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL"
     ("G644 ADIS=0.4", 0, ("deviation", 0.01 * math.sqrt(2))),
-    # 2xxx / 3xxx (frequency, maximum dynamics) are named as not modelled
-    ("G644 ADIS=0.4", 3000, ("reason", "G644 SMOOTHING_MODE 2xxx/3xxx: not modelled yet")),
+    # 6xxx..9xxx are not documented: named
+    ("G644 ADIS=0.4", 6000, ("reason", "G644 SMOOTHING_MODE digit not documented")),
     # spec 5.4 table, value 4 [M]: "rounding distance from ADIS/ADISPOS, as for G641"
     ("G642 ADIS=0.3", 40, ("distance", 0.3)),
     ("G643 ADIS=0.3", 4, ("distance", 0.3)),
@@ -461,6 +461,87 @@ def test_smoothing_mode_digits(mode, smoothing, expect):
         np.testing.assert_allclose(t.deviation_mm, value, rtol=1e-12)
 
 
+# the hand numbers of the G644 2xxx/3xxx tests: the test machine at F3000 round a 90
+# degree XY corner (t1 = X, t2 = Y: plane weights rho_X = rho_Y = 1)
+V_F3000 = 50.0                  # mm/s
+A_TEST, J_TEST = 2000.0, 40000.0  # MAX_AX_ACCEL 2 m/s^2, MAX_AX_JERK 40 m/s^3
+
+
+@pytest.mark.parametrize("accel", ["BRISK", "SOFT"])
+def test_g644_3xxx_rounds_with_the_maximum_dynamics_at_the_path_velocity(accel):
+    """B1 excerpt (G644, thousands digit 3xxx): "Any axis that has a velocity jump at a
+    corner traverses around the corner with the maximum possible dynamic response
+    (maximum acceleration and maximum jerk). SOFT: The jerk is limited. BRISK: ... only
+    the acceleration is limited ... neither the maximum deviations nor the rounding
+    distance are checked. The resulting deviations or rounding distances are determined
+    exclusively by the dynamic limits of the respective axis and the current path
+    velocity." By hand, with the shares the heuristic grants a curved segment (0.75 of
+    A for the centripetal part, 0.5 of J for the jerk): BRISK arc R = v^2 / (0.75 A);
+    SOFT clothoid pair of pieces L = max(theta v^2 / (0.75 A), sqrt(theta sqrt(1 +
+    theta^2) v^3 / (0.5 J))). The tolerance (MD33100 0.01 mm) and ADIS are ignored; the
+    rounding is crossed at the programmed speed."""
+    from reference.core.geometry import clothoid_pair_shape
+    theta = math.pi / 2
+    _, _, path = rounded(square("G644 ADIS=0.1", accel), machine(1.0, SMOOTHING_MODE=3000))
+    t = path.rounding
+    assert t.inserted.all()
+    if accel == "BRISK":
+        R = V_F3000 ** 2 / (0.75 * A_TEST)
+        np.testing.assert_allclose(t.radius_mm, R, rtol=1e-12)
+        np.testing.assert_allclose(t.distance_mm, R * math.tan(theta / 2), rtol=1e-12)
+    else:
+        L = max(theta * V_F3000 ** 2 / (0.75 * A_TEST),
+                math.sqrt(theta * math.sqrt(1 + theta ** 2) * V_F3000 ** 3 / (0.5 * J_TEST)))
+        assert L == pytest.approx(4.2757, abs=1e-4)        # the jerk decides
+        np.testing.assert_allclose(t.length_mm, 2 * L, rtol=1e-12)
+        d_1, _ = clothoid_pair_shape(np.array([theta]))
+        np.testing.assert_allclose(t.distance_mm, L * d_1[0], rtol=1e-12)
+    assert (t.deviation_mm > 0.01 * math.sqrt(2)).all()    # the tolerance is not checked
+    np.testing.assert_allclose(t.v_round, V_F3000, rtol=1e-12)
+
+
+@pytest.mark.parametrize("accel", ["BRISK", "SOFT"])
+def test_g644_2xxx_rounding_lasts_one_period_of_the_lowest_frequency(accel):
+    """B1 excerpt (G644, 2xxx): "Input the maximum possible frequencies of each axis in
+    the rounding area using ... MD32440 LOOKAH_FREQUENCY. The rounding area is defined so
+    that no frequencies in excess of the specified maximum can occur while the rounding
+    motion is in progress ... the rounding distance is limited to a minimum value, which
+    results from the maximum permissible excitation frequency and the current path
+    velocity"; spec 5.8 "2xxx: T_i >= 1/f_i". By hand: X at 20 Hz, Y at 10 Hz (Z at 1 Hz
+    has no velocity jump at an XY corner and does not count): the rounding lasts 1/10 s
+    at F3000, 5 mm of path, whatever the shape."""
+    d = copy.deepcopy(BASE)
+    d["channel"].update(acceleration_mode=accel, SMOOTHING_MODE=2000)
+    for ax in d["axis"].values():
+        ax["MAX_ACCEL_OVL_FACTOR"] = 1.0
+    d["axis"]["Y"]["LOOKAH_FREQUENCY"] = 10.0
+    d["axis"]["Z"]["LOOKAH_FREQUENCY"] = 1.0
+    _, _, path = rounded(square("G644"), machine_from_dict(d))
+    t = path.rounding
+    assert t.inserted.all()
+    np.testing.assert_allclose(t.length_mm, V_F3000 / 10.0, rtol=1e-12)
+    assert t.g2.all() == (accel == "SOFT")
+
+
+def test_g644_2xxx_and_3xxx_keep_the_half_block_clamp():
+    """B1 excerpt: "Any further limitations are also effective in addition to this
+    rounding distance limitation. The rounding distance cannot exceed half the length of
+    the original participating blocks." On the 50 mm square both are cut to 25 mm: 3xxx
+    at F30000 (arc R = v^2 / (0.75 A) = 166.7 mm), 2xxx at F3000 with every axis at 1 Hz
+    (50 mm of arc, d = 50 / (pi/2) = 31.8 mm)."""
+    slow = copy.deepcopy(BASE)
+    slow["channel"].update(SMOOTHING_MODE=2000)
+    for ax in slow["axis"].values():
+        ax.update(MAX_ACCEL_OVL_FACTOR=1.0, LOOKAH_FREQUENCY=1.0)
+    for text, mach in ((square("G644").replace("F3000", "F30000"),
+                        machine(1.0, SMOOTHING_MODE=3000)),
+                       (square("G644"), machine_from_dict(slow))):
+        _, _, path = rounded(text, mach)
+        t = path.rounding
+        assert t.clamped.all()
+        np.testing.assert_allclose(t.distance_mm, 25.0, rtol=1e-12)
+
+
 def test_g0_tolerance_factor_widens_the_g642_tolerance():
     """spec 5.7 "G0 blocks use a tolerance multiplied by MD20560 G0_TOLERANCE_FACTOR (e.g.
     factor 3 x COMPRESS_POS_TOL)"."""
@@ -477,6 +558,45 @@ def test_the_rounding_speed_estimate_uses_the_planner_default_centripetal_share(
     from reference.rounding import CENTRIPETAL_SHARE, JERK_VELOCITY_SHARE
     assert CENTRIPETAL_SHARE == DEFAULT_PARAMETERS.arc_centripetal_share
     assert JERK_VELOCITY_SHARE == DEFAULT_PARAMETERS.arc_jerk_velocity_share
+
+
+def test_soft_corner_with_a_faster_but_longer_rounding_stays_sharp_on_the_bundled_machine(
+        monkeypatch):
+    """spec 5.2 group 2 "Rounding would slow the program down", on the bundled SOFT
+    machine (A = 2 m/s^2, J = 40 m/s^3, overload factor 1.2, T_ipo = 4 ms): a 90 degree
+    G642 CTOL=0.05 corner at F3000. G64 passes it at the axis jump A (1.2 - 1) T_ipo =
+    1.6 mm/s (96 mm/min); the clothoid pair that deviates by 0.05 mm (pieces L =
+    0.05 / e_1(pi/2)) is crossed faster, at the jerk limit cbrt(0.5 J / |q3|), |q3| =
+    theta sqrt(1 + theta^2) / L^2 (5.15 mm/s, 309 mm/min), but over 0.28 mm, and both
+    ramp almost the same way down from 50 mm/s. Reported as a suspected bug of the
+    decision; planned both ways by the heuristic, the rounded contour is the slower one
+    (0.04 s per corner), so leaving the corners sharp is right."""
+    from reference import rounding as rounding_stage
+    from reference.core.geometry import clothoid_pair_shape
+    text = square("G642", "CTOL=0.05").replace("G17", "G17 SOFT")
+    prog = parse_text(text)
+    mach = load_machine()
+    path = build_path(prog, mach)
+    t = path.rounding
+    assert reasons(path) == ["rounding would be slower than G64"] * 3
+    theta = math.pi / 2
+    np.testing.assert_allclose(t.v_g64, 2000.0 * 0.2 * 0.004, rtol=1e-9)
+    _, e_1 = clothoid_pair_shape(np.array([theta]))
+    L = 0.05 / e_1[0]
+    v_jerk = (0.5 * 40000.0 * L * L / (theta * math.sqrt(1 + theta * theta))) ** (1 / 3)
+    assert v_jerk == pytest.approx(309.0 / 60.0, rel=1e-3)
+    np.testing.assert_allclose(t.v_round, v_jerk, rtol=1e-9)
+    # the same corners rounded (the stage told that the rounding costs nothing; even a
+    # G64 stop would cost less than this rounding) and planned: slower than sharp
+    loss = rounding_stage.corner_time_loss
+    monkeypatch.setattr(rounding_stage, "corner_time_loss", lambda *a: np.where(
+        np.asarray(a[7]) > 0, -np.inf, loss(*a)))
+    forced = build_path(prog, mach)
+    assert forced.rounding.inserted.all()
+    np.testing.assert_allclose(forced.rounding.deviation_mm, 0.05, rtol=1e-9)
+    t_sharp = plan(prog, mach, path=path).time_s
+    t_round = plan(prog, mach, path=forced).time_s
+    assert t_round > t_sharp + 3 * 0.03
 
 
 def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():

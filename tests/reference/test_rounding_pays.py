@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 
 from corpus_sinumerik import corpus_in_mode
+from seeded_programs import polyline
 from reference.core.geometry import KIND_CODES
 from reference.machine import load_machine
 from reference.nc import parse_text
@@ -31,19 +32,6 @@ from reference.rounding import corner_time_loss
 
 MACHINES = ("default", "linuxcnc_xyz")
 ROUNDING = KIND_CODES.index("rounding")
-
-
-def polyline(n: int, seed: int) -> str:
-    """``n`` seeded lines of 0.5..5 mm with turns of 5..120 degrees (body only)."""
-    rng = np.random.default_rng(seed)
-    heading, x, y, out = 0.0, 0.0, 0.0, []
-    for _ in range(n):
-        heading += np.radians(rng.uniform(5.0, 120.0)) * rng.choice((-1.0, 1.0))
-        step = rng.uniform(0.5, 5.0)
-        x += step * np.cos(heading)
-        y += step * np.sin(heading)
-        out.append(f"X{x:.4f} Y{y:.4f}")
-    return "\n".join(out) + "\nM30\n"
 
 
 def n_rounded(res) -> int:
