@@ -66,10 +66,13 @@ Constraints (:data:`CONSTRAINTS`)
     ``|s''| > FREQ_ACCEL_TOL_REL * max|s''|``, across knots; holds, constant-velocity
     spans and sign changes separate phases, while an acceleration that only touches
     zero for an instant, two S-ramps back to back, does not end one) lasts at least
-    ``1/f``, ``f`` the smallest LOOKAH_FREQUENCY of the axes moving during it. Value
-    ``1/duration`` (Hz), limit ``f`` (Hz), so the ratio is ``(1/f) / duration``; the
-    place (``t``, ``s``, block) is the start of the shortest phase relative to its
-    limit and the axis is the moving axis with the smallest ``f``.
+    ``1/f``, ``f`` the smallest LOOKAH_FREQUENCY of the axes moving during it, its length
+    measured as the effective duration ``2 min(t_c - t_0, t_1 - t_c)`` about the
+    acceleration-weighted mean time ``t_c`` (equal to the duration for symmetric ramps;
+    why, in :mod:`reference.core.phases`). Value ``1/D_eff`` (Hz), limit ``f`` (Hz), so
+    the ratio is ``(1/f) / D_eff``; the place (``t``, ``s``, block) is the start of the
+    shortest phase relative to its limit and the axis is the moving axis with the
+    smallest ``f``.
 
 Evaluation inside intervals and its error
 -----------------------------------------
@@ -134,7 +137,7 @@ from .tolerances import (ACCEL_CONTINUITY_TOL_REL, POS_TOL_MM, RATIO_TOL,
                          VEL_TOL_MM_S)
 
 __all__ = ["BOUND_SETS", "CONSTRAINTS", "FREQ_ACCEL_TOL_REL", "ConstraintReport", "ConstraintResult", "UNITS",
-           "check_profile", "scale_time", "time_scale_factor"]
+           "check_profile", "scale_time", "time_scale_factor", "time_scale_factors_by_block"]
 
 #: Every constraint the checker evaluates, in report order.
 CONSTRAINTS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "feed", "velocity_jump",
@@ -145,6 +148,7 @@ _ACC_SET = ("velocity", "acceleration", "feed", "velocity_jump", "stop")
 BOUND_SETS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "acc": _ACC_SET,
     "jerk": _ACC_SET + ("jerk",),
+    "acc+freq": _ACC_SET + ("frequency",),
     "jerk+freq": _ACC_SET + ("jerk", "frequency"),
 })
 
@@ -904,7 +908,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     if ph.n == 0:
         return
     f_min, ax = phase_frequencies(path, ctx.lim, ph, ctx.seg)
-    dur = ph.duration
+    dur = ph.effective_duration
     ok = np.isfinite(f_min) & (dur > 0)
     if not np.any(ok):
         return
@@ -982,6 +986,31 @@ def time_scale_factor(report: ConstraintReport, constraints: Iterable[str]) -> f
             if r > 1.0:
                 lam = max(lam, r ** (1.0 / _POWER[key]))
     return float(lam)
+
+
+def time_scale_factors_by_block(report: ConstraintReport,
+                                constraints: Iterable[str]) -> np.ndarray:
+    """Per program block, the factor :func:`time_scale_factor` would need there.
+
+    The same powers as :func:`time_scale_factor`, applied to ``report.block_ratios``; the
+    jerk ratio is not split by block into interval and step parts, so the safe (slower)
+    ``1/lam^2`` is assumed for it. Stretching only a part of a motion is valid where that
+    part starts and ends at rest (a stop), which the caller must ensure.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_blocks,)
+        ``>= 1``; ``inf`` where a ratio is infinite.
+    """
+    out = None
+    for name in _names(constraints):
+        r = np.asarray(report.block_ratios.get(name, np.zeros(0)), dtype=np.float64)
+        if r.size == 0:
+            continue
+        power = 2 if name == "jerk" else _POWER[name]
+        lam = np.where(r > 1.0, r ** (1.0 / power), 1.0)
+        out = lam if out is None else np.maximum(out, lam)
+    return np.ones(0) if out is None else out
 
 
 def scale_time(profile: Profile, lam: float) -> Profile:

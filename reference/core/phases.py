@@ -1,11 +1,15 @@
-"""The frequency rule (DESIGN section 6): acceleration phases and their shortest duration.
+"""The frequency rule (DESIGN section 6, as sharpened by issue 12): acceleration phases,
+their effective duration and its minimum ``1/f``.
 
 One rule, applied alike by the checker (:func:`reference.core.constraints.check_profile`,
 constraint ``frequency``), the heuristic's self-check (through the checker) and the oracle
 (:mod:`optimal.freq`):
 
     every acceleration or deceleration **phase** of the path motion lasts at least
-    ``1/f``, ``f`` the smallest LOOKAH_FREQUENCY (MD32440) of the axes moving in it.
+    ``1/f``, ``f`` the smallest LOOKAH_FREQUENCY (MD32440) of the axes moving in it,
+    where a phase's length is its **effective duration**
+    ``D_eff = 2 min(t_c - t_0, t_1 - t_c)``, ``t_c`` the acceleration-weighted mean time
+    ``int t |s''| dt / int |s''| dt`` of the phase ``[t_0, t_1]``.
 
 A phase is a maximal time span over which the path acceleration ``s''`` keeps one sign and
 is not zero, ``|s''| > FREQ_ACCEL_TOL_REL * max|s''|`` (:data:`FREQ_ACCEL_TOL_REL`,
@@ -13,19 +17,26 @@ relative to the profile's largest ``|s''|``). Holds, constant-velocity spans and
 changes separate phases; an acceleration that only *touches* zero for an instant (two
 S-ramps back to back) does not end one. Phases run across profile knots.
 
-What the rule does and does not imply (read before building bounds on it):
+Why the effective duration and not the plain one
+------------------------------------------------
+The plain duration ``t_1 - t_0`` constrains only the sign of ``s''``: a ramp may reach
+nearly full speed at full acceleration and *creep* the last fraction of the change with a
+tiny acceleration until the phase has lasted ``1/f``. The checker would accept it, it
+excites what the rule is there to avoid, and the closed form of DESIGN 6 (a rest-to-rest
+line at speed ``v`` with ``v/A < 1/f`` takes exactly ``L/v + 1/f``) would be false
+(tests/core/test_phases.py builds such a ramp 5 % faster). The effective duration closes
+that hole without touching the profiles the rule is meant for:
 
-* A rest-to-rest move has at least one acceleration and one deceleration phase, and
-  distinct rest-to-rest pieces have distinct ones (a phase cannot run through a rise
-  and a fall), so the motion lasts at least ``sum over pieces of 2/f`` (the proof is in
-  :mod:`optimal.freq.lower`).
-* It does **not** imply the FIR closed form ``L/v + 1/f`` for a rest-to-rest line: only
-  the sign of ``s''`` is constrained, so a ramp may reach nearly full speed at full
-  acceleration and *creep* the last ``1e-6`` of it with a tiny acceleration until the
-  phase has lasted ``1/f``. Such a motion costs ``O(FREQ_ACCEL_TOL_REL)`` more than the
-  jerk-limited one (tests/core/test_phases.py shows the checker accepts it). The closed
-  form is the minimum over FIR-shaped profiles (each velocity change a moving average
-  of window ``>= 1/f``), a smaller set.
+* ``D_eff <= t_1 - t_0`` always, so an accepted profile also meets the literal rule;
+* ``D_eff = t_1 - t_0`` for every ramp whose acceleration pulse is symmetric in time: a
+  constant acceleration (BRISK), a jerk-limited S-curve (SOFT), the adapted ramps of the
+  dynamic response adaptation, a moving average (FIR) of a step; back-to-back symmetric
+  ramps of at least ``1/f`` each also pass;
+* it is a statement on lost time: ``int_P (v_1 - v) dt = dv (t_c - t_0)`` and
+  ``int_P (v - v_0) dt = dv (t_1 - t_c)`` (integration by parts; ``v_0, v_1`` the speeds
+  at the phase ends, ``dv`` the change), so the rule says that every phase loses, against
+  either end speed, at least the time a linear ramp of ``1/f`` loses. That is what makes
+  ``L/v + 1/f`` exact and what the lower bound of :mod:`optimal.freq.lower` uses.
 
 Units: s, mm, Hz. numpy only.
 """
@@ -70,6 +81,10 @@ class Phases:
         First and last profile interval the phase touches (inclusive).
     start_tau : numpy.ndarray, shape (P,)
         Start of the phase inside interval ``first``, s from its start.
+    dv : numpy.ndarray, shape (P,)
+        Speed change ``int |s''| dt`` over the phase, mm/s (>= 0).
+    lead : numpy.ndarray, shape (P,)
+        ``t_c - t_0``: from the phase start to its acceleration-weighted mean time, s.
     """
 
     start_t: np.ndarray
@@ -78,11 +93,19 @@ class Phases:
     first: np.ndarray
     last: np.ndarray
     start_tau: np.ndarray
+    dv: np.ndarray
+    lead: np.ndarray
 
     @property
     def duration(self) -> np.ndarray:
         """``end_t - start_t``, s, shape (P,)."""
         return self.end_t - self.start_t
+
+    @property
+    def effective_duration(self) -> np.ndarray:
+        """``2 min(t_c - t_0, t_1 - t_c)``, s, shape (P,): the length the rule judges."""
+        lead = np.clip(self.lead, 0.0, self.duration)
+        return 2.0 * np.minimum(lead, self.duration - lead)
 
     @property
     def n(self) -> int:
@@ -93,7 +116,7 @@ class Phases:
 def _empty() -> Phases:
     z = np.zeros(0)
     i = np.zeros(0, np.int64)
-    return Phases(z, z, np.zeros(0, np.int8), i, i, z)
+    return Phases(z, z, np.zeros(0, np.int8), i, i, z, z, z)
 
 
 def acceleration_phases(profile: Profile, tol_rel: float = FREQ_ACCEL_TOL_REL) -> Phases:
@@ -170,9 +193,57 @@ def acceleration_phases(profile: Profile, tol_rel: float = FREQ_ACCEL_TOL_REL) -
     end_t = t[parent[ends - 1]] + tau1[ends - 1]
     keep = end_t > start_t
     starts, ends = starts[keep], ends[keep]
-    return Phases(start_t=start_t[keep], end_t=end_t[keep], sign=sign[starts].copy(),
+    start_t, end_t = start_t[keep], end_t[keep]
+    dv, lead = _pulse_moments(a0, j, t, parent, tau0, tau1, sign, starts, ends, start_t)
+    return Phases(start_t=start_t, end_t=end_t, sign=sign[starts].copy(),
                   first=parent[starts].astype(np.int64),
-                  last=parent[ends - 1].astype(np.int64), start_tau=tau0[starts].copy())
+                  last=parent[ends - 1].astype(np.int64), start_tau=tau0[starts].copy(),
+                  dv=dv, lead=lead)
+
+
+def _pulse_moments(a0: np.ndarray, j: np.ndarray, t: np.ndarray, parent: np.ndarray,
+                   tau0: np.ndarray, tau1: np.ndarray, sign: np.ndarray,
+                   starts: np.ndarray, ends: np.ndarray, start_t: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Area ``int |a| dt`` and first moment about the phase start of each phase's pulse.
+
+    The pieces ``[starts[p], ends[p])`` of phase ``p`` carry ``a(tau) = a0 + j tau`` on
+    ``[tau0, tau1]`` of their interval; the signed acceleration is multiplied by the
+    phase's sign, so a piece that dips a round-off below zero at its end subtracts its
+    (negligible) share instead of adding it. Moments are taken about the phase start
+    (times of the order of the phase, not of the whole motion: no cancellation).
+
+    Returns
+    -------
+    dv : numpy.ndarray, shape (P,)
+        mm/s.
+    lead : numpy.ndarray, shape (P,)
+        s; ``0`` where ``dv = 0``.
+    """
+    P = starts.size
+    dv = np.zeros(P)
+    mom = np.zeros(P)
+    n_p = ends - starts
+    for lo in range(0, P, _STEP):
+        hi = min(P, lo + _STEP)
+        idx = _ranges(starts[lo:hi], ends[lo:hi])
+        which = np.repeat(np.arange(hi - lo), n_p[lo:hi])
+        k = parent[idx]
+        c0 = a0[k] * sign[idx]
+        c1 = j[k] * sign[idx]
+        u0, u1 = tau0[idx], tau1[idx]
+        # offset of the interval start from the phase start
+        off = t[k] - start_t[lo:hi][which]
+        d1 = u1 - u0
+        d2 = (u1 * u1 - u0 * u0) / 2.0
+        d3 = (u1 ** 3 - u0 ** 3) / 3.0
+        area = c0 * d1 + c1 * d2
+        first = off * area + c0 * d2 + c1 * d3
+        dv[lo:hi] = np.bincount(which, area, minlength=hi - lo)
+        mom[lo:hi] = np.bincount(which, first, minlength=hi - lo)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lead = np.where(dv > 0, mom / np.where(dv > 0, dv, 1.0), 0.0)
+    return np.maximum(dv, 0.0), lead
 
 
 def moving_axes_by_segment(path: Path) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 spec/oracle-formulations 1.9: "Relaxations: T*_acc <= T*_jerk <= T*_freq. Dropping
 constraints always gives a lower bound." So on the same path LB(acc) <= LB(jerk) <=
-LB(jerk+freq) (each bound set's bound is at least the previous one's: the jerk oracle
+LB(jerk+freq), and likewise through acc+freq (each bound set's bound is at least the previous one's: the jerk oracle
 starts from the acc bound, the freq oracle from the jerk bound) and, for the verified
 motions, UB(acc) <= UB(jerk) <= UB(jerk+freq) within the brackets: UB(acc) is at most
 the acc bracket above T*_acc <= T*_jerk <= UB(jerk), and likewise one step up.
@@ -37,14 +37,16 @@ def test_relaxation_chain(program, machine):
     holds = imposed_holds(prog, path, m)
     lim = m.limits
     sols = {b: optimal.solve(path, lim, bounds=b, holds=holds, initial_intervals=200)
-            for b in ("acc", "jerk", "jerk+freq")}
-    lb = [sols[b].lower_bound_s for b in ("acc", "jerk", "jerk+freq")]
-    ub = [sols[b].upper_bound_s for b in ("acc", "jerk", "jerk+freq")]
-    gap = [sols[b].upper_bound_s - sols[b].lower_bound_s for b in ("acc", "jerk", "jerk+freq")]
-    assert lb[0] <= lb[1] <= lb[2]
-    assert ub[0] <= ub[1] + gap[0] and ub[1] <= ub[2] + gap[1]
-    assert all(lo <= hi for lo, hi in zip(lb, ub))
-    f = sols["jerk+freq"]
-    assert f.status in ("optimal", "gap_not_met") and f.bounds == "jerk+freq"
-    motion = f.profile
-    assert check_profile(path, lim, motion).ok(BOUND_SETS["jerk+freq"])
+            for b in ("acc", "jerk", "acc+freq", "jerk+freq")}
+    # both chains: acc <= jerk <= jerk+freq and acc <= acc+freq <= jerk+freq
+    for chain in (("acc", "jerk", "jerk+freq"), ("acc", "acc+freq", "jerk+freq")):
+        lb = [sols[b].lower_bound_s for b in chain]
+        ub = [sols[b].upper_bound_s for b in chain]
+        gap = [sols[b].upper_bound_s - sols[b].lower_bound_s for b in chain]
+        assert lb[0] <= lb[1] <= lb[2], chain
+        assert ub[0] <= ub[1] + gap[0] and ub[1] <= ub[2] + gap[1], chain
+        assert all(lo <= hi for lo, hi in zip(lb, ub))
+    for b in ("acc+freq", "jerk+freq"):
+        f = sols[b]
+        assert f.status in ("optimal", "gap_not_met") and f.bounds == b
+        assert check_profile(path, lim, f.profile).ok(BOUND_SETS[b])

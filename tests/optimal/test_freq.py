@@ -116,17 +116,19 @@ def test_relaxation_chain_on_hand_paths(case):
 
 def test_frequency_bound_decides_many_short_exact_stop_moves():
     # ten 0.2 mm moves with exact stops, f = 2 Hz: each piece needs a rise and a fall of
-    # 0.5 s, so S = 10 s; the jerk bound alone is about 0.4 s. The proof's alternative
-    # (optimal/freq/lower.py): a piece crossed with |s''| <= 1e-6 a_bar everywhere
-    # (a_bar = 2000 mm/s^2 on a line of X alone) takes tau with
-    # 1e-6 a_bar tau^2 + 1e-6 tau = 0.2 mm, about 10 s as well
+    # (effective) 0.5 s, so 1 s per piece and 10 s in all; the jerk bound alone is about
+    # 0.4 s. The proof's alternative per piece (optimal/freq/lower.py): a piece crossed
+    # with |s''| <= 1e-6 a_bar everywhere (a_bar = 2000 mm/s^2 on a line of X alone)
+    # takes tau with 1e-6 a_bar tau^2 + 1e-6 tau = 0.2 mm, about 10 s, more than 1 s;
+    # the lost-time bound L/v + 1/f is 0.502 s, less
     pts = [[0.2 * i, 0, 0] for i in range(11)]
     path = line_path(pts, feed=100.0, stops=("start",) + ("exact",) * 9 + ("end",))
     lim = machine(f=2.0)
     frq = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
     c = 1e-6 * 2000.0 * (1 + RATIO_TOL)
     tau = 2 * 0.2 / (1e-6 + np.sqrt(1e-12 + 4 * c * 0.2))
-    assert frq.lower_bound_s == pytest.approx(min(10.0 / (1 + RATIO_TOL), tau), rel=1e-12)
+    assert tau > 1.0
+    assert frq.lower_bound_s == pytest.approx(10 * 2 * 0.5 / (1 + RATIO_TOL), rel=1e-12)
     assert frq.lower_bound_s > 9.99
     assert frq.lower_bound_s <= frq.upper_bound_s
     assert check_profile(path, lim, frq.profile).ok(BOUND_SETS["jerk+freq"])
