@@ -71,10 +71,15 @@ __all__ = ["freq_lower_bound", "piece_lower_bounds", "rest_pieces", "segment_per
            "segment_speed_caps"]
 
 
-def rest_pieces(path: Path) -> np.ndarray:
-    """Segment index ranges of the rest-to-rest pieces, shape (P, 2): ``[lo, hi)``."""
+def rest_pieces(path: Path, extra_breaks: np.ndarray | None = None) -> np.ndarray:
+    """Segment index ranges of the rest-to-rest pieces, shape (P, 2): ``[lo, hi)``.
+
+    Pieces end at the stop breaks (``path.stop``) and at ``extra_breaks`` (break indices
+    where a motion is at rest anyway, e.g. corners whose speed cap is zero).
+    """
     stops = np.flatnonzero(path.stop)
-    cuts = np.unique(np.concatenate(([0], stops, [path.n_segments])))
+    extra = np.zeros(0, np.int64) if extra_breaks is None else np.asarray(extra_breaks)
+    cuts = np.unique(np.concatenate(([0], stops, extra, [path.n_segments])))
     return np.stack((cuts[:-1], cuts[1:]), axis=1)
 
 

@@ -8,7 +8,9 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
 2. lower bound: ``max`` of the base oracle's certified bound (``base`` is a relaxation
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
    (proof there), plus the holds;
-3. upper bound: the faster of the verified candidates of :mod:`optimal.freq.upper`;
+3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
+   (the base optimum slowed down, the filtered acc optimum, the filtered eroded-caps
+   motion);
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -37,10 +39,12 @@ from .upper import eroded_plan, fir_filtered, scaled, verified
 
 ProgressFn = Callable[..., object]
 
-#: Factors on the axis accelerations of the extra acc solves whose FIR-filtered optima
-#: are candidates (1 is always tried). Higher factors give shorter ramps, closer to the
-#: FIR closed form on lines, but faster arcs (then slowed down by the checker's scaling).
-FIR_ACCEL_FACTORS = (2.0, 4.0, 8.0)
+#: Factors on the axis accelerations of extra acc solves whose FIR-filtered optima are
+#: candidates (the optimum itself is always one). Raised accelerations give shorter
+#: ramps, which leave more of each phase to the filter; since the eroded-caps candidate
+#: (optimal.freq.upper.eroded_plan) they won on none of the corpus programs or hand
+#: cases, so none is solved by default (each costs one acc solve).
+FIR_ACCEL_FACTORS: tuple[float, ...] = ()
 
 
 def _raised(limits: MachineLimits, g: float) -> MachineLimits:
@@ -130,17 +134,16 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     lim_w = limits.for_axes(work.axes)
     T_max = float(np.max(segment_periods(work, lim_w), initial=0.0))
     if T_max > 0:
-        W = max(T_max, float(np.max(lim_w.a_max) / np.min(lim_w.j_max))) if base == "jerk" \
-            else T_max
         try:
-            u = eroded_plan(path, limits, W)
+            u = eroded_plan(path, limits, T_max, base == "jerk")
         except ProfileError:
-            # a cap of zero inside a piece (a corner without velocity-jump allowance)
-            # leaves the eroded motion stuck there: no candidate from this construction
+            # the eroded caps leave an interval at zero speed at both ends (cannot be
+            # crossed): no candidate from this construction
             u = None
         if u is not None:
             c = verified("fir (eroded caps)", path, limits,
-                         fir_filtered(path, limits, u, base == "jerk"), name)
+                         fir_filtered(path, limits, u.profile, base == "jerk",
+                                      u.rest_breaks), name, u.rest_breaks)
             if c is not None:
                 cands.append(c)
     t_check = time.perf_counter() - tc
