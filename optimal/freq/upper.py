@@ -449,7 +449,7 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     cap = np.sqrt(b_cap)
     rest_nodes = np.concatenate((grid.break_node[work.stop], grid.break_node[rest]))
     cap[grid.break_node[rest]] = np.inf          # rests are piece ends, not caps
-    cap = np.minimum(cap, vcap)
+    b = cone_envelope(grid.s, cap, W) ** 2
     b = cone_envelope(grid.s, cap, W) ** 2
     b[rest_nodes] = 0.0
     # tangential acceleration left at the eroded speed, per interval (both ends)
@@ -476,7 +476,7 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         dip = np.zeros(rv.size, bool)
         dip[1:-1] = (rv[:-2] > rv[1:-1]) & (rv[2:] > rv[1:-1])
         low = np.repeat(dip, np.diff(np.concatenate((starts, [v.size]))))
-        low[rest_nodes] = False
+        v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
         v_top = float(np.max(v))
         v[rest_nodes] = vcap           # nor are the rests themselves narrow dips
