@@ -253,6 +253,9 @@ ERODED_GRID_MIN, ERODED_GRID_MAX = 2_000, 200_000
 #: of the smallest axis acceleration: where the caps leave none (a speed at the curvature
 #: limit), the motion still moves, and the checker's time scaling pays for it.
 ERODED_MIN_ACCEL_SHARE = 0.05
+#: Rounds in which :func:`eroded_plan` re-evaluates the tangential acceleration at the
+#: speeds its passes reached (the checker judges the result; more rounds change little).
+TANGENTIAL_ROUNDS = 2
 #: Bisection steps of the cone envelope in :func:`eroded_plan` (relative resolution
 #: 2^-48 of the largest cap: below round-off of the speeds it feeds).
 ENVELOPE_BISECTIONS = 48
@@ -452,15 +455,26 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     b = cone_envelope(grid.s, cap, W) ** 2
     b = cone_envelope(grid.s, cap, W) ** 2
     b[rest_nodes] = 0.0
-    # tangential acceleration left at the eroded speed, per interval (both ends)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rem0 = (lim.a_max[None, :] - np.abs(ddq0) * b[:-1, None]) / np.abs(dq0)
-        rem1 = (lim.a_max[None, :] - np.abs(ddq1) * b[1:, None]) / np.abs(dq1)
-    rem0 = np.where(np.abs(dq0) > 0, rem0, np.inf).min(axis=1)
-    rem1 = np.where(np.abs(dq1) > 0, rem1, np.inf).min(axis=1)
-    a_t = np.maximum(np.minimum(rem0, rem1), ERODED_MIN_ACCEL_SHARE * float(np.min(lim.a_max)))
-    step = 2.0 * a_t * np.diff(grid.s)
-    b = _passes(b, step)
+    # tangential acceleration the axes have left beside the curvature term at the speed
+    # reached, per interval (both ends): first at the eroded caps (the least), then at
+    # the passes' own speeds, which are lower where a ramp has not reached the cap yet
+    floor = ERODED_MIN_ACCEL_SHARE * float(np.min(lim.a_max))
+    ds_n = np.diff(grid.s)
+
+    def steps(b_at: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rem0 = (lim.a_max[None, :] - np.abs(ddq0) * b_at[:-1, None]) / np.abs(dq0)
+            rem1 = (lim.a_max[None, :] - np.abs(ddq1) * b_at[1:, None]) / np.abs(dq1)
+        rem0 = np.where(np.abs(dq0) > 0, rem0, np.inf).min(axis=1)
+        rem1 = np.where(np.abs(dq1) > 0, rem1, np.inf).min(axis=1)
+        return 2.0 * np.maximum(np.minimum(rem0, rem1), floor) * ds_n
+
+    b_caps = b
+    step = steps(b_caps)
+    b = _passes(b_caps, step)
+    for _ in range(TANGENTIAL_ROUNDS):
+        step = steps(b)
+        b = _passes(b_caps, step)
     # a dip or a bump that u crosses in less than W leaves phases of its own width after
     # the filter (a moving average spreads a step over W, not a pulse): dips are widened
     # to plateaus crossed in W (the cone envelope of u itself) and narrower bumps cut
