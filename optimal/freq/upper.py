@@ -478,7 +478,7 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     # a dip or a bump that u crosses in less than W leaves phases of its own width after
     # the filter (a moving average spreads a step over W, not a pulse): dips are widened
     # to plateaus crossed in W (the cone envelope of u itself) and narrower bumps cut
-    # (an opening about W max(u) / 2 wide), then the passes again
+    # (an opening of width W in time), then the passes again
     s_n = grid.s
     for _ in range(REGULARISE_ROUNDS):
         v = np.sqrt(np.maximum(b, 0.0))
@@ -492,15 +492,17 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         low = np.repeat(dip, np.diff(np.concatenate((starts, [v.size]))))
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
-        v_top = float(np.max(v))
-        v[rest_nodes] = vcap           # nor are the rests themselves narrow dips
-        # one window of nodes for all: a flat opening preserves monotone sequences
-        # exactly (a varying or spatial window cuts steps into ramps); its half-width is
-        # the largest speed's W/2 in typical node spacings, so that it cuts what is
-        # crossed fastest too
-        k = int(np.ceil(0.5 * W * v_top / float(np.median(np.diff(s_n)))))
-        idx = np.arange(v.size)
-        lo, hi = np.maximum(idx - k, 0), np.minimum(idx + k + 1, v.size)
+        # the bumps are cut by an opening in *time* (window W, the time at which u
+        # reaches each node): a flat opening of constant width in its parameter keeps
+        # monotone ramps and removes exactly the peaks narrower than W; the rests are
+        # piece ends, not dips, for it
+        v_nodes = np.sqrt(np.maximum(b, 0.0))
+        vs = v_nodes[:-1] + v_nodes[1:]
+        t_n = np.concatenate(([0.0], np.cumsum(np.where(vs > 0, 2.0 * ds_n / np.where(
+            vs > 0, vs, 1.0), 0.0))))
+        v[rest_nodes] = vcap
+        lo = np.searchsorted(t_n, t_n - 0.5 * W, side="left")
+        hi = np.searchsorted(t_n, t_n + 0.5 * W, side="right")
         opened = -_window_min(-_window_min(v, lo, hi), lo, hi)
         b = np.minimum(b, np.minimum(opened, v) ** 2)
         b[rest_nodes] = 0.0
@@ -521,14 +523,17 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         short = np.flatnonzero(ph.effective_duration < need * (1.0 - ADAPT_MARGIN))
         if short.size == 0:
             break
-        a_cap = np.full(ds.size, np.inf)
-        # the mean acceleration slowed by the stretch still missing (a phase cut by the
-        # grid into unequal pieces is not quite symmetric: the next round corrects it)
-        a_new = (ph.dv / ph.duration) * ph.effective_duration / (need * (1.0 + ADAPT_MARGIN))
+        # the mean acceleration of a linear ramp of the needed length; a phase already
+        # at it (cut by the grid into unequal pieces, not quite symmetric) is slowed by
+        # the stretch still missing, at most halved per round
+        a_new = ph.dv / (need * (1.0 + ADAPT_MARGIN))
+        shrink = np.clip(ph.effective_duration / (need * (1.0 + ADAPT_MARGIN)), 0.5, 1.0)
         for p_ in short:
             sl = slice(int(ph.first[p_]), int(ph.last[p_]) + 1)
-            a_cap[sl] = np.minimum(a_cap[sl], a_new[p_])
-        step = np.minimum(step, 2.0 * a_cap * ds)
+            a_now = step[sl] / (2.0 * ds[sl])
+            a_set = np.where(a_now <= a_new[p_] * (1.0 + 1e-9), a_now * shrink[p_],
+                             a_new[p_])
+            step[sl] = 2.0 * a_set * ds[sl]
         b = _passes(b_env, step)
     prof = Profile.from_path_velocity(s_n, np.sqrt(np.maximum(b, 0.0)), blocks)
     return ErodedPlan(profile=prof, rest_breaks=rest, window_s=W)
