@@ -38,12 +38,14 @@ def prefixed(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
 
 
 #: Bound sets the ``--bounds`` option names (``auto`` picks one, see :func:`resolve_bounds`).
-BOUND_CHOICES = ("auto", "acc", "jerk", "jerk+freq")
+BOUND_CHOICES = ("auto", "acc", "jerk", "acc+freq", "jerk+freq")
 
 
 #: Bound sets ``--bounds auto`` may pick: the planner's own (``acc`` for BRISK, ``jerk``
-#: for SOFT), so the gap compares like with like and both of its ends mean something.
-AUTO_BOUND_SETS = ("acc", "jerk")
+#: for SOFT, each ``+freq`` where the dynamic response adaptation is active and the plan
+#: meets the frequency rule), so the gap compares like with like and both of its ends
+#: mean something.
+AUTO_BOUND_SETS = ("acc", "jerk", "acc+freq", "jerk+freq")
 
 
 class BoundsNotAvailable(FeedOracleError, ValueError):

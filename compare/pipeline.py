@@ -351,7 +351,7 @@ def compare_program(program: ProgramLike, machine: MachineLike = None, *,
     ----------
     program, machine, dialect
         See :func:`load_inputs`.
-    bounds : {"auto", "acc", "jerk", "jerk+freq"}
+    bounds : {"auto", "acc", "jerk", "acc+freq", "jerk+freq"}
         Oracle bound set; ``"auto"`` takes the heuristic's own where the oracle solves
         it, else ``"acc"`` with a note in :attr:`Comparison.notes`.
     tol : float, optional

@@ -44,12 +44,13 @@ from .solution import IterationRecord, OptimalSolution
 from .upper import line_tents, upper_interval_times, verified_profile
 from .status import SolveStatus
 from .jerk.tolerances import DEFAULT_JERK_GAP_TOL
+from .freq.oracle import DEFAULT_FREQ_GAP_TOL
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
                          DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE,
                          LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET,
                          SLOPE_SOLVES)
 
-SUPPORTED_BOUNDS = ("acc", "jerk")
+SUPPORTED_BOUNDS = ("acc", "jerk", "acc+freq", "jerk+freq")
 
 ProgressFn = Callable[[str, float], None]
 
@@ -283,7 +284,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     limits : MachineLimits
         Machine limits; must define every axis of the path.
     bounds : str
-        Bound set: ``"acc"`` (velocity and acceleration) or ``"jerk"`` (also axis jerk;
+        Bound set: ``"acc"`` (velocity and acceleration), ``"acc+freq"`` and
+        ``"jerk+freq"`` (also the frequency rule; :func:`optimal.freq.solve_freq`, default
+        gap 2 %) or ``"jerk"`` (also axis jerk;
         solved by :func:`optimal.jerk.solve_jerk`, see there; ``backend``,
         ``backend_options``, ``max_grid`` and ``max_iterations`` then apply to the
         ``acc`` solve inside it, ``initial_intervals`` to its NLP grid).
@@ -335,7 +338,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         raise ValueError(f"bound set {bounds!r} is not supported by the oracle yet "
                          f"(supported: {', '.join(SUPPORTED_BOUNDS)})")
     if tol is None:
-        tol = DEFAULT_JERK_GAP_TOL if bounds == "jerk" else DEFAULT_GAP_TOL
+        tol = {"jerk": DEFAULT_JERK_GAP_TOL, "acc+freq": DEFAULT_FREQ_GAP_TOL,
+               "jerk+freq": DEFAULT_FREQ_GAP_TOL}.get(bounds, DEFAULT_GAP_TOL)
     if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
         raise ValueError(f"tol = {tol!r}: must be a finite number > 0")
     if not (isinstance(max_grid, int) and max_grid >= 2):
@@ -345,6 +349,14 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     if initial_intervals is not None and not (isinstance(initial_intervals, int)
                                               and initial_intervals >= 1):
         raise ValueError(f"initial_intervals = {initial_intervals!r}: must be an int >= 1")
+    if bounds in ("acc+freq", "jerk+freq"):
+        # the frequency oracle (optimal.freq) runs the base (and acc) oracles inside
+        from .freq import solve_freq
+        inner = partial(solve, backend=backend, backend_options=backend_options,
+                        max_grid=max_grid, max_iterations=max_iterations,
+                        initial_intervals=initial_intervals)
+        return solve_freq(path, limits, solve=inner, base=bounds.split("+")[0], tol=tol,
+                          holds=holds, progress=progress)
     if bounds == "jerk":
         from .jerk.backends import NLP_BACKENDS
         if nlp_backend not in NLP_BACKENDS:

@@ -60,14 +60,19 @@ Constraints (:data:`CONSTRAINTS`)
     the same speed enters ``velocity_jump``. Only the velocity is required; start/end accelerations are not judged here
     (a non-zero one shows up as a jerk step).
 ``frequency``
-    DESIGN section 6: no velocity-change process may be shorter than ``1/f``, ``f`` the
-    smallest LOOKAH_FREQUENCY of the axes moving during it. A process is a maximal time
-    span in which the path acceleration keeps one sign and is not zero
-    (``|s''| > FREQ_ACCEL_TOL_REL * max|s''|``), across knots; holds, constant-velocity
-    spans and sign changes separate processes, while an acceleration that only touches
-    zero for an instant (two S-ramps back to back) does not end one. Value ``1/duration`` (Hz), limit ``f``
-    (Hz), so the ratio is ``(1/f) / duration``; the place is the start of the shortest
-    process and the axis is the moving axis with the smallest ``f``.
+    DESIGN section 6, the rule of :mod:`reference.core.phases` (one definition for the
+    checker, the heuristic and the oracle): every acceleration or deceleration phase (a
+    maximal time span in which the path acceleration keeps one sign and is not zero,
+    ``|s''| > FREQ_ACCEL_TOL_REL * max|s''|``, across knots; holds, constant-velocity
+    spans and sign changes separate phases, while an acceleration that only touches
+    zero for an instant, two S-ramps back to back, does not end one) lasts at least
+    ``1/f``, ``f`` the smallest LOOKAH_FREQUENCY of the axes moving during it, its length
+    measured as the effective duration ``2 min(t_c - t_0, t_1 - t_c)`` about the
+    acceleration-weighted mean time ``t_c`` (equal to the duration for symmetric ramps;
+    why, in :mod:`reference.core.phases`). Value ``1/D_eff`` (Hz), limit ``f`` (Hz), so
+    the ratio is ``(1/f) / D_eff``; the place (``t``, ``s``, block) is the start of the
+    shortest phase relative to its limit and the axis is the moving axis with the
+    smallest ``f``.
 
 Evaluation inside intervals and its error
 -----------------------------------------
@@ -122,15 +127,17 @@ import numpy as np
 from .errors import ProfileError
 from .geometry import Path, clothoid_derivative_norms, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
+from .phases import (FREQ_ACCEL_TOL_REL, acceleration_phases, min_phase_duration,
+                     phase_frequencies)
 from .profile import Profile
 from .rules import (STEPS_AT_BREAKS, STEPS_SPREAD, axis_acceleration, axis_jerk,
                     axis_velocity, axis_velocity_jumps, curvature_jumps, jump_ratio,
                     step_jerk_limit)
-from .tolerances import (ACCEL_CONTINUITY_TOL_REL, MOVING_AXIS_TOL, POS_TOL_MM, RATIO_TOL,
+from .tolerances import (ACCEL_CONTINUITY_TOL_REL, POS_TOL_MM, RATIO_TOL,
                          VEL_TOL_MM_S)
 
-__all__ = ["BOUND_SETS", "CONSTRAINTS", "ConstraintReport", "ConstraintResult", "UNITS",
-           "check_profile", "scale_time", "time_scale_factor"]
+__all__ = ["BOUND_SETS", "CONSTRAINTS", "FREQ_ACCEL_TOL_REL", "ConstraintReport", "ConstraintResult", "UNITS",
+           "check_profile", "scale_time", "time_scale_factor", "time_scale_factors_by_block"]
 
 #: Every constraint the checker evaluates, in report order.
 CONSTRAINTS: tuple[str, ...] = ("velocity", "acceleration", "jerk", "feed", "velocity_jump",
@@ -141,6 +148,7 @@ _ACC_SET = ("velocity", "acceleration", "feed", "velocity_jump", "stop")
 BOUND_SETS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "acc": _ACC_SET,
     "jerk": _ACC_SET + ("jerk",),
+    "acc+freq": _ACC_SET + ("frequency",),
     "jerk+freq": _ACC_SET + ("jerk", "frequency"),
 })
 
@@ -173,12 +181,6 @@ CHUNK_SAMPLES = 65_536
 #: ``CHUNK_SAMPLES``, which also sets how a long arc interval is cut into pieces).
 _WORK_CHUNK = CHUNK_SAMPLES
 
-#: Path accelerations below this fraction of the profile's largest |s''| count as zero
-#: when cutting the motion into velocity-change processes. It absorbs the round-off of
-#: a = 0 phases (a = dv/dt of equal speeds, about 1e-12 relative) and solver noise of a
-#: few 1e-7, while a process whose acceleration stays below 1e-6 of the profile's
-#: largest one changes the speed by a negligible amount and excites nothing.
-FREQ_ACCEL_TOL_REL = 1e-6
 
 
 # =========================================================================== results
@@ -899,103 +901,34 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
 
 
 def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
-    """Shortest velocity-change process against 1/f of the axes moving in it."""
-    p, path, lim = ctx.prof, ctx.path, ctx.lim
-    h = ctx.h
-    a0, j = p.a, p.j
-    K = h.size
-    # Per-interval and per-piece work in chunks of intervals: 10^6 blocks make ~5e6
-    # pieces, and a dozen whole-length temporaries would be some 400 MB at once.
-    step = _WORK_CHUNK
-    scale = 0.0
-    for lo in range(0, K, step):
-        hi = min(K, lo + step)
-        a1 = a0[lo:hi] + j[lo:hi] * h[lo:hi]
-        scale = max(scale, float(np.max(np.abs(a0[lo:hi]))), float(np.max(np.abs(a1))))
-    if scale == 0.0:
+    """Shortest acceleration phase against 1/f of the axes moving in it (the rule of
+    :mod:`reference.core.phases`)."""
+    p, path = ctx.prof, ctx.path
+    ph = acceleration_phases(p)
+    if ph.n == 0:
         return
-    tol = FREQ_ACCEL_TOL_REL * scale
-    parents, signs, taus0, taus1 = [], [], [], []
-    for lo in range(0, K, step):
-        hi = min(K, lo + step)
-        c_a0, c_j, c_h = a0[lo:hi], j[lo:hi], h[lo:hi]
-        c_a1 = c_a0 + c_j * c_h
-        # pieces: intervals cut where a(tau), linear in tau, changes sign clearly (both
-        # ends beyond tol); an end within tol of zero is a touch, not a change of sign, so
-        # that round-off at the end of a ramp (a = -1e-13 instead of 0) cannot split a
-        # process
-        cross = (c_j != 0) & (c_a0 * c_a1 < 0) & (np.abs(c_a0) > tol) & (np.abs(c_a1) > tol)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tz = np.where(cross, -c_a0 / np.where(cross, c_j, 1.0), 0.0)
-        npc = 1 + cross.astype(np.int64)
-        local = np.repeat(np.arange(hi - lo), npc)
-        second = np.zeros(local.size, bool)
-        second[np.cumsum(npc)[cross] - 1] = True
-        first_of_two = np.repeat(cross, npc) & ~second
-        tau0 = np.where(second, tz[local], 0.0)
-        tau1 = np.where(first_of_two, tz[local], c_h[local])
-        pa0 = c_a0[local] + c_j[local] * tau0
-        pa1 = c_a0[local] + c_j[local] * tau1
-        amax = np.maximum(np.abs(pa0), np.abs(pa1))
-        moving = (p.s[lo + 1:hi + 1] > p.s[lo:hi])[local]
-        dominant = np.where(np.abs(pa1) > np.abs(pa0), pa1, pa0)
-        signs.append(np.where((amax > tol) & moving, np.sign(dominant), 0.0).astype(np.int8))
-        parents.append(local + lo)
-        taus0.append(tau0)
-        taus1.append(tau1)
-    sign = np.concatenate(signs)
-    del signs
-    if not np.any(sign):
-        return
-    parent = np.concatenate(parents)
-    del parents
-    tau0 = np.concatenate(taus0)
-    del taus0
-    tau1 = np.concatenate(taus1)
-    del taus1
-    starts = np.concatenate(([0], np.flatnonzero(np.diff(sign)) + 1))
-    ends = np.concatenate((starts[1:], [sign.size]))
-    nz = sign[starts] != 0
-    del sign
-    t0_start = p.t[parent[starts]] + tau0[starts]
-    dur = (p.t[parent[ends - 1]] + tau1[ends - 1]) - t0_start
-    del tau1
-    # axes that can move on each piece's segment, OR-ed over each run of pieces
-    seg = ctx.seg
-    rw = path.radius * np.abs(path.omega)
-    reach = np.abs(path.d) + rw[:, None] * (np.abs(path.e1) + np.abs(path.e2))
-    seg_moving = (reach > MOVING_AXIS_TOL).astype(np.uint8)
-    del rw, reach
-    piece_moving = seg_moving[seg[parent]]
-    run_moving = np.maximum.reduceat(piece_moving, starts, axis=0).astype(bool)
-    del piece_moving, seg_moving
-    f = np.where(run_moving, lim.frequency_hz[None, :], np.inf)
-    del run_moving
-    f_min = f.min(axis=1)
-    ax = f.argmin(axis=1)
-    del f
-    ok = nz & np.isfinite(f_min) & (dur > 0)
+    f_min, ax = phase_frequencies(path, ctx.lim, ph, ctx.seg)
+    dur = ph.effective_duration
+    ok = np.isfinite(f_min) & (dur > 0)
     if not np.any(ok):
         return
-    starts, ends, dur, f_min, ax = starts[ok], ends[ok], dur[ok], f_min[ok], ax[ok]
-    t0_start = t0_start[ok]
-    ratio = (1.0 / f_min) / dur
-    # per block: every block a process touches (in chunks of processes)
+    need = min_phase_duration(f_min)
+    ratio = np.where(ok, need / np.where(dur > 0, dur, 1.0), 0.0)
+    # per block: every block a phase touches (in chunks of phases)
     if w.per_block.size:
-        for r0 in range(0, starts.size, step):
-            r1 = min(starts.size, r0 + step)
-            n_r = ends[r0:r1] - starts[r0:r1]
-            pieces = _ranges(starts[r0:r1], ends[r0:r1])
-            np.maximum.at(w.per_block, path.block[seg[parent[pieces]]],
-                          np.repeat(ratio[r0:r1], n_r))
+        sel = np.flatnonzero(ok)
+        for r0 in range(0, sel.size, _WORK_CHUNK):
+            q = sel[r0:r0 + _WORK_CHUNK]
+            n_r = ph.last[q] - ph.first[q] + 1
+            idx = _ranges(ph.first[q], ph.last[q] + 1)
+            np.maximum.at(w.per_block, path.block[ctx.seg[idx]], np.repeat(ratio[q], n_r))
     i = int(np.argmax(ratio))
-    pc = starts[i]
-    k = parent[pc]
-    s_at, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], tau0[pc])
+    k = int(ph.first[i])
+    s_at, _, _ = _poly(p.s[k], p.v[k], p.a[k], p.j[k], ph.start_tau[i])
     w.found = True
     w.ratio, w.value, w.limit = float(ratio[i]), float(1.0 / dur[i]), float(f_min[i])
-    w.s, w.t = float(s_at), float(t0_start[i])
-    w.block = int(path.block[seg[k]])
+    w.s, w.t = float(s_at), float(ph.start_t[i])
+    w.block = int(path.block[ctx.seg[k]])
     w.axis = path.axes[int(ax[i])]
 
 
@@ -1053,6 +986,31 @@ def time_scale_factor(report: ConstraintReport, constraints: Iterable[str]) -> f
             if r > 1.0:
                 lam = max(lam, r ** (1.0 / _POWER[key]))
     return float(lam)
+
+
+def time_scale_factors_by_block(report: ConstraintReport,
+                                constraints: Iterable[str]) -> np.ndarray:
+    """Per program block, the factor :func:`time_scale_factor` would need there.
+
+    The same powers as :func:`time_scale_factor`, applied to ``report.block_ratios``; the
+    jerk ratio is not split by block into interval and step parts, so the safe (slower)
+    ``1/lam^2`` is assumed for it. Stretching only a part of a motion is valid where that
+    part starts and ends at rest (a stop), which the caller must ensure.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_blocks,)
+        ``>= 1``; ``inf`` where a ratio is infinite.
+    """
+    out = None
+    for name in _names(constraints):
+        r = np.asarray(report.block_ratios.get(name, np.zeros(0)), dtype=np.float64)
+        if r.size == 0:
+            continue
+        power = 2 if name == "jerk" else _POWER[name]
+        lam = np.where(r > 1.0, r ** (1.0 / power), 1.0)
+        out = lam if out is None else np.maximum(out, lam)
+    return np.ones(0) if out is None else out
 
 
 def scale_time(profile: Profile, lam: float) -> Profile:

@@ -202,6 +202,9 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
 
     report_progress("adaptation", 0.7)
     adapt = tuple(ch.adapt_path_dynamic)
+    # the factor of each segment's mode (BRISK and DRIVE: index 0, SOFT: index 1)
+    adapt_active = bool(units.n_units) and bool(np.any(
+        np.asarray(adapt)[modes.jerk_limited.astype(np.int64)] > 1.0))
     if max(adapt) > 1.0 and units.n_units:
         n_ad = 0
         for _ in range(params.adaptation_rounds):
@@ -251,6 +254,12 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
         trace.append(("check", f"bound set {bound_set!r}: " + (
             "no violations" if not viol else
             "; ".join(f"{v.constraint} ratio {v.ratio:.6g}" for v in viol))))
+        if adapt_active:
+            bound_set, note = _declared_with_frequency(bound_set, report)
+            trace.append(("check", note))
+    elif adapt_active:
+        trace.append(("check", f"frequency rule not declared: the plan was not checked "
+                               f"(bound set {bound_set!r})"))
     trace.append(("time", f"planned {profile.duration:.6g} s in "
                           f"{time.perf_counter() - t_start:.3g} s wall time"))
     report_progress("done", 1.0)
@@ -259,6 +268,25 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
                          trace=tuple(TraceEntry(*e) for e in trace),
                          bound_set=bound_set, report=report, limits=limits,
                          parameters=params, holds=holds, segment_cause=seg_cause)
+
+
+def _declared_with_frequency(base: str, report) -> tuple[str, str]:
+    """The bound set the plan declares when the dynamic response adaptation is active.
+
+    Adaptation stretches velocity changes towards ``1/f`` (model note 7.4), but by at most
+    ADAPT_PATH_DYNAMIC, and re-planning may shorten a stretched change again: the plan
+    declares the frequency rule (``base + "+freq"``) only when its own profile meets it,
+    and otherwise says where the shortest phase is.
+    """
+    cand = f"{base}+freq"
+    w = report.worst("frequency")
+    if report.ok(BOUND_SETS[cand]):
+        return cand, (f"bound set {cand!r}: the adapted plan meets the frequency rule "
+                      f"(shortest phase at ratio {w.ratio:.6g})")
+    return base, (f"frequency rule not declared (bound set stays {base!r}): the phase "
+                  f"starting at t = {w.t:.6g} s in block {w.block} lasts {1 / w.value:.6g} s "
+                  f"(effective) < 1/f = {1 / w.limit:.6g} s of axis {w.axis}; "
+                  f"ADAPT_PATH_DYNAMIC limits the stretching")
 
 
 def _cause_counts(what: str, codes: np.ndarray) -> str:

@@ -137,7 +137,7 @@ def test_bad_input_exits_2_without_traceback(case, tmp_path):
     prog.write_text("G1 X10 F1000\nG1 Y10\n")
     args = {"missing": ["compare", tmp_path / "nope.mpf"],
             "syntax": ["compare", tmp_path / "bad.mpf"],
-            "bounds": ["compare", prog, "--bounds", "jerk+freq", "--no-report"],
+            "bounds": ["compare", prog, "--bounds", "snap", "--no-report"],
             "max_gap": ["compare", prog, "--max-gap", "lots"],
             "machine": ["compare", prog, "--machine", tmp_path / "m.toml"]}[case]
     (tmp_path / "bad.mpf").write_text("G1 X10 F100\nG1 Y1O\n")
@@ -151,6 +151,7 @@ def test_bad_input_exits_2_without_traceback(case, tmp_path):
     if case == "syntax":
         assert f"{tmp_path / 'bad.mpf'}:2:" in r.stderr
     if case == "bounds":
-        assert "bound set 'jerk+freq' is not available yet; use --bounds acc or jerk" in r.stderr
+        # every bound set is solvable now (jerk+freq since issue 12): an unknown one
+        assert "snap" in r.stderr
     if case == "max_gap":
         assert "--max-gap 'lots'" in r.stderr

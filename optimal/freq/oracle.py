@@ -1,0 +1,207 @@
+"""``optimal.solve(..., bounds="acc+freq" | "jerk+freq")``: the frequency-bounded oracle.
+
+Pipeline (``base`` is ``acc`` or ``jerk``):
+
+1. the ``base`` oracle and the ``acc`` oracle on the same path, without the imposed
+   holds (they are a constant added to both bounds and inserted at the end, as the other
+   bound sets do; a motion with its holds cannot be time-scaled);
+2. lower bound: ``max`` of the base oracle's certified bound (``base`` is a relaxation
+   of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
+   (proof there), plus the holds;
+3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
+   (the base optimum slowed down, the filtered acc optimum, the filtered eroded-caps
+   motion);
+4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
+   both valid bounds; ``solver_error`` when no candidate could be verified.
+
+Units: mm, s.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable
+
+import numpy as np
+
+from reference.core.errors import ProfileError
+from reference.core.geometry import Path
+from reference.core.holds import NO_HOLDS, Holds, dwell_holds, with_holds
+from reference.core.limits import MachineLimits
+from reference.core.profile import Profile
+from reference.core.rows import block_motion, block_rows
+
+from ..solution import IterationRecord, OptimalSolution
+from ..status import SolveStatus
+from .lower import freq_lower_bound
+from .lower import segment_periods
+from .upper import eroded_plan, fir_filtered, scaled, verified
+
+ProgressFn = Callable[..., object]
+
+#: Factors on the axis accelerations of extra acc solves whose FIR-filtered optima are
+#: candidates (the optimum itself is always one). Raised accelerations give shorter
+#: ramps, which leave more of each phase to the filter; since the eroded-caps candidate
+#: (optimal.freq.upper.eroded_plan) they won on none of the corpus programs or hand
+#: cases, so none is solved by default (each costs one acc solve).
+FIR_ACCEL_FACTORS: tuple[float, ...] = ()
+
+
+def _raised(limits: MachineLimits, g: float) -> MachineLimits:
+    from dataclasses import replace as dc_replace
+    return dc_replace(limits, axes=tuple(dc_replace(a, a_max=a.a_max * g)
+                                         for a in limits.axes))
+
+
+#: Default requested gap (DESIGN/issue: 2 % where achievable).
+DEFAULT_FREQ_GAP_TOL = 2e-2
+
+
+def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object],
+               base: str = "jerk", tol: float = DEFAULT_FREQ_GAP_TOL, holds: Holds | None = None,
+               progress: ProgressFn | None = None, jerk_tol: float | None = None
+               ) -> OptimalSolution:
+    """Minimum-time motion under ``base+freq``, with a certified bracket.
+
+    Parameters
+    ----------
+    path : Path
+    limits : MachineLimits
+    solve : callable
+        :func:`optimal.solve` (passed in by the dispatcher), for the inner ``base`` and
+        ``acc`` solves.
+    base : {"acc", "jerk"}
+        The bound set the frequency rule is added to.
+    tol : float
+        Requested relative gap.
+    holds : Holds, optional
+        Imposed holds (default: the dwells of ``path.blocks``).
+    progress : callable, optional
+        ``progress(message, fraction)``.
+    jerk_tol : float, optional
+        Gap requested from the inner jerk solve (default ``tol / 2``, at most 1 %).
+
+    Returns
+    -------
+    OptimalSolution
+        ``bounds = base + "+freq"``; ``active`` names ``frequency`` on every interval
+        when the frequency rule decided the upper bound, else the base solve's labels.
+    """
+    t_start = time.perf_counter()
+    if holds is None:
+        holds = dwell_holds(path)
+    hold_t = holds.total_s
+    name = f"{base}+freq"
+    if base not in ("acc", "jerk"):
+        raise ValueError(f"base bound set {base!r}: must be 'acc' or 'jerk'")
+    sub = (lambda msg, f=-1.0: progress(f"{base}: {msg}", 0.8 * max(f, 0.0))) if progress \
+        else None
+    if path.n_segments == 0:
+        from dataclasses import replace
+        return replace(solve(path, limits, "acc", holds=holds), bounds=name)
+    if base == "jerk":
+        jt = jerk_tol if jerk_tol else min(tol / 2, 1e-2)
+        base_sol = solve(path, limits, "jerk", tol=jt, holds=NO_HOLDS, progress=sub)
+        acc = solve(path, limits, "acc", holds=NO_HOLDS)
+    else:
+        base_sol = acc = solve(path, limits, "acc", holds=NO_HOLDS, progress=sub)
+    # FIR candidates from acc optima with raised accelerations too: their shorter ramps
+    # leave more of each phase to the filter (optimal.freq.upper.fir_filtered)
+    accs = [acc]
+    for g in FIR_ACCEL_FACTORS:
+        accs.append(solve(path, _raised(limits, g), "acc", holds=NO_HOLDS, tol=1e-2))
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    tb = time.perf_counter()
+    lb_freq = freq_lower_bound(work, limits.for_axes(work.axes))
+    lb = max(base_sol.lower_bound_s, lb_freq) + hold_t
+    t_bound = base_sol.bound_time_s + (acc.bound_time_s if acc is not base_sol else 0.0) \
+        + time.perf_counter() - tb
+    tc = time.perf_counter()
+    cands = []
+    if base_sol.profile is not None:
+        c = scaled(path, limits, base_sol.profile, name)
+        if c is not None:
+            cands.append(c)
+    for g, a_sol in zip((1.0,) + FIR_ACCEL_FACTORS, accs):
+        if a_sol.profile is None:
+            continue
+        prof = a_sol.profile
+        if np.any(prof.j != 0.0):
+            # the acc optimum's pieces with jerk (on curves) as constant-acceleration
+            # pieces through the same knots (v^2 linear in s between them): the filter's
+            # exact integration needs that form; the checker judges the result anyway
+            prof = Profile.from_path_velocity(prof.s, prof.v, prof.block)
+        c = verified(f"fir (acc x{g:g})", path, limits,
+                     fir_filtered(path, limits, prof, base == "jerk"), name)
+        if c is not None:
+            cands.append(c)
+    # the FIR of a motion under the caps eroded by the window (optimal.freq.upper.eroded_plan):
+    # keeps corner, feed and curvature caps where the plain filtered optima overshoot them
+    lim_w = limits.for_axes(work.axes)
+    T_max = float(np.max(segment_periods(work, lim_w), initial=0.0))
+    if T_max > 0:
+        try:
+            u = eroded_plan(path, limits, T_max, base == "jerk")
+        except ProfileError:
+            # the eroded caps leave an interval at zero speed at both ends (cannot be
+            # crossed): no candidate from this construction
+            u = None
+        if u is not None:
+            c = verified("fir (eroded caps)", path, limits,
+                         fir_filtered(path, limits, u.profile, base == "jerk",
+                                      u.rest_breaks), name, u.rest_breaks)
+            if c is not None:
+                cands.append(c)
+    t_check = time.perf_counter() - tc
+    inner = (base_sol,) if acc is base_sol else (base_sol, acc)
+    common = dict(grid=base_sol.grid, grid_points=base_sol.grid_points, iterations=base_sol.iterations,
+                  backend=base_sol.backend, build_time_s=sum(x.build_time_s for x in inner),
+                  solve_time_s=sum(x.solve_time_s for x in inner),
+                  check_time_s=sum(x.check_time_s for x in inner) + t_check,
+                  bound_time_s=t_bound, dwell_s=base_sol.dwell_s if holds is NO_HOLDS else
+                  float(sum(d for d, c_ in zip(holds.duration_s, holds.cause)
+                            if c_ == "dwell")),
+                  holds=holds, bounds=name)
+    if not cands:
+        return OptimalSolution(
+            status=SolveStatus.SOLVER_ERROR, profile=None, lower_bound_s=lb,
+            upper_bound_s=math.inf, objective_s=math.inf, gap=math.inf, time_scale=1.0,
+            segment_times_s=np.full(path.n_segments, np.nan), block_times_s=np.zeros(0),
+            blocks=(), active=(), total_time_s=time.perf_counter() - t_start,
+            history=(IterationRecord(base_sol.grid_points, lb, math.inf, math.inf, 1.0),),
+            message=f"no candidate motion passed the checker under {name}", **common)
+    best = min(cands, key=lambda c: c.duration)
+    ub = best.duration + hold_t
+    gap = (ub - lb) / lb if lb > 0 else math.inf
+    status = SolveStatus.OPTIMAL if gap <= tol else SolveStatus.GAP_NOT_MET
+    prof_h = with_holds(best.profile, path, holds)
+    freq_decides = best.name.startswith("fir") or best.time_scale > 1.0
+    active = (("frequency",) * len(base_sol.active)) if freq_decides else base_sol.active
+    base_cause = [r.cause for r in base_sol.blocks] if len(base_sol.blocks) == len(path.blocks) \
+        else ["none" if b.n_segments > 0 else b.stop_reason for b in path.blocks]
+    causes = [("frequency" if freq_decides and b.n_segments > 0 else c_)
+              for b, c_ in zip(path.blocks, base_cause)]
+    hold = None
+    if path.blocks:
+        idx = np.array([b.block for b in path.blocks], dtype=np.int64)
+        hold = holds.per_block(int(idx.max()) + 1)[idx]
+    rows = block_rows(path, block_motion(path, prof_h), causes, hold) if path.blocks else ()
+    names = ", ".join(f"{c.name} {c.duration + hold_t:.6g} s (x{c.time_scale:.4g})"
+                      for c in cands)
+    lb_src = "frequency rule" if lb_freq > base_sol.lower_bound_s else f"{base} oracle"
+    message = (f"gap {gap:.4%} {'<=' if status == SolveStatus.OPTIMAL else '>'} {tol:.4%}; "
+               f"bracket [{lb:.6g}, {ub:.6g}] s, lower bound from the {lb_src}, "
+               f"candidates: {names}")
+    if progress:
+        progress("done", 1.0)
+    return OptimalSolution(
+        status=status, profile=prof_h, lower_bound_s=lb, upper_bound_s=ub,
+        objective_s=best.duration + hold_t, gap=gap, time_scale=best.time_scale,
+        segment_times_s=prof_h.segment_times(path), block_times_s=prof_h.block_times(path),
+        blocks=rows, active=active, total_time_s=time.perf_counter() - t_start,
+        report=best.report, history=(IterationRecord(base_sol.grid_points, lb, ub,
+                                                      best.duration + hold_t,
+                                                      best.time_scale),),
+        message=message, **common)

@@ -1,0 +1,539 @@
+"""Verified upper bounds for the frequency bound sets ``acc+freq`` and ``jerk+freq``.
+
+Candidate motions, each judged by ``check_profile`` and slowed down until it
+passes every constraint of the set (:func:`reference.core.constraints.time_scale_factor`:
+stretching time by ``lam`` divides velocity by ``lam``, acceleration by ``lam^2``, jerk by
+``lam^3`` and multiplies every phase duration by ``lam``, so the scaled motion is accepted
+whatever the candidate was). The faster accepted one is the upper bound.
+
+1. **The base optimum (acc or jerk), slowed down** (:func:`scaled`): exact and cheap;
+   tight where its phases already last ``1/f`` (long moves, low frequencies), poor where a
+   single short phase forces the whole motion slower.
+2. **The acc optimum through a moving-average (FIR) filter of window ``W_k`` per
+   rest-to-rest piece** (:func:`fir_filtered`; Biagiotti & Melchiorri 2012,
+   spec/oracle-formulations 1.8). Per piece ``u(t) = (1/W) int_{t-W}^{t} v dt``: the
+   acceleration becomes ``(v(t) - v(t-W))/W``, continuous, and the jerk ``(a(t) -
+   a(t-W))/W``, piecewise constant because the acc optimum's acceleration is
+   (representable exactly as a :class:`Profile`). What it preserves, checked rather than
+   assumed: on a straight line the filtered speed and acceleration are averages of
+   feasible ones (within the limits), the jerk is at most ``2 A / W``, and a rest-to-rest
+   move of one rise and one fall gets phases of at least ``W`` and lasts ``W`` longer
+   (the closed form of DESIGN 6 with the acc profile's own ramps added). It does **not**
+   hold in general: on a path the filtered motion reaches a position later than the
+   original and carries its speed there (a corner cap can be exceeded), the jerk bound
+   ``2 A / W`` may exceed the machine's, and a speed that rises and falls within ``W``
+   leaves shorter phases. Each of these shows in the checker's report and is paid for
+   by the time scaling. Pieces are filtered separately so that every stop stays at rest.
+
+3. **A motion under the caps eroded for the filter, then filtered** (:func:`eroded_plan`,
+   :func:`cone_envelope`): the speed caps (feed, axis speeds, corners, curvature) lowered
+   so that the moving average keeps them where it arrives, dips widened and bumps cut so
+   that the filter leaves no short phase, short phases stretched as the control's
+   adaptation does; then filtered with the smallest window the rule still needs. It wins
+   on paths with corners and arcs, where the filtered optimum overshoots.
+
+Every candidate is slowed down per rest-to-rest piece (:func:`verified`) until the
+checker accepts it. A time-domain NLP over phase durations (CasADi) could be tighter but
+would need its own verification anyway; the candidates are exact constructions whose
+only certificate is the checker, as for the other bound sets.
+
+Units: mm, s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
+                                        scale_time, time_scale_factor,
+                                        time_scale_factors_by_block)
+from reference.core.geometry import Path
+from reference.core.limits import MachineLimits
+from reference.core.phases import (acceleration_phases, min_phase_duration,
+                                   moving_axes_by_segment, phase_frequencies)
+from reference.core.profile import Profile
+from reference.core.rules import curvature_jump_speed_cap
+
+from .lower import rest_pieces, segment_periods
+
+__all__ = ["Candidate", "fir_filtered", "scaled", "verified"]
+
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Candidate:
+    """A verified motion (holds excluded).
+
+    Attributes
+    ----------
+    name : str
+        ``"jerk scaled"`` or ``"fir"``.
+    profile : Profile
+        The accepted (time-scaled) motion.
+    time_scale : float
+        Factor it was slowed down by.
+    report : ConstraintReport
+        The checker's report before scaling.
+    """
+
+    name: str
+    profile: Profile
+    time_scale: float
+    report: ConstraintReport
+
+    @property
+    def duration(self) -> float:
+        return self.profile.duration
+
+
+def verified(name: str, path: Path, limits: MachineLimits, prof: Profile,
+             bounds: str = "jerk+freq", rest_breaks: np.ndarray | None = None
+             ) -> Candidate | None:
+    """Check ``prof`` and slow it down until ``bounds`` holds; ``None`` if it cannot.
+
+    Each rest-to-rest piece is first slowed down by its own factor (the largest
+    :func:`~reference.core.constraints.time_scale_factors_by_block` of its blocks):
+    pieces start and end at rest, so stretching one leaves the others as they are. If
+    that motion is not accepted (a violation the per-block ratios do not place, round-off
+    at a stop), the whole motion is stretched by the single factor instead.
+    ``rest_breaks``: further breaks where ``prof`` is at rest (pieces end there too).
+    """
+    cons = BOUND_SETS[bounds]
+    rep = check_profile(path, limits, prof)
+    lam = time_scale_factor(rep, cons)
+    if not np.isfinite(lam):
+        return None
+    if lam <= 1.0:
+        return Candidate(name, prof, 1.0, rep)
+    per_block = time_scale_factors_by_block(rep, cons)
+    pieces = rest_pieces(path, rest_breaks)
+    if per_block.size and pieces.shape[0] > 1:
+        lam_k = np.array([float(np.max(per_block[path.block[lo:hi]], initial=1.0))
+                          for lo, hi in pieces])
+        if np.all(np.isfinite(lam_k)):
+            out = _scale_pieces(path, prof, pieces, lam_k)
+            if check_profile(path, limits, out).ok(cons):
+                return Candidate(name, out, float(np.max(lam_k)), rep)
+    out = scale_time(prof, lam)
+    # the scaling argument is exact, but round-off at ratio 1 is judged once more
+    if not check_profile(path, limits, out).ok(cons):
+        out = scale_time(out, 1.0 + 1e-9)
+        if not check_profile(path, limits, out).ok(cons):
+            return None
+    return Candidate(name, out, lam, rep)
+
+
+def _scale_pieces(path: Path, prof: Profile, pieces: np.ndarray, lam_k: np.ndarray) -> Profile:
+    """``prof`` with the time of piece ``k`` stretched by ``lam_k[k]`` (>= 1).
+
+    Interval ``i`` belongs to the piece holding its mid position; its duration is
+    multiplied by ``lam``, ``a`` divided by ``lam^2``, ``j`` by ``lam^3`` and its start
+    speed by ``lam``, as :func:`~reference.core.constraints.scale_time` does for the whole.
+    At a stop the speed is at most ``VEL_TOL_MM_S``, so the two pieces meet within it.
+    """
+    h = np.diff(prof.t)
+    mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+    starts = path.s_breaks[pieces[:, 0]]
+    k = np.clip(np.searchsorted(starts, mid, side="right") - 1, 0, lam_k.size - 1)
+    lam = lam_k[k]
+    t = np.concatenate(([0.0], np.cumsum(h * lam)))
+    v = prof.v / np.concatenate((lam, lam[-1:]))
+    return Profile(t=t, s=prof.s, v=v, a=prof.a / lam ** 2, j=prof.j / lam ** 3,
+                   block=prof.block)
+
+
+def scaled(path: Path, limits: MachineLimits, base_profile: Profile,
+           bounds: str = "jerk+freq") -> Candidate | None:
+    """Candidate 1: the base set's optimum (without holds), slowed down."""
+    return verified(f"{bounds.split('+')[0]} scaled", path, limits, base_profile, bounds)
+
+
+def fir_filtered(path: Path, limits: MachineLimits, acc_profile: Profile,
+                 jerk_limited: bool = True, rest_breaks: np.ndarray | None = None
+                 ) -> Profile:
+    """Candidate 2 before verification: the acc optimum (without holds; piecewise
+    constant acceleration) filtered per rest-to-rest piece by a moving average of window
+    ``W_k = max(T_k - r_k, a_k / J_k)``: ``T_k`` the largest ``1/f`` of the segments of
+    piece ``k``, ``r_k`` the shortest acceleration phase of the acc profile there
+    (:func:`reference.core.phases.acceleration_phases`; a phase of length ``r`` followed
+    by a cruise of at least ``W`` becomes one of ``r + W >= T_k``), ``a_k`` its largest
+    ``|s''|`` and ``J_k`` the smallest jerk limit of its moving axes (a step ``a_k``
+    spread over ``W`` has the jerk ``a_k / W``). On a rest-to-rest line whose acc profile
+    is a trapezoid with ramps ``r`` this is the closed form ``L/v + T`` plus ``r``, and
+    the dispatcher tries acc profiles with raised accelerations (shorter ``r``).
+
+    Parameters
+    ----------
+    path : Path
+    limits : MachineLimits
+    acc_profile : Profile
+        Constant acceleration on every interval (``j = 0``), at rest at every stop break.
+    jerk_limited : bool
+        Widen the window to ``a_k / J_k`` for the jerk limit (``jerk+freq``); ``False``
+        for ``acc+freq``, where the filtered motion's jerk is not bounded.
+    rest_breaks : numpy.ndarray of int, optional
+        Further breaks where ``acc_profile`` is at rest: pieces are filtered separately.
+
+    Returns
+    -------
+    Profile
+        Unverified; lasts ``sum_k W_k`` longer.
+    """
+    if np.any(acc_profile.j != 0.0):
+        raise ValueError("the FIR candidate needs a piecewise-constant acceleration")
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    lim = limits.for_axes(work.axes)
+    per = segment_periods(work, lim)
+    seg_j = np.where(moving_axes_by_segment(work), lim.j_max[None, :], np.inf).min(axis=1)
+    pieces = rest_pieces(path, rest_breaks)
+    ph = acceleration_phases(acc_profile)
+    ph_t = 0.5 * (ph.start_t + ph.end_t)
+    sb = path.s_breaks
+    t_cut = acc_profile.time_at(sb[np.concatenate((pieces[:, 0], pieces[-1:, 1]))])
+    tk = acc_profile.t
+    D, A0, JJ = [], [], []
+    for k, (lo, hi) in enumerate(pieces):
+        t0, t1 = float(t_cut[k]), float(t_cut[k + 1])
+        T = float(np.max(per[lo:hi]))
+        mine = (ph_t > t0) & (ph_t < t1)
+        r = float(np.min(ph.effective_duration[mine])) if np.any(mine) else 0.0
+        sel = (tk[:-1] >= t0) & (tk[:-1] < t1)
+        a_k = float(np.max(np.abs(acc_profile.a[sel]), initial=0.0))
+        J = float(np.min(seg_j[lo:hi]))
+        spread = a_k / J if (jerk_limited and np.isfinite(J)) else 0.0
+        W = max(T - r, spread) if T > 0 else 0.0
+        inner = tk[(tk > t0) & (tk < t1)]
+        if W <= 0.0:
+            knots = np.concatenate(([t0], inner, [t1]))
+        else:
+            knots = np.unique(np.concatenate(([t0], inner, [t1], inner + W, [t0 + W, t1 + W])))
+        h = np.diff(knots)
+        keep = h > 0
+        lo_t, h = knots[:-1][keep], h[keep]
+        if W <= 0.0:
+            _, _, a, _ = _state(acc_profile, lo_t + 0.5 * h, t0, t1)
+            D.append(h)
+            A0.append(a)
+            JJ.append(np.zeros_like(h))
+            continue
+        _, v_now, _, _ = _state(acc_profile, lo_t, t0, t1)
+        _, v_old, _, _ = _state(acc_profile, lo_t - W, t0, t1)
+        _, _, a_now, _ = _state(acc_profile, lo_t + 0.5 * h, t0, t1)
+        _, _, a_old, _ = _state(acc_profile, lo_t + 0.5 * h - W, t0, t1)
+        D.append(h)
+        A0.append((v_now - v_old) / W)
+        JJ.append((a_now - a_old) / W)
+    d, a0, jj = np.concatenate(D), np.concatenate(A0), np.concatenate(JJ)
+    prof = Profile.from_phases(d, a0, jj)
+    # the integration reaches the path end up to round-off; pin the last knot there
+    s = prof.s.copy()
+    s[-1] = min(max(s[-1], 0.0), path.total_length) if abs(s[-1] - path.total_length) < \
+        1e-9 * max(1.0, path.total_length) else s[-1]
+    v = np.where(np.abs(prof.v) < 1e-12 * max(1.0, float(np.max(prof.v))), 0.0, prof.v)
+    return Profile(t=prof.t, s=s, v=np.maximum(v, 0.0), a=prof.a, j=prof.j, block=prof.block)
+
+
+def _state(prof: Profile, t: np.ndarray, t0: float, t1: float):
+    """``s, v, a, j`` of one rest-to-rest piece ``[t0, t1]`` of ``prof``, at rest outside."""
+    inside = (t >= t0) & (t <= t1)
+    s, v, a, j = prof.state(np.clip(t, t0, t1))
+    z = np.zeros_like(t)
+    return s, np.where(inside, v, z), np.where(inside, a, z), np.where(inside, j, z)
+
+
+#: Intervals of the base grid of :func:`eroded_plan` per erosion distance ``V W`` (``V``
+#: the largest speed cap), between the two bounds below; nodes are added where the caps
+#: change (around every corner), so this only sets the resolution of curvature caps.
+ERODED_GRID_PER_DISTANCE = 8
+ERODED_GRID_MIN, ERODED_GRID_MAX = 2_000, 200_000
+#: Smallest tangential acceleration the passes of :func:`eroded_plan` use, as a fraction
+#: of the smallest axis acceleration: where the caps leave none (a speed at the curvature
+#: limit), the motion still moves, and the checker's time scaling pays for it.
+ERODED_MIN_ACCEL_SHARE = 0.05
+#: Rounds in which :func:`eroded_plan` re-evaluates the tangential acceleration at the
+#: speeds its passes reached (the checker judges the result; more rounds change little).
+TANGENTIAL_ROUNDS = 2
+#: Bisection steps of the cone envelope in :func:`eroded_plan` (relative resolution
+#: 2^-48 of the largest cap: below round-off of the speeds it feeds).
+ENVELOPE_BISECTIONS = 48
+#: Rounds of dip widening and bump cutting in :func:`eroded_plan` (each followed by the
+#: acceleration passes, which can leave new short features behind; two settle the corpus).
+REGULARISE_ROUNDS = 2
+#: Rounds of stretching u's short phases in :func:`eroded_plan`, and the margin they aim
+#: above the rule (so that round-off does not leave a phase a hair short).
+ADAPT_ROUNDS = 4
+ADAPT_MARGIN = 1e-3
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ErodedPlan:
+    """Input motion of the FIR candidate (:func:`eroded_plan`).
+
+    Attributes
+    ----------
+    profile : Profile
+        Constant acceleration per interval (``j = 0``), at rest at every stop break and at
+        every break in ``rest_breaks``; unverified.
+    rest_breaks : numpy.ndarray of int
+        Interior breaks whose speed cap is zero (a corner without velocity-jump
+        allowance): the motion rests there, and the filter treats them as piece ends.
+    window_s : float
+        The FIR window the caps were eroded for, s.
+    """
+
+    profile: Profile
+    rest_breaks: np.ndarray
+    window_s: float
+
+
+def _sparse_table(x: np.ndarray) -> list[np.ndarray]:
+    """Minima of ``x`` over windows of 1, 2, 4, ... elements (``log2 N`` arrays)."""
+    levels = [x]
+    span = 1
+    while 2 * span <= x.size:
+        prev = levels[-1]
+        levels.append(np.minimum(prev[:-span], prev[span:]))
+        span *= 2
+    return levels
+
+
+def _query(levels: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``min(x[lo[i]:hi[i]])`` from :func:`_sparse_table` (non-empty windows), O(1) each."""
+    k = np.floor(np.log2(np.maximum(hi - lo, 1))).astype(np.int64)
+    out = np.empty(lo.size)
+    for lev in np.unique(k):
+        sel = k == lev
+        tab = levels[int(lev)]
+        out[sel] = np.minimum(tab[lo[sel]], tab[hi[sel] - (1 << int(lev))])
+    return out
+
+
+def _window_min(x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``min(x[lo[i]:hi[i]])`` for every ``i`` (non-empty windows), by a sparse table:
+    ``log2 N`` halvings, O(N log N) work and memory, vectorised."""
+    return _query(_sparse_table(x), lo, hi)
+
+
+def _passes(b: np.ndarray, step: np.ndarray) -> np.ndarray:
+    """Largest ``b' <= b`` with ``|b'[i+1] - b'[i]| <= step[i]``: forward and backward
+    min-plus scans, ``b_k = D_k + min_{i<=k} (b_i - D_i)``, ``D`` the cumulative steps."""
+    D = np.concatenate(([0.0], np.cumsum(step)))
+    b = np.minimum(b, D + np.minimum.accumulate(b - D))
+    Dr = np.concatenate(([0.0], np.cumsum(step[::-1])))
+    return np.minimum(b, (Dr + np.minimum.accumulate(b[::-1] - Dr))[::-1])
+
+
+def cone_envelope(s: np.ndarray, cap: np.ndarray, window_s: float) -> np.ndarray:
+    """``c(p) = min over nodes q of max(cap(q), |s_p - s_q| / W)``, at every node.
+
+    A motion ``u <= c`` has the property :func:`eroded_plan` needs: wherever
+    ``|s_p - s_q| < u(p) W``, ``u(p) <= cap(q)``. Computed per node by bisection on
+    ``y``: the smallest ``y`` with ``min(cap over |s - s_p| <= y W) <= y`` (the left side
+    falls and the right side rises with ``y``).
+
+    Parameters
+    ----------
+    s : numpy.ndarray, shape (N,)
+        Increasing nodes, mm.
+    cap : numpy.ndarray, shape (N,)
+        Speed caps, mm/s (finite, >= 0).
+    window_s : float
+        ``W``, s (> 0).
+    """
+    lo_y = np.zeros(s.size)
+    hi_y = cap.copy()          # y = cap(p) always qualifies (q = p)
+    table = _sparse_table(cap)
+    for _ in range(ENVELOPE_BISECTIONS):
+        y = 0.5 * (lo_y + hi_y)
+        a = np.searchsorted(s, s - y * window_s, side="left")
+        b = np.searchsorted(s, s + y * window_s, side="right")
+        ok = _query(table, a, b) <= y
+        hi_y = np.where(ok, y, hi_y)
+        lo_y = np.where(ok, lo_y, y)
+    return hi_y
+
+
+def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
+    """The initial grid plus nodes at ``cap W / 2`` and ``cap W`` on both sides of every
+    finite junction cap (where the envelope bends), inside the neighbouring segments."""
+    from ..grid import Grid, initial_grid
+    g = initial_grid(path, n)
+    sb = path.s_breaks
+    fin = np.flatnonzero(np.isfinite(v_junction) & (v_junction > 0))
+    extra = [g.s]
+    for f in (0.5, 1.0):
+        d = v_junction[fin] * window_s * f
+        lo = np.maximum(sb[fin] - d, sb[np.maximum(fin - 1, 0)])
+        hi = np.minimum(sb[fin] + d, sb[np.minimum(fin + 1, sb.size - 1)])
+        extra += [lo, hi]
+    s = np.unique(np.concatenate(extra))
+    # drop nodes within round-off of a break (the break itself stays)
+    near = np.abs(s[:, None] - sb[None, :]).min(axis=1) if s.size * sb.size < 5e7 else None
+    if near is not None:
+        keep = (near == 0) | (near > 1e-9 * max(1.0, float(sb[-1])))
+        s = s[keep]
+    seg = np.clip(np.searchsorted(sb, 0.5 * (s[:-1] + s[1:]), side="right") - 1, 0,
+                  path.n_segments - 1)
+    return Grid(s=s, segment=seg, break_node=np.searchsorted(s, sb))
+
+
+def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
+                jerk_limited: bool) -> ErodedPlan:
+    """A motion whose moving average keeps every speed cap *where it arrives*: the input
+    of the FIR candidate on paths with corners and curves.
+
+    A moving average ``v_out(t) = (1/W) int_{t-W}^t u`` is at most the largest ``u`` in its
+    window, at some ``tau``, and it reaches the position ``s_out(t)``, an average of the
+    window's positions, so ``|s_u(tau) - s_out(t)| <= W u(tau)`` (the window covers at
+    most ``W`` times its largest speed). If ``u(p) <= cap(q)`` wherever ``|p - q| <
+    u(p) W``, then ``v_out(t) <= cap(s_out(t))``: the filtered motion keeps the feed, the
+    axis speeds, the corner (junction) caps and the curvature limit
+    (:func:`optimal.problem.pair_mvc`) where a plain filtered optimum overshoots them.
+    :func:`cone_envelope` gives the largest such speed; at a corner of cap ``v_c`` it is a
+    plateau of length ``v_c W``, which ``u`` crosses in ``W``: the filter then passes the
+    corner at ``v_c``. Forward and backward passes with the tangential acceleration the
+    axes have left at that speed make ``u``. A corner with a zero cap is a rest (a
+    plateau of zero length cannot be crossed): the filter takes it as a piece end.
+
+    Parameters
+    ----------
+    path : Path
+    limits : MachineLimits
+    period_s : float
+        The largest ``1/f`` of the path's segments, s.
+    jerk_limited : bool
+        The filter's window also spreads ``u``'s acceleration over ``a / J``
+        (:func:`fir_filtered`); the erosion is for the larger window then.
+
+    Returns
+    -------
+    ErodedPlan
+    """
+    from dataclasses import replace as dc_replace
+
+    from ..problem import common_node_caps, interval_geometry, junction_speed_caps, pair_mvc
+
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    lim = limits.for_axes(work.axes)
+    free = dc_replace(work, stop=np.zeros_like(work.stop))
+    v_j, _ = junction_speed_caps(free, lim, permissive=False)
+    rest = np.flatnonzero(np.isfinite(v_j) & (v_j <= 0.0))
+    # the largest path acceleration (lines: min_j A_j/|d_j|; curves: sqrt(n) max A) sets
+    # the spread a/J of the filter
+    curved = (work.radius * np.abs(work.omega) > 0) | (work.sharpness != 0)
+    with np.errstate(divide="ignore"):
+        a_line = np.min(np.where(np.abs(work.d) > 0, lim.a_max[None, :] / np.abs(work.d),
+                                 np.inf), axis=1)
+    a_path = float(np.max(np.where(curved, np.sqrt(work.n_axes) * np.max(lim.a_max), a_line)))
+    W = max(period_s, a_path / float(np.min(lim.j_max))) if jerk_limited else period_s
+    vcap = float(np.max(np.minimum(work.feed, np.sqrt(work.n_axes) * np.max(lim.v_max))))
+    L = float(work.total_length)
+    n = int(np.clip(ERODED_GRID_PER_DISTANCE * L / max(vcap * W, 1e-9), ERODED_GRID_MIN,
+                    ERODED_GRID_MAX))
+    grid = _eroded_grid(free, n, v_j, W)
+    dq0, ddq0, dq1, ddq1 = interval_geometry(free, grid)
+    b_cap = common_node_caps(free, lim, grid, dq0, dq1, permissive=False).cap.copy()
+    b_cap[:-1] = np.minimum(b_cap[:-1], pair_mvc(dq0, ddq0, lim.a_max))
+    b_cap[1:] = np.minimum(b_cap[1:], pair_mvc(dq1, ddq1, lim.a_max))
+    m = free.n_segments
+    if jerk_limited and m >= 2:
+        # a curvature jump steps the centripetal acceleration at any speed: the jerk set
+        # holds that step to PATH_TRANS_JERK_LIM (at least MAX_AX_JERK) over one IPO cycle
+        sb = free.s_breaks
+        _, _, k_in, _ = free.evaluate(sb[1:m], segment=np.arange(m - 1))
+        _, _, k_out, _ = free.evaluate(sb[1:m], segment=np.arange(1, m))
+        v_k = curvature_jump_speed_cap(k_in, k_out, np.maximum(lim.path_trans_jerk, lim.j_max),
+                                       limits.t_ipo_s)
+        b_cap[grid.break_node[1:m]] = np.minimum(b_cap[grid.break_node[1:m]], v_k ** 2)
+    cap = np.sqrt(b_cap)
+    rest_nodes = np.concatenate((grid.break_node[work.stop], grid.break_node[rest]))
+    cap[grid.break_node[rest]] = np.inf          # rests are piece ends, not caps
+    b = cone_envelope(grid.s, cap, W) ** 2
+    b = cone_envelope(grid.s, cap, W) ** 2
+    b[rest_nodes] = 0.0
+    # tangential acceleration the axes have left beside the curvature term at the speed
+    # reached, per interval (both ends): first at the eroded caps (the least), then at
+    # the passes' own speeds, which are lower where a ramp has not reached the cap yet
+    floor = ERODED_MIN_ACCEL_SHARE * float(np.min(lim.a_max))
+    ds_n = np.diff(grid.s)
+
+    def steps(b_at: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rem0 = (lim.a_max[None, :] - np.abs(ddq0) * b_at[:-1, None]) / np.abs(dq0)
+            rem1 = (lim.a_max[None, :] - np.abs(ddq1) * b_at[1:, None]) / np.abs(dq1)
+        rem0 = np.where(np.abs(dq0) > 0, rem0, np.inf).min(axis=1)
+        rem1 = np.where(np.abs(dq1) > 0, rem1, np.inf).min(axis=1)
+        return 2.0 * np.maximum(np.minimum(rem0, rem1), floor) * ds_n
+
+    b_caps = b
+    step = steps(b_caps)
+    b = _passes(b_caps, step)
+    for _ in range(TANGENTIAL_ROUNDS):
+        step = steps(b)
+        b = _passes(b_caps, step)
+    # a dip or a bump that u crosses in less than W leaves phases of its own width after
+    # the filter (a moving average spreads a step over W, not a pulse): dips are widened
+    # to plateaus crossed in W (the cone envelope of u itself) and narrower bumps cut
+    # (an opening of width W in time), then the passes again
+    s_n = grid.s
+    for _ in range(REGULARISE_ROUNDS):
+        v = np.sqrt(np.maximum(b, 0.0))
+        # the sources are u's dips: runs of equal speed with a higher run on both sides
+        # (not a flat step on a ramp, nor the ramps from the rests, which are piece ends)
+        chg = np.flatnonzero(np.diff(v) != 0) + 1
+        starts = np.concatenate(([0], chg))
+        rv = v[starts]
+        dip = np.zeros(rv.size, bool)
+        dip[1:-1] = (rv[:-2] > rv[1:-1]) & (rv[2:] > rv[1:-1])
+        low = np.repeat(dip, np.diff(np.concatenate((starts, [v.size]))))
+        v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
+        v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
+        # the bumps are cut by an opening in *time* (window W, the time at which u
+        # reaches each node): a flat opening of constant width in its parameter keeps
+        # monotone ramps and removes exactly the peaks narrower than W; the rests are
+        # piece ends, not dips, for it
+        v_nodes = np.sqrt(np.maximum(b, 0.0))
+        vs = v_nodes[:-1] + v_nodes[1:]
+        t_n = np.concatenate(([0.0], np.cumsum(np.where(vs > 0, 2.0 * ds_n / np.where(
+            vs > 0, vs, 1.0), 0.0))))
+        v[rest_nodes] = vcap
+        lo = np.searchsorted(t_n, t_n - 0.5 * W, side="left")
+        hi = np.searchsorted(t_n, t_n + 0.5 * W, side="right")
+        opened = -_window_min(-_window_min(v, lo, hi), lo, hi)
+        b = np.minimum(b, np.minimum(opened, v) ** 2)
+        b[rest_nodes] = 0.0
+        b_env = b
+        b = _passes(b, step)
+    # the rule on u itself, as the control's adaptation does it: a phase that is shorter
+    # than its 1/f (less the filter's jerk spread, which lengthens every phase) gets the
+    # constant acceleration dv / duration that makes it last that long; repeated, as a
+    # slower ramp can change its neighbours
+    spread = a_path / float(np.min(lim.j_max)) if jerk_limited else 0.0
+    ds = np.diff(s_n)
+    blocks = work.block[grid.segment]
+    for _ in range(ADAPT_ROUNDS):
+        prof = Profile.from_path_velocity(s_n, np.sqrt(np.maximum(b, 0.0)), blocks)
+        ph = acceleration_phases(prof)
+        f, _ = phase_frequencies(work, lim, ph, grid.segment)
+        need = np.maximum(min_phase_duration(f) - spread, 0.0)
+        short = np.flatnonzero(ph.effective_duration < need * (1.0 - ADAPT_MARGIN))
+        if short.size == 0:
+            break
+        # the mean acceleration of a linear ramp of the needed length; a phase already
+        # at it (cut by the grid into unequal pieces, not quite symmetric) is slowed by
+        # the stretch still missing, at most halved per round
+        a_new = ph.dv / (need * (1.0 + ADAPT_MARGIN))
+        shrink = np.clip(ph.effective_duration / (need * (1.0 + ADAPT_MARGIN)), 0.5, 1.0)
+        for p_ in short:
+            sl = slice(int(ph.first[p_]), int(ph.last[p_]) + 1)
+            a_now = step[sl] / (2.0 * ds[sl])
+            a_set = np.where(a_now <= a_new[p_] * (1.0 + 1e-9), a_now * shrink[p_],
+                             a_new[p_])
+            step[sl] = 2.0 * a_set * ds[sl]
+        b = _passes(b_env, step)
+    prof = Profile.from_path_velocity(s_n, np.sqrt(np.maximum(b, 0.0)), blocks)
+    return ErodedPlan(profile=prof, rest_breaks=rest, window_s=W)

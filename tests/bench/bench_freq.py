@@ -1,0 +1,59 @@
+"""The frequency oracles against their base oracles on the same path, as ratios.
+
+Path: the stadium of ``bench_jerk.py`` (default machine, 2 laps). At about 1,000 and
+10,000 NLP grid intervals (``initial_intervals``; one round, ``tol`` wide open so both
+stop after their first verified profile): wall time of ``optimal.solve(bounds="jerk")``
+and of ``bounds="jerk+freq"`` (which runs that jerk solve inside, plus four acc solves and
+the candidates' checks), and ``freq / jerk``; likewise ``acc+freq`` against ``acc`` (the
+``acc`` grid starts at the same size). Also both brackets, and the scaling exponent of
+the frequency solve's wall time between the two sizes.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path as FsPath
+
+HERE = FsPath(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parents[1]))
+sys.path.insert(0, str(HERE))
+
+import optimal  # noqa: E402
+from bench_jerk import stadium_gcode  # noqa: E402
+from reference.machine import load_machine  # noqa: E402
+from reference.nc import parse_text  # noqa: E402
+from reference.prepare import build_path  # noqa: E402
+
+SIZES = (1_000, 10_000)
+
+
+def main() -> int:
+    machine = load_machine(None)
+    path = build_path(parse_text(stadium_gcode(), "stadium.mpf"), machine)
+    print(f"stadium: {path.n_segments} segments, {path.total_length:.1f} mm, default machine")
+    print(f"{'set':>9} {'N':>7} {'base s':>9} {'freq s':>9} {'freq/base':>10}  "
+          f"brackets (base | freq)")
+    for base in ("acc", "jerk"):
+        walls = []
+        for n in SIZES:
+            opts = dict(initial_intervals=n, tol=1.0)
+            t0 = time.perf_counter()
+            j = optimal.solve(path, machine.limits, bounds=base, **opts)
+            t1 = time.perf_counter()
+            f = optimal.solve(path, machine.limits, bounds=f"{base}+freq", **opts)
+            t2 = time.perf_counter()
+            walls.append((j.grid_points, t2 - t1))
+            print(f"{base + '+freq':>9} {j.grid_points:>7} {t1 - t0:>9.2f} {t2 - t1:>9.2f} "
+                  f"{(t2 - t1) / (t1 - t0):>10.2f}  [{j.lower_bound_s:.4f}, "
+                  f"{j.upper_bound_s:.4f}] | [{f.lower_bound_s:.4f}, {f.upper_bound_s:.4f}]",
+                  flush=True)
+        (n0, w0), (n1, w1) = walls
+        print(f"{'':>9} scaling of the {base}+freq wall time: N^"
+              f"{math.log(w1 / w0) / math.log(n1 / n0):.2f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

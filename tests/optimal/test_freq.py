@@ -1,0 +1,134 @@
+"""The jerk+freq oracle (optimal.freq) against independent references.
+
+* ruckig (rest-to-rest straight lines) with the acceleration lowered, by bisection,
+  until every acceleration phase of its profile lasts at least 1/f: a motion the rule of
+  DESIGN section 6 accepts, so the oracle's upper bound must match or beat it (issue 12,
+  item 5), and the lower bound must stay below it;
+* the closed form L/v + 1/f of DESIGN 6 for FIR-shaped motions;
+* the relaxation chain LB(jerk) <= LB(jerk+freq), UB(jerk) <= UB(jerk+freq)
+  (spec/oracle-formulations 1.9: T*_jerk <= T*_freq) on hand paths here and on the corpus
+  in tests/compare/test_freq_chain.py.
+The oracle's profile is judged by check_profile (the certificate), never by itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import optimal
+from oracle_cases import XYZ, line_arc_line, line_path
+from reference.core import AxisLimits, MachineLimits
+from reference.core.constraints import BOUND_SETS, check_profile
+from reference.core.tolerances import RATIO_TOL
+
+ruckig = pytest.importorskip("ruckig")
+
+T_IPO = 0.004
+#: Relative slack for "matches or beats": ruckig's durations and ours are exact to
+#: round-off; the bisection on ruckig's acceleration is run to 1e-9 relative.
+MATCH_SLACK = 1e-6
+N0 = 200
+
+
+def machine(v=500.0, a=2000.0, j=100_000.0, f=10.0) -> MachineLimits:
+    return MachineLimits(tuple(AxisLimits(n, v, a, j, 1.2, f) for n in XYZ), T_IPO)
+
+
+def ruckig_phases(L, V, A, J, dt=2e-5):
+    """Duration of ruckig's rest-to-rest move and of its shortest acceleration phase."""
+    otg = ruckig.Ruckig(1)
+    inp = ruckig.InputParameter(1)
+    traj = ruckig.Trajectory(1)
+    inp.current_position, inp.target_position = [0.0], [L]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
+    otg.calculate(inp, traj)
+    D = traj.duration
+    t = np.linspace(0.0, D, int(D / dt) + 2)
+    acc = np.array([traj.at_time(x)[2][0] for x in t])
+    sign = np.where(np.abs(acc) > 1e-6 * np.max(np.abs(acc)), np.sign(acc), 0)
+    edges = np.flatnonzero(np.diff(sign)) + 1
+    runs = np.split(np.arange(t.size), edges)
+    lengths = [t[r[-1]] - t[r[0]] + dt for r in runs if sign[r[0]] != 0]
+    return D, min(lengths)
+
+
+def ruckig_lowered(L, V, A, J, T):
+    """ruckig with the acceleration lowered until every phase lasts >= T (bisection)."""
+    D, ph = ruckig_phases(L, V, A, J)
+    if ph >= T:
+        return D
+    lo, hi = 1e-3 * A, A
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        if ruckig_phases(L, V, mid, J)[1] >= T:
+            lo = mid
+        else:
+            hi = mid
+    D, ph = ruckig_phases(L, V, lo, J)
+    assert ph >= T * (1 - 1e-3)
+    return D
+
+
+@pytest.mark.parametrize("L, feed, f", [(100.0, 100.0, 10.0), (20.0, 200.0, 10.0),
+                                        (300.0, 400.0, 5.0)])
+def test_line_matches_or_beats_ruckig_with_lowered_acceleration(L, feed, f):
+    lim = machine(f=f)
+    path = line_path([[0, 0, 0], [L, 0, 0]], feed=feed)
+    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    assert sol.bounds == "jerk+freq" and sol.status in ("optimal", "gap_not_met")
+    rep = check_profile(path, lim, sol.profile)
+    assert rep.ok(BOUND_SETS["jerk+freq"]), rep.violations(BOUND_SETS["jerk+freq"])
+    assert sol.profile.duration == pytest.approx(sol.upper_bound_s, rel=1e-12)
+    # the path speed is the X speed on this line; ruckig's axis limits are the path's
+    ref = ruckig_lowered(L, min(feed, 500.0), 2000.0, 100_000.0, 1.0 / f)
+    assert sol.upper_bound_s <= ref * (1 + MATCH_SLACK)
+    assert sol.lower_bound_s <= ref * (1 + MATCH_SLACK)
+    assert sol.lower_bound_s <= sol.upper_bound_s
+
+
+def test_closed_form_line_upper_bound():
+    # DESIGN 6: a rest-to-rest line at v with v/A < 1/f (and A/J < 1/f) takes L/v + 1/f
+    # among FIR-shaped motions; the oracle's upper bound reaches it
+    sol = optimal.solve(line_path([[0, 0, 0], [100, 0, 0]], feed=100.0), machine(),
+                        bounds="jerk+freq", initial_intervals=N0)
+    assert sol.upper_bound_s <= (100 / 100 + 0.1) * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("case", ["stops", "arc"])
+def test_relaxation_chain_on_hand_paths(case):
+    lim = machine(f=20.0)
+    if case == "stops":
+        path = line_path([[0, 0, 0], [40, 0, 0], [40, 30, 0], [0, 30, 0]], feed=150.0,
+                         stops=("start", "exact", "exact", "end"))
+    else:
+        path = line_arc_line(10.0, 30.0, feed=150.0)
+    jerk = optimal.solve(path, lim, bounds="jerk", initial_intervals=N0)
+    frq = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    assert jerk.lower_bound_s <= frq.lower_bound_s
+    assert jerk.upper_bound_s <= frq.upper_bound_s * (1 + 1e-9)
+    assert frq.lower_bound_s <= frq.upper_bound_s
+    rep = check_profile(path, lim, frq.profile)
+    assert rep.ok(BOUND_SETS["jerk+freq"])
+    # every phase of the accepted motion lasts at least 1/f (1/20 s), by the checker
+    assert rep.worst("frequency").ratio <= 1 + RATIO_TOL
+
+
+def test_frequency_bound_decides_many_short_exact_stop_moves():
+    # ten 0.2 mm moves with exact stops, f = 2 Hz: each piece needs a rise and a fall of
+    # (effective) 0.5 s, so 1 s per piece and 10 s in all; the jerk bound alone is about
+    # 0.4 s. The proof's alternative per piece (optimal/freq/lower.py): a piece crossed
+    # with |s''| <= 1e-6 a_bar everywhere (a_bar = 2000 mm/s^2 on a line of X alone)
+    # takes tau with 1e-6 a_bar tau^2 + 1e-6 tau = 0.2 mm, about 10 s, more than 1 s;
+    # the lost-time bound L/v + 1/f is 0.502 s, less
+    pts = [[0.2 * i, 0, 0] for i in range(11)]
+    path = line_path(pts, feed=100.0, stops=("start",) + ("exact",) * 9 + ("end",))
+    lim = machine(f=2.0)
+    frq = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    c = 1e-6 * 2000.0 * (1 + RATIO_TOL)
+    tau = 2 * 0.2 / (1e-6 + np.sqrt(1e-12 + 4 * c * 0.2))
+    assert tau > 1.0
+    assert frq.lower_bound_s == pytest.approx(10 * 2 * 0.5 / (1 + RATIO_TOL), rel=1e-12)
+    assert frq.lower_bound_s > 9.99
+    assert frq.lower_bound_s <= frq.upper_bound_s
+    assert check_profile(path, lim, frq.profile).ok(BOUND_SETS["jerk+freq"])
