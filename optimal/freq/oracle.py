@@ -141,19 +141,18 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     # keeps corner, feed and curvature caps where the plain filtered optima overshoot them
     lim_w = limits.for_axes(work.axes)
     T_max = float(np.max(segment_periods(work, lim_w), initial=0.0))
-    if T_max > 0:
+    for opening in ("time", "index") if T_max > 0 else ():
         try:
-            u = eroded_plan(path, limits, T_max, base == "jerk")
+            u = eroded_plan(path, limits, T_max, base == "jerk", opening)
         except ProfileError:
             # the eroded caps leave an interval at zero speed at both ends (cannot be
             # crossed): no candidate from this construction
-            u = None
-        if u is not None:
-            c = verified("fir (eroded caps)", path, limits,
-                         fir_filtered(path, limits, u.profile, base == "jerk",
-                                      u.rest_breaks), name, u.rest_breaks)
-            if c is not None:
-                cands.append(c)
+            continue
+        c = verified(f"fir (eroded caps, {opening} opening)", path, limits,
+                     fir_filtered(path, limits, u.profile, base == "jerk", u.rest_breaks),
+                     name, u.rest_breaks)
+        if c is not None:
+            cands.append(c)
     t_check = time.perf_counter() - tc
     inner = (base_sol,) if acc is base_sol else (base_sol, acc)
     common = dict(grid=base_sol.grid, grid_points=base_sol.grid_points, iterations=base_sol.iterations,

@@ -381,7 +381,7 @@ def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
 
 
 def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
-                jerk_limited: bool) -> ErodedPlan:
+                jerk_limited: bool, opening: str = "time") -> ErodedPlan:
     """A motion whose moving average keeps every speed cap *where it arrives*: the input
     of the FIR candidate on paths with corners and curves.
 
@@ -407,6 +407,9 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     jerk_limited : bool
         The filter's window also spreads ``u``'s acceleration over ``a / J``
         (:func:`fir_filtered`); the erosion is for the larger window then.
+    opening : {"time", "index"}
+        How bumps narrower than the window are cut (see the comment in the code): the
+        oracle tries both, as neither is always faster.
 
     Returns
     -------
@@ -491,18 +494,26 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         dip[1:-1] = (rv[:-2] > rv[1:-1]) & (rv[2:] > rv[1:-1])
         low = np.repeat(dip, np.diff(np.concatenate((starts, [v.size]))))
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
+        v_top = float(np.max(v))
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
-        # the bumps are cut by an opening in *time* (window W, the time at which u
-        # reaches each node): a flat opening of constant width in its parameter keeps
-        # monotone ramps and removes exactly the peaks narrower than W; the rests are
-        # piece ends, not dips, for it
-        v_nodes = np.sqrt(np.maximum(b, 0.0))
-        vs = v_nodes[:-1] + v_nodes[1:]
-        t_n = np.concatenate(([0.0], np.cumsum(np.where(vs > 0, 2.0 * ds_n / np.where(
-            vs > 0, vs, 1.0), 0.0))))
+        v_top = float(np.max(v))
+        # the bumps are cut by a flat opening (constant width in its parameter, so that
+        # monotone ramps stay and exactly the narrower peaks go): in *time* (window W,
+        # the time at which u reaches each node), or in node index with the width the
+        # top speed covers in W (cuts more, also slow peaks next to corners); the rests
+        # are piece ends, not dips, for it
         v[rest_nodes] = vcap
-        lo = np.searchsorted(t_n, t_n - 0.5 * W, side="left")
-        hi = np.searchsorted(t_n, t_n + 0.5 * W, side="right")
+        if opening == "time":
+            v_nodes = np.sqrt(np.maximum(b, 0.0))
+            vs = v_nodes[:-1] + v_nodes[1:]
+            t_n = np.concatenate(([0.0], np.cumsum(np.where(vs > 0, 2.0 * ds_n / np.where(
+                vs > 0, vs, 1.0), 0.0))))
+            lo = np.searchsorted(t_n, t_n - 0.5 * W, side="left")
+            hi = np.searchsorted(t_n, t_n + 0.5 * W, side="right")
+        else:
+            k = int(np.ceil(0.5 * W * v_top / float(np.median(ds_n))))
+            idx = np.arange(v.size)
+            lo, hi = np.maximum(idx - k, 0), np.minimum(idx + k + 1, v.size)
         opened = -_window_min(-_window_min(v, lo, hi), lo, hi)
         b = np.minimum(b, np.minimum(opened, v) ** 2)
         b[rest_nodes] = 0.0
