@@ -72,9 +72,9 @@ Lipschitz (``b' = 2a``), ``b <= (v_max_j / |q'_j|)^2`` and ``b <= F^2`` everywhe
    pieces. At an inner point ``s``, integrating step 2b's identity from either end
    gives, for every axis with ``q'_j(s) != 0``,
    ``b(s) <= (q'_j(s_k)^2 bhat_k + 2 A_j int_{s_k}^{s} |q'_j|) / q'_j(s)^2`` and the same
-   from ``s_{k+1}`` (the travel: the exact chord where ``q'_j`` keeps its sign on the
-   interval, on helices in the cancellation-free form of step 2b; else length times
-   ``sup|q'_j|``); also the tent of step 4. These hold for every feasible motion, and
+   from ``s_{k+1}`` (the travel: where ``q'_j`` keeps its sign on the interval, the sum
+   of the pieces' exact chords, on helices in the cancellation-free form of step 2b;
+   else length times ``sup|q'_j|``); also the tent of step 4. These hold for every feasible motion, and
    the energy bound is *equal* to ``b(s)`` where one axis stays at its acceleration
    limit, which is where the tent and the one-axis envelopes of step 4 lose most. Step
    4 on the pieces with these node bounds (the parent's bounds of ``b``, ``|b'|``,
@@ -770,38 +770,30 @@ def subnode_times(path: Path, lim: AxisArrays, grid: Grid, geo: "_IntervalData",
                                                     + slope[k, None] * (D[:, None] - x)))
         # energy bounds: (q'_j^2 b)' = 2 q'_j (q'_j a + q''_j b), so from either end
         # q'_j(s)^2 b(s) <= q'_j(end)^2 b_end + 2 A_j (travel of axis j in between);
-        # the travel is the exact chord where q'_j keeps its sign on the parent (helix
-        # form without cancellation), else length times sup|q'_j|
+        # the travel is the sum of the pieces' exact chords where q'_j keeps its sign on
+        # the parent (helix form without cancellation, from the piece's mid-point
+        # tangent), else length times sup|q'_j|
         mids = D[:, None] * (frac[:-1] + 0.5 / pieces)[None, :]
-        pts = np.concatenate((s0[:, None] + x,                     # inner nodes
-                              s0[:, None] + 0.5 * x,               # mid of [s_k, node]
-                              s0[:, None] + 0.5 * (x + D[:, None]),  # mid of [node, s_k+1]
-                              s0[:, None] + mids), axis=1)         # piece mid-points
+        pts = np.concatenate((s0[:, None] + x, s0[:, None] + mids), axis=1)
         segs = np.repeat(seg, pts.shape[1])
         _, dq_all, ddq_all, _ = path.evaluate(pts.ravel(), segment=segs)
         n = dq_all.shape[1]
-        dq_all = dq_all.reshape(K, -1, n)
-        ddq_all = ddq_all.reshape(K, -1, n)
         P1 = pieces - 1
-        dq_node = dq_all[:, :P1]
-        dq_left, dq_right = dq_all[:, P1:2 * P1], dq_all[:, 2 * P1:3 * P1]
-        dq_mid, ddq_mid = dq_all[:, 3 * P1:], ddq_all[:, 3 * P1:]
-        w = path.omega[seg][:, None, None]
+        dq_node = dq_all.reshape(K, -1, n)[:, :P1]
+        dq_mid = dq_all.reshape(K, -1, n)[:, P1:]                  # (K, P, n)
+        ddq_mid = ddq_all.reshape(K, -1, n)[:, P1:]
+        y = (0.5 * path.omega[seg] * d)[:, None, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sinc = np.where(y != 0, np.sin(y) / np.where(y != 0, y, 1.0), 1.0)
         dd = path.d[seg][:, None, :]
-        helix = ~_varying_curvature(path, seg)[:, None, None]
-        keep = (geo.lo[k] > 0)[:, None, :]
-        hi = geo.hi[k][:, None, :]
-
-        def travel(length, dq_m):
-            y = 0.5 * w * length[:, :, None]
-            with np.errstate(invalid="ignore", divide="ignore"):
-                sinc = np.where(y != 0, np.sin(y) / np.where(y != 0, y, 1.0), 1.0)
-            chord = np.abs(length[:, :, None] * (sinc * (dq_m - dd) + dd))
-            worst = length[:, :, None] * hi
-            return np.where(keep & helix, np.minimum(chord, worst), worst)
-
-        t_left = travel(x, dq_left)
-        t_right = travel(D[:, None] - x, dq_right)
+        chord = np.abs(d[:, None, None] * (sinc * (dq_mid - dd) + dd))
+        worst = d[:, None, None] * geo.hi[k][:, None, :]
+        exact = (~_varying_curvature(path, seg)[:, None, None]
+                 & (geo.lo[k] > 0)[:, None, :])
+        piece = np.where(exact, np.minimum(chord, worst), worst)    # (K, P, n)
+        cum = np.cumsum(piece, axis=1)
+        t_left = cum[:, :-1]                                        # (K, P - 1, n)
+        t_right = cum[:, -1:] - t_left
         num = np.minimum(geo.dq0[k][:, None, :] ** 2 * b_hat[k, None, None]
                          + 2.0 * A * t_left,
                          geo.dq1[k][:, None, :] ** 2 * b_hat[k + 1, None, None]
