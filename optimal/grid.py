@@ -62,19 +62,25 @@ class Grid:
         return int(self.s.size)
 
 
-def _counts(path: Path, n_target: int, min_arc: int, arc_step: float) -> np.ndarray:
+def _counts(path: Path, n_target: int, min_arc: int, arc_step: float,
+            lines_by_length: bool = True) -> np.ndarray:
     length = path.length
     h0 = path.total_length / max(n_target, 1)
     n = np.maximum(MIN_SEGMENT_INTERVALS, np.ceil(length / h0 * (1 - 1e-12))).astype(np.int64)
     arc = path.radius > 0
     sweep = np.abs(path.omega) * length
     n_arc = np.maximum(min_arc, np.ceil(sweep / arc_step)).astype(np.int64)
-    return np.where(arc, np.maximum(n, n_arc), n)
+    line = n if lines_by_length else np.full_like(n, MIN_SEGMENT_INTERVALS)
+    return np.where(arc, np.maximum(n, n_arc), line)
 
 
-def initial_counts(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS) -> np.ndarray:
-    """Intervals per segment of :func:`initial_grid` (default settings), without building
-    it: the size of the oracle's first grid, known before anything is allocated.
+def initial_counts(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS, *,
+                   lines_by_length: bool = True) -> np.ndarray:
+    """Intervals per segment of :func:`initial_grid` (default settings, the same
+    ``lines_by_length``), without building it: the size of a first grid, known before
+    anything is allocated. The default (lines spread by length) is the base of the jerk
+    NLP's grid and at least the ``acc`` oracle's first grid (``lines_by_length=False``),
+    so a size budget on it holds for both.
 
     Returns
     -------
@@ -87,7 +93,8 @@ def initial_counts(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS) -> 
         n = np.maximum(MIN_SEGMENT_INTERVALS, np.ceil(length / h0 * (1 - 1e-12)))
         sweep = np.abs(path.omega) * length
         n_arc = np.maximum(MIN_ARC_INTERVALS, np.ceil(sweep / MAX_ARC_STEP_RAD))
-        return np.where(path.radius > 0, np.maximum(n, n_arc), n).astype(np.float64)
+        line = n if lines_by_length else np.full_like(n, MIN_SEGMENT_INTERVALS)
+        return np.where(path.radius > 0, np.maximum(n, n_arc), line).astype(np.float64)
 
 
 def grid_from_counts(path: Path, counts: np.ndarray) -> Grid:
@@ -116,12 +123,17 @@ def grid_from_counts(path: Path, counts: np.ndarray) -> Grid:
 
 def initial_grid(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS, *,
                  min_arc_intervals: int = MIN_ARC_INTERVALS,
-                 max_arc_step_rad: float = MAX_ARC_STEP_RAD) -> Grid:
+                 max_arc_step_rad: float = MAX_ARC_STEP_RAD,
+                 lines_by_length: bool = True) -> Grid:
     """Piece-aware starting grid.
 
     Each segment gets ``max(2, ceil(length / h))`` equal intervals with
     ``h = total_length / n_intervals``; arcs and helices at least ``min_arc_intervals`` and
-    at most ``max_arc_step_rad`` of sweep per interval.
+    at most ``max_arc_step_rad`` of sweep per interval. With ``lines_by_length=False``
+    straight segments get :data:`MIN_SEGMENT_INTERVALS` only (the ``acc`` oracle: both of
+    its bounds are exact on a line interval of any length, see
+    :mod:`optimal.upper` and :mod:`optimal.bounds`, so length-spread nodes there only
+    cost; where a line still carries part of the bracket, refinement splits it).
 
     Parameters
     ----------
@@ -134,13 +146,16 @@ def initial_grid(path: Path, n_intervals: int = DEFAULT_INITIAL_INTERVALS, *,
         Fewest intervals per arc.
     max_arc_step_rad : float
         Largest sweep per arc interval, rad.
+    lines_by_length : bool
+        Spread nodes over straight segments by length too (default), or give them the
+        fewest intervals.
 
     Returns
     -------
     Grid
     """
     return grid_from_counts(path, _counts(path, n_intervals, min_arc_intervals,
-                                          max_arc_step_rad))
+                                          max_arc_step_rad, lines_by_length))
 
 
 def split(grid: Grid, path: Path, mark: np.ndarray) -> Grid:
@@ -172,7 +187,7 @@ def split(grid: Grid, path: Path, mark: np.ndarray) -> Grid:
     return Grid(s=s, segment=seg, break_node=break_node)
 
 
-def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces: int = 2) -> Grid:
+def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces=2) -> Grid:
     """Split the marked intervals into ``pieces`` equal parts (a power of two).
 
     Parameters
@@ -183,25 +198,29 @@ def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces: int = 2) -> Grid
         Its path.
     mark : numpy.ndarray of bool, shape (N,)
         Intervals to split.
-    pieces : int
-        2, 4, 8, ...
+    pieces : int or numpy.ndarray of int, shape (N,)
+        2, 4, 8, ... for every marked interval, or one such number per interval.
 
     Returns
     -------
     Grid
         The refined grid (the same object when nothing can be split).
     """
-    if pieces < 2 or pieces & (pieces - 1):
+    p = np.broadcast_to(np.asarray(pieces, dtype=np.int64), (grid.n_intervals,))
+    marks = np.asarray(mark, bool)
+    p = np.where(marks, p, 1)
+    if np.any(p[marks] < 2) or np.any(p & (p - 1)):
         raise ValueError(f"pieces = {pieces}: must be a power of two >= 2")
     out = grid
-    marks = np.asarray(mark, bool)
-    for _ in range(pieces.bit_length() - 1):
-        new = split(out, path, marks)
+    rem = p
+    while np.any(rem > 1):
+        cut = rem > 1
+        new = split(out, path, cut)
         if new is out:
             break
-        # the halves of a marked interval are marked again
+        # the halves of a cut interval carry on with half of its pieces
         mid = 0.5 * (new.s[:-1] + new.s[1:])
         parent = np.clip(np.searchsorted(out.s, mid) - 1, 0, out.n_intervals - 1)
-        marks = marks[parent]
+        rem = np.where(cut, rem // 2, rem)[parent]
         out = new
     return out

@@ -3,13 +3,15 @@
 Pipeline (one pure function, no state kept between calls):
 
 1. validate (bound set, feeds, limits for every axis);
-2. piece-aware initial grid (:mod:`optimal.grid`);
+2. piece-aware initial grid (:mod:`optimal.grid`; nodes spread by length on curved
+   segments, two intervals per line, where both bounds are exact at any length);
 3. repeat: build the grid problem (:mod:`optimal.problem`), solve it with the chosen
    backend, verify its profile with ``check_profile`` and time-scale it (upper bound),
    solve the relaxation (lower bound, :mod:`optimal.bounds`); stop when
-   ``(upper - lower) / lower <= tol``; otherwise halve the intervals that carry most of
-   the gap (and the arc intervals of blocks where the checker found the grid profile too
-   fast) and go on, up to ``max_grid`` intervals;
+   ``(upper - lower) / lower <= tol``; otherwise cut the intervals that carry the gap
+   into 2, 4 or 8 pieces, the cuts with the best predicted gain per new point first
+   (and halve the arc intervals of blocks where the checker found the grid profile too
+   fast), and go on, up to ``max_grid`` intervals;
 4. report the best bounds seen (both stay valid on every grid), the accepted profile,
    times per segment and per NC block, and the active constraint along the path.
 
@@ -41,14 +43,14 @@ from .problem import (CAP_ACCELERATION, CAP_FEED, CAP_NAMES, CAP_VELOCITY, Discr
                       DiscreteResult, acceleration_slopes, build_grid_problem, check_feed,
                       interval_geometry, interval_times, slopes_keep_positive)
 from .solution import IterationRecord, OptimalSolution
-from .upper import line_tents, upper_interval_times, verified_profile
+from .upper import line_phase_times, line_tents, upper_interval_times, verified_profile
 from .status import SolveStatus
 from .jerk.tolerances import DEFAULT_JERK_GAP_TOL
 from .freq.oracle import DEFAULT_FREQ_GAP_TOL
 from .tolerances import (ACTIVE_TOL_REL, DEFAULT_GAP_TOL, DEFAULT_INITIAL_INTERVALS,
-                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, REFINE_GAP_SHARE,
-                         LB_ROUNDS, LB_ROUNDS_WARM, REFINE_RESIDUAL, REFINE_TARGET,
-                         SLOPE_SOLVES)
+                         DEFAULT_MAX_GRID, DEFAULT_MAX_ITERATIONS, LB_ROUNDS,
+                         LB_ROUNDS_PIECES, LB_ROUNDS_WARM, LB_SUB_PIECES, REFINE_MAX_PIECES,
+                         REFINE_RESIDUAL, REFINE_TARGET, SLOPE_SOLVES)
 
 SUPPORTED_BOUNDS = ("acc", "jerk", "acc+freq", "jerk+freq")
 
@@ -85,6 +87,9 @@ class _Candidate:
         The checker's report on the grid profile before time scaling.
     interval_times_s : numpy.ndarray, shape (N,)
         Time of the unscaled grid profile on each grid interval, s.
+    phases : _LinePhases
+        The phases of the line intervals' tents and their constraints
+        (:func:`_line_phases`).
     """
 
     upper_bound_s: float
@@ -95,6 +100,27 @@ class _Candidate:
     time_scale: float
     report: ConstraintReport
     interval_times_s: np.ndarray
+    phases: "_LinePhases"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _LinePhases:
+    """Accelerate, cruise and brake on the line intervals of a grid solution.
+
+    Attributes
+    ----------
+    line : numpy.ndarray of int, shape (L,)
+        The line intervals.
+    times_s : numpy.ndarray, shape (L, 3)
+        Unscaled time of each phase, s.
+    labels : numpy.ndarray of object, shape (L, 3)
+        The constraint that sets each phase: ``"acceleration <axis>"`` on the ramps,
+        ``"feed"`` or ``"velocity <axis>"`` while cruising.
+    """
+
+    line: np.ndarray
+    times_s: np.ndarray
+    labels: np.ndarray
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -142,17 +168,21 @@ def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
         Length ``N``: ``"feed"``, ``"velocity X"``, ``"acceleration X"``,
         ``"velocity_jump"``, ``"stop"`` or ``"none"``.
     """
-    N = problem.n_intervals
-    axes = problem.axes
+    axes = tuple(problem.axes)
+    n_ax = len(axes)
     cap = problem.cap
     tight_node = np.where(cap > 0, b >= cap * (1 - ACTIVE_TOL_REL), b <= 0)
-
-    def cap_label(k: int) -> str:
-        code = int(problem.cap_code[k])
-        ax = int(problem.cap_axis[k])
-        if code in (CAP_VELOCITY, CAP_ACCELERATION) and ax >= 0:
-            return f"{CAP_NAMES[code]} {axes[ax]}"
-        return CAP_NAMES[code]
+    # every label once; intervals pick indices into this table (one pass, no loop per
+    # interval): node caps by (code, axis), then "acceleration <axis>" rows, then "none"
+    names = sorted(CAP_NAMES)
+    table = [f"{CAP_NAMES[c]} {axes[a]}" if c in (CAP_VELOCITY, CAP_ACCELERATION) and a >= 0
+             else CAP_NAMES[c] for c in names for a in range(-1, n_ax)]
+    row_base, none_idx = len(table), len(table) + n_ax
+    table += [f"acceleration {a}" for a in axes] + ["none"]
+    code = np.asarray(problem.cap_code, dtype=np.int64)
+    cap_axis = np.asarray(problem.cap_axis, dtype=np.int64)
+    node_idx = (np.searchsorted(names, code) * (n_ax + 1)
+                + np.clip(cap_axis, -1, n_ax - 1) + 1)
 
     lhs = problem.c1 * b[:-1, None] + problem.c2 * b[1:, None]
     scale = np.abs(problem.c1 * b[:-1, None]) + np.abs(problem.c2 * b[1:, None]) + problem.h
@@ -160,56 +190,94 @@ def active_labels(problem: DiscreteProblem, b: np.ndarray) -> tuple[str, ...]:
     tight_row = used & (lhs >= problem.h - ACTIVE_TOL_REL * scale)
     any_row = tight_row.any(axis=1)
     first_row = np.argmax(tight_row, axis=1)
-    out = []
-    steady = (CAP_FEED, CAP_VELOCITY, CAP_ACCELERATION)
-    for k in range(N):
-        c0, c1 = int(problem.cap_code[k]), int(problem.cap_code[k + 1])
-        if (tight_node[k] and tight_node[k + 1] and c0 == c1 and c0 in steady
-                and problem.cap_axis[k] == problem.cap_axis[k + 1]):
-            out.append(cap_label(k))
-        elif any_row[k]:
-            out.append(f"acceleration {axes[int(problem.row_axis[first_row[k]])]}")
-        elif tight_node[k + 1]:
-            out.append(cap_label(k + 1))
-        elif tight_node[k]:
-            out.append(cap_label(k))
-        else:
-            out.append("none")
-    return tuple(out)
+    row_axis = np.asarray(problem.row_axis, dtype=np.int64)
+    c0, c1 = code[:-1], code[1:]
+    steady = (np.isin(c0, (CAP_FEED, CAP_VELOCITY, CAP_ACCELERATION))
+              & tight_node[:-1] & tight_node[1:] & (c0 == c1)
+              & (cap_axis[:-1] == cap_axis[1:]))
+    idx = np.select(
+        [steady, any_row, tight_node[1:], tight_node[:-1]],
+        [node_idx[:-1], row_base + (row_axis[first_row] if row_axis.size
+                                    else np.zeros_like(first_row)),
+         node_idx[1:], node_idx[:-1]],
+        default=none_idx)
+    return tuple(np.asarray(table, dtype=object)[idx].tolist())
+
+
+def _line_phases(work: Path, lim, grid: Grid, b: np.ndarray, tents) -> _LinePhases:
+    """The phases of the tents on the line intervals (:func:`optimal.upper.grid_profile`)
+    and the constraint of each: on a line the ramps run at the path acceleration of the
+    axis with the smallest ``A_j / |u_j|``, the cruise at the smaller of the feed and the
+    axis velocity caps ``V_j / |u_j|`` (``u`` the unit direction)."""
+    line, times = line_phase_times(grid.s, b, tents)
+    seg = grid.segment[line]
+    u = np.abs(work.d[seg])
+    axes = np.asarray(work.axes, dtype=object)
+    with np.errstate(divide="ignore"):
+        inv = np.where(u > 0, 1.0 / np.where(u > 0, u, 1.0), np.inf)
+    acc_ax = np.argmin(lim.a_max[None, :] * inv, axis=1)
+    vel = lim.v_max[None, :] * inv
+    vel_ax = np.argmin(vel, axis=1)
+    feed = work.feed[seg] <= vel[np.arange(seg.size), vel_ax]
+    ramp = np.char.add("acceleration ", axes[acc_ax].astype(str)).astype(object)
+    cruise = np.where(feed, "feed",
+                      np.char.add("velocity ", axes[vel_ax].astype(str))).astype(object)
+    return _LinePhases(line, times, np.stack([ramp, cruise, ramp], axis=1))
+
+
+def _with_phases(labels: tuple[str, ...], phases: _LinePhases) -> tuple[str, ...]:
+    """Interval labels where a line interval takes the label of its longest phase (its
+    node caps only bound the tent's ends)."""
+    if phases.line.size == 0:
+        return labels
+    out = np.asarray(labels, dtype=object)
+    pick = np.argmax(phases.times_s, axis=1)
+    out[phases.line] = phases.labels[np.arange(pick.size), pick]
+    return tuple(out.tolist())
 
 
 def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, lam: float,
                   report: ConstraintReport | None, budget: int, target_s: float
-                  ) -> tuple[np.ndarray, int]:
-    """Intervals to refine and into how many pieces (2 or 4).
+                  ) -> np.ndarray:
+    """Into how many equal pieces (1, 2, 4, ... :data:`REFINE_MAX_PIECES`) to cut every
+    interval.
 
-    The fewest of the largest carriers of the gap whose halving is predicted to bring
-    the gap below ``target_s`` (a halved interval keeps about :data:`REFINE_RESIDUAL` of
-    its share), at most :data:`REFINE_GAP_SHARE` of it; when halving that share is not
-    predicted to be enough, the carriers are quartered instead (keeping about
-    ``REFINE_RESIDUAL^2``), which saves a round. Plus the arc intervals of blocks where
-    the checker needed time scaling. At most ``budget`` new intervals.
+    Prediction model: an interval cut into ``2^l`` pieces keeps about
+    ``REFINE_RESIDUAL^l`` of its share of the gap (grid time minus lower-bound time).
+    Each cut of a level costs ``2^(l - 1)`` new intervals and gains
+    ``d REFINE_RESIDUAL^(l - 1) (1 - REFINE_RESIDUAL)``; the cuts with the best gain per
+    new interval are taken (for each interval the gains per interval fall level by
+    level, so the order takes its levels in turn) until the predicted gap reaches
+    ``target_s``, within ``budget`` new intervals: a gap spread evenly over the path is
+    halved everywhere, one carried by a few intervals is cut finer there, and both
+    predicted to land in one round. Plus the arc intervals of blocks where the checker
+    needed time scaling.
     """
     N = grid.n_intervals
-    mark = np.zeros(N, bool)
-    pieces = 2
+    level = np.zeros(N, dtype=np.int64)
     d = np.maximum(lam * t_prim - t_lb, 0.0)
     disc = np.maximum(t_prim - t_lb, 0.0)
     total = float(disc.sum())
-    if total > 0:
-        order = np.argsort(-disc, kind="stable")
-        cum = np.cumsum(disc[order])
-        excess = max(total - max(target_s, 0.0), 0.0)
-        share = excess / (1.0 - REFINE_RESIDUAL)
-        if share > REFINE_GAP_SHARE * total:
-            pieces = 4
-            share = min(excess / (1.0 - REFINE_RESIDUAL ** 2), REFINE_GAP_SHARE * total)
-        n_take = int(np.searchsorted(cum, share)) + 1
-        mark[order[:n_take]] = True
+    need = total - max(target_s, 0.0)
+    n_lev = int(REFINE_MAX_PIECES).bit_length() - 1
+    if need > 0 and budget > 0 and n_lev > 0:
+        R = REFINE_RESIDUAL
+        lev = np.arange(n_lev)
+        gain = disc[:, None] * (R ** lev * (1.0 - R))[None, :]         # (N, L)
+        cost = np.broadcast_to(2.0 ** lev, gain.shape)
+        order = np.argsort(-(gain / cost).ravel(), kind="stable")
+        cum_gain = np.cumsum(gain.ravel()[order])
+        cum_cost = np.cumsum(cost.ravel()[order])
+        n_take = min(int(np.searchsorted(cum_gain, need)) + 1,
+                     int(np.searchsorted(cum_cost, budget, side="right")))
+        taken = order[:n_take] // n_lev
+        level = np.bincount(taken, minlength=N).astype(np.int64)
+    pieces = np.left_shift(1, level)
     scale_part = (lam - 1.0) * float(t_prim.sum())
     if report is not None and lam > 1.0 and scale_part > 0.2 * float(d.sum()):
         power = {"velocity": 1, "feed": 1, "velocity_jump": 1, "acceleration": 2}
         bad_blocks = set()
+        extra = np.zeros(N, bool)
         for name, pw in power.items():
             br = np.asarray(report.block_ratios.get(name, np.zeros(0)))
             thr = 1.0 + 0.5 * (lam ** pw - 1.0)
@@ -217,20 +285,19 @@ def _refine_marks(path: Path, grid: Grid, t_prim: np.ndarray, t_lb: np.ndarray, 
             w = report.worst(name)
             if w.ratio > 1.0:
                 k = int(np.clip(np.searchsorted(grid.s, w.s) - 1, 0, N - 1))
-                mark[max(k - 2, 0):k + 3] = True
+                extra[max(k - 2, 0):k + 3] = True
         if bad_blocks:
             blk = path.block[grid.segment]
             arc = path.radius[grid.segment] > 0
-            mark |= np.isin(blk, list(bad_blocks)) & arc
-    if int(mark.sum()) * (pieces - 1) > budget:
-        pieces = 2
-    n_mark = int(mark.sum())
-    if n_mark > budget:
-        idx = np.flatnonzero(mark)
-        keep = idx[np.argsort(-d[idx], kind="stable")[:max(budget, 0)]]
-        mark[:] = False
-        mark[keep] = True
-    return mark, pieces
+            extra |= np.isin(blk, list(bad_blocks)) & arc
+        pieces = np.where(extra, np.maximum(pieces, 2), pieces)
+    # the budget: keep the cuts of the largest carriers of the (scaled) gap
+    if int((pieces - 1).sum()) > budget:
+        idx = np.flatnonzero(pieces > 1)
+        keep = idx[np.argsort(-d[idx], kind="stable")]
+        room = np.cumsum(pieces[keep] - 1) <= max(budget, 0)
+        pieces[keep[~room]] = 1
+    return pieces
 
 
 def _dwell_part(holds: Holds) -> float:
@@ -389,7 +456,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
 
     if initial_intervals is None:
         initial_intervals = DEFAULT_INITIAL_INTERVALS
-    grid = initial_grid(path, min(initial_intervals, max_grid))
+    sub_pieces = LB_SUB_PIECES
+    # lines get the fewest intervals: both bounds are exact on a line interval
+    grid = initial_grid(path, min(initial_intervals, max_grid), lines_by_length=False)
     t_build = t_solve = t_check = t_bound = 0.0
     history: list[IterationRecord] = []
     best: _Candidate | None = None
@@ -410,7 +479,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         geometry = interval_geometry(work, grid)
         lb, t_lb, rel, b_hat = lower_bound(
             work, lim, grid, b_node=b_node,
-            rounds=LB_ROUNDS if b_node is None else LB_ROUNDS_WARM, geometry=geometry)
+            rounds=(LB_ROUNDS_WARM if b_node is not None
+                    else LB_ROUNDS_PIECES if sub_pieces > 1 else LB_ROUNDS),
+            geometry=geometry,
+            sub_pieces=sub_pieces)
         warm = _WarmStart(grid, b_hat, rel.b_bar)
         del rel, b_node
         t_bound += time.perf_counter() - te
@@ -439,9 +511,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         disc_gap = (t_grid - best_lb) / best_lb if best_lb > 0 else math.inf
         new_grid = None
         if not (disc_gap <= tol or last):
-            mark, pieces = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget,
-                                         REFINE_TARGET * tol * best_lb)
-            new_grid = subdivide(grid, path, mark, pieces)
+            pieces = _refine_marks(path, grid, t_prim, t_lb, 1.0, None, budget,
+                                   REFINE_TARGET * tol * best_lb)
+            new_grid = subdivide(grid, path, pieces > 1, pieces)
             if new_grid is grid:
                 last, new_grid = True, None
         if new_grid is not None:
@@ -459,8 +531,10 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
         t_check += time.perf_counter() - td
         ub = prof.duration + hold_t
         if best is None or ub < best.upper_bound_s:
+            phases = _line_phases(work, lim, grid, res.b, tents)
             best = _Candidate(upper_bound_s=ub, grid=grid,
-                              labels=active_labels(problem, res.b), result=res,
+                              labels=_with_phases(active_labels(problem, res.b), phases),
+                              phases=phases, result=res,
                               profile=prof, time_scale=lam, report=report,
                               interval_times_s=t_prim)
         history.append(IterationRecord(grid.n_points, lb + hold_t, ub, t_grid, lam))
@@ -471,9 +545,9 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
             break
         if last:
             break
-        mark, pieces = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget,
-                                     REFINE_TARGET * tol * best_lb)
-        new_grid = subdivide(grid, path, mark, pieces)
+        pieces = _refine_marks(path, grid, t_prim, t_lb, lam, report, budget,
+                               REFINE_TARGET * tol * best_lb)
+        new_grid = subdivide(grid, path, pieces > 1, pieces)
         if new_grid is grid:
             break
         grid = new_grid
@@ -493,7 +567,8 @@ def solve(path: Path, limits: MachineLimits, bounds: str = "acc", *,
     seg_t = prof_h.segment_times(path)
     blk_t = prof_h.block_times(path)
     labels = best.labels
-    rows = _block_rows(path, g, prof_h, labels, lam * best.interval_times_s, holds)
+    rows = _block_rows(path, g, prof_h, labels, lam * best.interval_times_s, holds,
+                       best.phases, lam)
     gap = (ub - best_lb) / best_lb if best_lb > 0 else math.inf
     if status == SolveStatus.SOLVER_ERROR:
         message = msg
@@ -587,13 +662,24 @@ def _first_blocked_interval(problem: DiscreteProblem, res: DiscreteResult) -> in
 
 
 def _block_rows(path: Path, grid: Grid, prof: Profile, labels: tuple[str, ...],
-                t_int: np.ndarray, holds: Holds) -> tuple[BlockRow, ...]:
+                t_int: np.ndarray, holds: Holds, phases: _LinePhases | None = None,
+                lam: float = 1.0) -> tuple[BlockRow, ...]:
     """The oracle's rows: the motion measured on its verified profile (holds included),
-    the cause the constraint active for most of the block's grid time."""
+    the cause the constraint active for most of the block's grid time (on line
+    intervals counted phase by phase: ``phases``, times scaled by ``lam``)."""
     # per block, the label with the largest grid time (ties: the first label in sorted
     # order), by one sort over (block, label) pairs instead of a pass per block
     blk_of_int = path.block[grid.segment]
-    uniq, code = np.unique(np.asarray(labels, dtype=str), return_inverse=True)
+    labels = np.asarray(labels, dtype=object)
+    t_int = np.asarray(t_int, dtype=np.float64)
+    if phases is not None and phases.line.size:
+        other = np.ones(blk_of_int.size, bool)
+        other[phases.line] = False
+        blk_of_int = np.concatenate((blk_of_int[other],
+                                     np.repeat(blk_of_int[phases.line], 3)))
+        labels = np.concatenate((labels[other], phases.labels.ravel()))
+        t_int = np.concatenate((t_int[other], lam * phases.times_s.ravel()))
+    uniq, code = np.unique(labels.astype(str), return_inverse=True)
     key = blk_of_int * max(uniq.size, 1) + code
     ukey, inv = np.unique(key, return_inverse=True)
     wsum = np.bincount(inv, weights=t_int, minlength=ukey.size)

@@ -84,22 +84,37 @@ LB_ROUNDS = 4
 #: S-bend and CAM benchmarks.
 LB_ROUNDS_WARM = 1
 
+#: Sub-pieces per curved interval of the lower bound's time estimate
+#: (:func:`optimal.bounds.subnode_times`, step 5 of :mod:`optimal.bounds`): the time
+#: inside an interval is bounded on this many equal pieces whose inner nodes get energy
+#: bounds. Measured on 200 tangent S-bends at 12,213 equal-spaced points (distance of the
+#: bound below the converged time): 1 piece 0.285 %, 2 pieces 0.125 %, 4 pieces 0.064 %,
+#: 8 pieces about 0.04 %; 4 cost about as much again as the relaxation, and with them the
+#: S-bend and 10^4-piece CAM benchmarks (``tests/bench/bench_arcs.py``) need 2 rounds
+#: and 13,007 / 89,828 points instead of 3 and 16,991 / 2 and 119,453.
+LB_SUB_PIECES = 4
+#: Rounds of the relaxation on the first grid when the time estimate uses sub-pieces
+#: (:data:`LB_SUB_PIECES` > 1): the second round sharpened the estimate of step 4 alone
+#: (by up to 1.4 % on the anisotropic hand cases at 30 intervals), but with the
+#: sub-pieces' energy node bounds it moved no bound at all, measured on the corpus and
+#: examples on both bundled machines, the arc hand cases of ``tests/optimal`` and
+#: ``tests/bench/bench_arcs.py``; it cost 40 % of the relaxation there.
+LB_ROUNDS_PIECES = 1
 #: Stop the lower-bound rounds when the bound improves by less than this (relative).
 LB_ROUND_IMPROVEMENT = 1e-4
 
-#: Largest share of the bracket (sum over intervals of grid time minus lower-bound time)
-#: whose largest carriers are refined in one round (halved, or quartered when halving
-#: that share is not predicted to reach the target: ``optimal.oracle._refine_marks``). With the second-order arc bound
-#: (:mod:`optimal.arc_bounds`) an interval's share falls about fourfold per halving, so
-#: refining nearly all of the bracket at once saves rounds: measured on the S-bend and
-#: CAM benchmarks (``tests/bench/bench_arcs.py``), 0.6 took 6-7 rounds, 0.9 4-5, for
-#: grids of similar size.
-REFINE_GAP_SHARE = 0.9
+#: Most pieces one interval is cut into in one refinement round
+#: (``optimal.oracle._refine_marks``); a power of two.
+REFINE_MAX_PIECES = 8
 
 #: Share of its gap contribution that an interval keeps, summed over its two halves, after
-#: it is halved: the refinement's prediction model. Measured on the S-bend and CAM
-#: benchmarks (``tests/bench/bench_arcs.py``) with the energy rows of the lower bound:
-#: 0.3-0.4 (between the first-order 0.5 and the second-order 0.25).
+#: it is halved: the refinement's prediction model (an interval cut into ``2^l`` pieces
+#: keeps ``REFINE_RESIDUAL^l``; ``optimal.oracle._refine_marks`` takes the cuts with the
+#: best predicted gain per new point). Measured on the S-bend and CAM benchmarks
+#: (``tests/bench/bench_arcs.py``) with the energy rows of the lower bound: 0.3-0.4
+#: (between the first-order 0.5 and the second-order 0.25); with the sub-piece time
+#: estimate of the lower bound 0.35 still lands both in two rounds (0.45: 10 % more
+#: points on the CAM case, 0.55: 35 % more).
 REFINE_RESIDUAL = 0.35
 
 #: A round refines so that the predicted gap lands at this fraction of the requested one

@@ -115,6 +115,74 @@ def upper_interval_times(s: np.ndarray, b: np.ndarray, gamma: np.ndarray | None,
     return t
 
 
+def _tent_pieces(Dl: np.ndarray, b0: np.ndarray, b1: np.ndarray, v0: np.ndarray,
+                 v1: np.ndarray, cap: np.ndarray, M: np.ndarray):
+    """The tent of every line interval as three pieces (accelerate, cruise, brake).
+
+    Parameters
+    ----------
+    Dl, b0, b1, v0, v1, cap, M : numpy.ndarray, shape (L,)
+        Interval lengths (mm), end values of ``b`` (mm^2/s^2) and ``v`` (mm/s), the
+        ``b`` cap and the slope ``M`` (:class:`LineTents`).
+
+    Returns
+    -------
+    P, dur, V1, acc : numpy.ndarray, shape (L, 3)
+        Piece lengths (mm, 0 for absent pieces), durations (s), end speeds (mm/s) and
+        accelerations (mm/s^2).
+    """
+    cap = np.maximum(cap, np.maximum(b0, b1))
+    l1 = np.clip((cap - b0) / M, 0.0, Dl)
+    l3 = np.clip((cap - b1) / M, 0.0, Dl)
+    meet = l1 + l3 > Dl                      # no cruise: the two ramps meet at a peak
+    lp = np.clip((b1 - b0 + M * Dl) / (2.0 * M), 0.0, Dl)
+    l1 = np.where(meet, lp, l1)
+    l3 = np.where(meet, Dl - lp, l3)
+    # pieces shorter than round-off of the interval are none (a ramp of 1e-17 mm would
+    # carry an acceleration made of round-off): their length goes to the neighbour
+    tiny = 1e-9 * Dl
+    l1 = np.where(l1 < tiny, 0.0, l1)
+    l3 = np.where(l3 < tiny, 0.0, l3)
+    l2 = Dl - l1 - l3
+    l2 = np.where(l2 < tiny, 0.0, l2)
+    l1 = np.where((l2 == 0.0) & (l1 > 0), Dl - l3, l1)
+    l3 = np.where((l2 == 0.0) & (l1 == 0), Dl, l3)
+    vp = np.sqrt(np.minimum(cap, b0 + M * l1))     # speed at the peak or while cruising
+    P = np.stack([l1, l2, l3], 1)                  # (L, 3) piece lengths
+    V0 = np.stack([v0, vp, vp], 1)
+    V1 = np.stack([vp, vp, v1], 1)
+    keep = P > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dur = np.where(keep, 2.0 * P / (V0 + V1), 0.0)
+    # a ramp's acceleration from its end speeds (consistent with the knots), never above
+    # the tent's own M / 2 in size (round-off); cruising: 0
+    half = (M / 2.0)[:, None]
+    acc = np.where(keep, np.clip((V1 - V0) / np.where(dur > 0, dur, 1.0), -half, half), 0.0)
+    acc[:, 1] = 0.0
+    return P, dur, V1, acc
+
+
+def line_phase_times(s: np.ndarray, b: np.ndarray, tents: LineTents
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Time of the motion :func:`grid_profile` builds in each phase of every line
+    interval.
+
+    Returns
+    -------
+    line : numpy.ndarray of int, shape (L,)
+        The line intervals (those with a tent).
+    dur : numpy.ndarray, shape (L, 3)
+        Seconds accelerating, cruising at the cap and braking.
+    """
+    s = np.asarray(s, dtype=np.float64)
+    b = np.maximum(np.asarray(b, dtype=np.float64), 0.0)
+    v = np.sqrt(b)
+    line = np.flatnonzero(tents.on)
+    _, dur, _, _ = _tent_pieces(np.diff(s)[line], b[line], b[line + 1], v[line],
+                                v[line + 1], tents.cap[line], tents.slope[line])
+    return line, dur
+
+
 def grid_profile(s: np.ndarray, b: np.ndarray, block: np.ndarray,
                  gamma: np.ndarray | None = None, tents: LineTents | None = None
                  ) -> Profile:
@@ -157,42 +225,14 @@ def grid_profile(s: np.ndarray, b: np.ndarray, block: np.ndarray,
     if line.size == 0:
         t = np.concatenate(([0.0], np.cumsum(h)))
         return Profile(t=t, s=s, v=v, a=a, j=j, block=block)
-    # ---- line intervals: three pieces (accelerate, cruise, brake) of lengths l1, l2, l3
-    Dl, b0, b1 = D[line], b[line], b[line + 1]
-    M = tents.slope[line]
-    cap = np.maximum(tents.cap[line], np.maximum(b0, b1))
-    l1 = np.clip((cap - b0) / M, 0.0, Dl)
-    l3 = np.clip((cap - b1) / M, 0.0, Dl)
-    meet = l1 + l3 > Dl                      # no cruise: the two ramps meet at a peak
-    lp = np.clip((b1 - b0 + M * Dl) / (2.0 * M), 0.0, Dl)
-    l1 = np.where(meet, lp, l1)
-    l3 = np.where(meet, Dl - lp, l3)
-    # pieces shorter than round-off of the interval are none (a ramp of 1e-17 mm would
-    # carry an acceleration made of round-off): their length goes to the neighbour
-    tiny = 1e-9 * Dl
-    l1 = np.where(l1 < tiny, 0.0, l1)
-    l3 = np.where(l3 < tiny, 0.0, l3)
-    l2 = Dl - l1 - l3
-    l2 = np.where(l2 < tiny, 0.0, l2)
-    l1 = np.where((l2 == 0.0) & (l1 > 0), Dl - l3, l1)
-    l3 = np.where((l2 == 0.0) & (l1 == 0), Dl, l3)
-    vp = np.sqrt(np.minimum(cap, b0 + M * l1))     # speed at the peak or while cruising
-    P = np.stack([l1, l2, l3], 1)                  # (L, 3) piece lengths
-    V0 = np.stack([v[line], vp, vp], 1)
-    V1 = np.stack([vp, vp, v[line + 1]], 1)
+    # ---- line intervals: three pieces (accelerate, cruise, brake)
+    P, dur, V1, acc = _tent_pieces(D[line], b[line], b[line + 1], v[line], v[line + 1],
+                                   tents.cap[line], tents.slope[line])
     keep = P > 0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dur = np.where(keep, 2.0 * P / (V0 + V1), 0.0)
     if not np.all(np.isfinite(dur)):
         k = int(line[np.flatnonzero(~np.all(np.isfinite(dur), axis=1))[0]])
         raise InternalError(f"grid profile: interval {k} is never traversed "
                             f"(b = {b[k]:.6g}, {b[k + 1]:.6g} mm^2/s^2)")
-    # a ramp's acceleration from its end speeds (consistent with the knots), never above
-    # the tent's own M / 2 in size (round-off); cruising: 0
-    half = (M / 2.0)[:, None]
-    acc = np.where(keep, np.clip((V1 - V0) / np.where(dur > 0, dur, 1.0), -half, half), 0.0)
-    acc[:, 1] = 0.0
-    del V0, half
     # ---- assemble: every interval's pieces in order (1 off lines, 1 to 3 on lines)
     count = np.ones(N, dtype=np.int64)
     count[line] = keep.sum(axis=1)

@@ -144,6 +144,9 @@ def test_oracle_initial_counts_are_the_grid_it_builds():
     for text in (HELIX_SIN.format(n=3), "G90 G1 F1000 X10\nG2 X20 I5 J0\nG1 Y30\nM30\n"):
         path = prepare(parse_text(text))
         assert initial_counts(path).sum() == initial_grid(path).n_intervals
+        for by_length in (True, False):
+            assert (initial_counts(path, lines_by_length=by_length).sum()
+                    == initial_grid(path, lines_by_length=by_length).n_intervals)
 
 
 def test_compare_counts_the_oracle_grid(tmp_path, capsys):

@@ -566,3 +566,62 @@ def test_grid_profile_on_arcs_needs_no_time_scaling(seed):
         b, _, _ = sweep(build_grid_problem(path, la, g))
         _, lam, _ = verified_profile(path, limits, g.s, b, path.block[g.segment])
         assert lam <= 1 + 1e-9
+
+
+@pytest.mark.parametrize("name", list(HAND_CASES))
+def test_subnode_time_is_below_a_feasible_motion_on_every_interval(name):
+    """Step 5 of :mod:`optimal.bounds` (energy bounds at inner points, step 4 on the
+    pieces), started from the node values of a feasible motion (toppra on a fine grid,
+    accepted by the checker after its time scaling) and from a-priori interval bounds,
+    never exceeds that motion's time on any interval; and it is tighter than step 4 on
+    the whole intervals: the argument alone, interval by interval."""
+    from optimal.arc_bounds import envelope_times
+    from optimal.bounds import _slope_bound, subnode_times, tent_times
+
+    build, lim = HAND_CASES[name]
+    path = build()
+    limits = _limits(*lim, axes=path.axes)
+    la = limits.for_axes(path.axes)
+    fine, prof = _feasible_profile(path, limits)
+    for per_arc in (8, 40, 200):
+        coarse = grid_from_counts(path, np.where(path.radius > 0, per_arc, 2))
+        assert np.all(np.isin(coarse.s, fine.s))
+        actual = np.diff(np.interp(coarse.s, prof.s, prof.t))
+        b_nodes = np.interp(coarse.s, prof.s, prof.v) ** 2
+        geo = _interval_data(path, la, coarse)
+        B = geo.b_static
+        M = _slope_bound(geo, la, B)
+        whole = np.maximum(tent_times(coarse.s, b_nodes, B, M),
+                           envelope_times(geo.ds, b_nodes[:-1], b_nodes[1:], B, la.a_max,
+                                          geo.dq_mid, geo.ddq_mid, geo.lo, geo.hi, geo.k3))
+        arc = path.radius[coarse.segment] > 0
+        for pieces in (2, 4, 8):
+            est = subnode_times(path, la, coarse, geo, b_nodes, B, M, pieces)
+            assert np.all(est <= actual * (1 + 1e-9)), (per_arc, pieces)
+            assert np.all(est[~arc] == 0.0)
+            better = np.maximum(est, whole)
+            assert better[arc].sum() > whole[arc].sum()
+        # with 8 pieces most of the distance below the motion's time is gone
+        assert (actual[arc] - better[arc]).sum() < 0.5 * (actual[arc] - whole[arc]).sum()
+
+
+def test_subnode_pieces_bring_the_bound_closer_on_tangent_arcs():
+    """Step 5 of :mod:`optimal.bounds` on tangent S-bends: with 4 pieces the bound's
+    distance below the minimum time (toppra's Richardson-extrapolated reference, as in
+    the test above) is at most a third of the distance without them, on the same grids
+    (measured on 200 S-bends at 12,213 points: 0.285 % against 0.064 %)."""
+    from optimal.bounds import lower_bound
+    from optimal.grid import initial_counts
+
+    path = _sbend_path(8)
+    limits = load_machine(None).limits
+    la = limits.for_axes(path.axes)
+    c0 = initial_counts(path).astype(np.int64)
+    t_ref = (2 * _toppra_feasible_time(path, limits, per_arc=4000)[0]
+             - _toppra_feasible_time(path, limits, per_arc=2000)[0])
+    for f in (1, 2):
+        g = grid_from_counts(path, f * c0)
+        plain = lower_bound(path, la, g)[0]
+        pieces = lower_bound(path, la, g, sub_pieces=4)[0]
+        assert plain <= pieces < t_ref
+        assert t_ref - pieces < (t_ref - plain) / 3, (f, t_ref - plain, t_ref - pieces)

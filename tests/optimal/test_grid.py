@@ -38,3 +38,47 @@ def test_subdivide_rejects_pieces_that_are_not_powers_of_two():
     g = grid_from_counts(path, np.array([2, 2, 2]))
     with pytest.raises(ValueError, match="power of two"):
         subdivide(g, path, np.ones(g.n_intervals, bool), 3)
+
+
+def test_subdivide_takes_pieces_per_interval():
+    path = line_arc_line(5.0, 20.0)
+    g = grid_from_counts(path, np.array([3, 8, 3]))
+    pieces = np.array([1, 2, 4, 8, 1, 1, 2, 1, 1, 8, 1, 4, 1, 2])
+    new = subdivide(g, path, pieces > 1, pieces)
+    assert new.n_intervals == int(pieces.sum())
+    for k in range(g.n_intervals):
+        inside = new.s[(new.s > g.s[k]) & (new.s < g.s[k + 1])]
+        expect = g.s[k] + (g.s[k + 1] - g.s[k]) * np.arange(1, pieces[k]) / pieces[k]
+        np.testing.assert_allclose(inside, expect, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(new.s[new.break_node], path.s_breaks)
+
+
+def test_refinement_halves_a_spread_gap_and_cuts_a_concentrated_one_finer():
+    """The prediction model of ``optimal.oracle._refine_marks`` (an interval cut into
+    ``2^l`` pieces keeps ``R^l`` of its gap), worked by hand: an even gap is met by the
+    cheapest cuts, halvings; a gap carried by a few intervals by cutting those finer."""
+    from optimal.oracle import _refine_marks
+    from optimal.tolerances import REFINE_RESIDUAL as R
+
+    path = line_arc_line(5.0, 20.0)
+    g = grid_from_counts(path, np.array([20, 40, 20]))
+    N = g.n_intervals
+    t_lb = np.ones(N)
+    # even gap 0.01 s per interval; target: (1 - (1 - R) / 2) of it, met by halving
+    # half of the intervals
+    d = np.full(N, 0.01)
+    pieces = _refine_marks(path, g, t_lb + d, t_lb, 1.0, None, N, d.sum() * (1 + R) / 2)
+    assert set(np.unique(pieces)) == {1, 2}
+    assert abs(int((pieces == 2).sum()) - N // 2) <= 1
+    # two intervals carry nearly all of it: they are cut into 4 or 8, nothing else
+    d = np.full(N, 1e-6)
+    d[[7, 50]] = 0.5
+    pieces = _refine_marks(path, g, t_lb + d, t_lb, 1.0, None, N, 0.15 * d.sum())
+    assert pieces[7] >= 4 and pieces[50] >= 4
+    assert np.all(pieces[np.setdiff1d(np.arange(N), [7, 50])] == 1)
+    # predicted remainder R^l per cut interval meets the target
+    lev = np.log2(pieces).astype(int)
+    assert float(np.sum(d * R ** lev)) <= 0.15 * d.sum()
+    # the budget bounds the new intervals
+    pieces = _refine_marks(path, g, t_lb + 0.01, t_lb, 1.0, None, 5, 0.0)
+    assert int((pieces - 1).sum()) <= 5
