@@ -370,11 +370,11 @@ def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
         hi = np.minimum(sb[fin] + d, sb[np.minimum(fin + 1, sb.size - 1)])
         extra += [lo, hi]
     s = np.unique(np.concatenate(extra))
-    # drop nodes within round-off of a break (the break itself stays)
-    near = np.abs(s[:, None] - sb[None, :]).min(axis=1) if s.size * sb.size < 5e7 else None
-    if near is not None:
-        keep = (near == 0) | (near > 1e-9 * max(1.0, float(sb[-1])))
-        s = s[keep]
+    # drop nodes within round-off of a break (the break itself stays): the distance to
+    # the nearest break from the sorted breaks, O(N log m)
+    j = np.clip(np.searchsorted(sb, s), 1, sb.size - 1)
+    near = np.minimum(np.abs(s - sb[j - 1]), np.abs(sb[j] - s))
+    s = s[(near == 0) | (near > 1e-9 * max(1.0, float(sb[-1])))]
     seg = np.clip(np.searchsorted(sb, 0.5 * (s[:-1] + s[1:]), side="right") - 1, 0,
                   path.n_segments - 1)
     return Grid(s=s, segment=seg, break_node=np.searchsorted(s, sb))

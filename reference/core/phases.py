@@ -38,6 +38,12 @@ that hole without touching the profiles the rule is meant for:
   either end speed, at least the time a linear ramp of ``1/f`` loses. That is what makes
   ``L/v + 1/f`` exact and what the lower bound of :mod:`optimal.freq.lower` uses.
 
+What it still accepts: a speed change concentrated in the *middle* of a long phase whose
+ends creep (the centroid stays central). Such a phase loses exactly as much time as the
+linear ramp of its effective duration, so no motion gains time by it and the bounds of
+every bound set stay what they claim; but the rule is a rule on time, not a guarantee of a
+smooth acceleration spectrum.
+
 Units: s, mm, Hz. numpy only.
 """
 
