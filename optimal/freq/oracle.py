@@ -80,7 +80,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     progress : callable, optional
         ``progress(message, fraction)``.
     jerk_tol : float, optional
-        Gap requested from the inner jerk solve (default ``tol / 2``, at most 1 %).
+        Gap requested from the inner jerk solve (default ``tol / 2``: half the bracket
+        for the base set, the other half for the frequency rule).
 
     Returns
     -------
@@ -101,7 +102,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         from dataclasses import replace
         return replace(solve(path, limits, "acc", holds=holds), bounds=name)
     if base == "jerk":
-        jt = jerk_tol if jerk_tol else min(tol / 2, 1e-2)
+        jt = jerk_tol if jerk_tol else tol / 2
         base_sol = solve(path, limits, "jerk", tol=jt, holds=NO_HOLDS, progress=sub)
         acc = solve(path, limits, "acc", holds=NO_HOLDS)
     else:
