@@ -142,7 +142,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     # keeps corner, feed and curvature caps where the plain filtered optima overshoot them
     lim_w = limits.for_axes(work.axes)
     T_max = float(np.max(segment_periods(work, lim_w), initial=0.0))
-    for opening in ("time", "index") if T_max > 0 else ():
+    for opening in ("time", "space") if T_max > 0 else ():
         try:
             u = eroded_plan(path, limits, T_max, base == "jerk", opening)
         except ProfileError:

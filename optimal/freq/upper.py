@@ -407,7 +407,7 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     jerk_limited : bool
         The filter's window also spreads ``u``'s acceleration over ``a / J``
         (:func:`fir_filtered`); the erosion is for the larger window then.
-    opening : {"time", "index"}
+    opening : {"time", "space"}
         How bumps narrower than the window are cut (see the comment in the code): the
         oracle tries both, as neither is always faster.
 
@@ -499,9 +499,9 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         v_top = float(np.max(v))
         # the bumps are cut by a flat opening (constant width in its parameter, so that
         # monotone ramps stay and exactly the narrower peaks go): in *time* (window W,
-        # the time at which u reaches each node), or in node index with the width the
-        # top speed covers in W (cuts more, also slow peaks next to corners); the rests
-        # are piece ends, not dips, for it
+        # the time at which u reaches each node), or in path length with the distance
+        # the top speed covers in W (cuts more, also slow peaks next to corners); the
+        # rests are piece ends, not dips, for it
         v[rest_nodes] = vcap
         if opening == "time":
             v_nodes = np.sqrt(np.maximum(b, 0.0))
@@ -511,9 +511,9 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
             lo = np.searchsorted(t_n, t_n - 0.5 * W, side="left")
             hi = np.searchsorted(t_n, t_n + 0.5 * W, side="right")
         else:
-            k = int(np.ceil(0.5 * W * v_top / float(np.median(ds_n))))
-            idx = np.arange(v.size)
-            lo, hi = np.maximum(idx - k, 0), np.minimum(idx + k + 1, v.size)
+            half = 0.5 * W * v_top
+            lo = np.searchsorted(s_n, s_n - half, side="left")
+            hi = np.searchsorted(s_n, s_n + half, side="right")
         opened = -_window_min(-_window_min(v, lo, hi), lo, hi)
         b = np.minimum(b, np.minimum(opened, v) ** 2)
         b[rest_nodes] = 0.0
