@@ -86,6 +86,7 @@ which would merge them, are not modelled), so each such block keeps its own IPO 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from operator import is_not
 
 import numpy as np
 
@@ -162,38 +163,58 @@ def _digit(value: int, place: int) -> int:
 def _block_attributes(program: Program, default_accel: str) -> dict[str, np.ndarray]:
     """Per program block, shape (nb,): the mode governing the corner at its end (RND,
     RNDM, else the group-10 mode), acceleration mode, ADIS, ADISPOS, CTOL (``nan`` if
-    unset) and programmed rounding radius (mm).
+    unset) and programmed rounding radius (mm); and ``mode_id``, ``accel_id`` (int, shape
+    (nb,)) indexing the tuples ``mode_names``, ``accel_names`` (the distinct values), so
+    that membership and equality tests compare integers (numpy compares fixed-width
+    strings a character at a time, and :func:`numpy.isin` sorts them).
 
     Consecutive blocks share one :class:`~reference.nc.program.Modal` object while
-    nothing modal changes, so the modal values are read once per distinct object.
+    nothing modal changes (and blocks without extras one ``BlockExtra``), so the values
+    are read once per run of blocks with the same object (:func:`_runs`).
     """
     blocks = program.blocks
-    nb = len(blocks)
-    index: dict[int, int] = {}
-    uniq = []
-    code = np.empty(nb, dtype=np.int64)
-    for i, blk in enumerate(blocks):
-        md = blk.modal
-        j = index.get(id(md))
-        if j is None:
-            j = index[id(md)] = len(uniq)
-            uniq.append(md)
-        code[i] = j
-    rnd = np.array([blk.extra.rnd_mm for blk in blocks], dtype=np.float64)
-    # fixed-width strings: numpy compares them in C (object arrays per element)
-    mode = np.array([md.continuous_mode for md in uniq], dtype=_MODE_DTYPE)[code]
+    modals = [blk.modal for blk in blocks]
+    uniq, code = _runs(modals)
+    extras, e_code = _runs([blk.extra for blk in blocks])
+    rnd = np.array([e.rnd_mm for e in extras], dtype=np.float64)[e_code]
     rndm = np.array([md.rndm_mm for md in uniq], dtype=np.float64)[code]
-    mode = np.where(rnd > 0, "RND", np.where(rndm > 0, "RNDM", mode)).astype(_MODE_DTYPE)
+    # per run: group-10 mode, then RND / RNDM per block where programmed
+    run_mode = [md.continuous_mode for md in uniq]
+    run_accel = [md.accel_mode or default_accel for md in uniq]
+    mode_names = tuple(sorted(set(run_mode) | {"RND", "RNDM"}))
+    accel_names = tuple(sorted(set(run_accel)))
+    mode_id = np.array([mode_names.index(v) for v in run_mode], dtype=np.int64)[code]
+    mode_id = np.where(rnd > 0, mode_names.index("RND"),
+                       np.where(rndm > 0, mode_names.index("RNDM"), mode_id))
+    accel_id = np.array([accel_names.index(v) for v in run_accel], dtype=np.int64)[code]
     return {
-        "mode": mode,
-        "accel": np.array([md.accel_mode or default_accel for md in uniq],
-                          dtype=_MODE_DTYPE)[code],
+        "mode": np.array(mode_names, dtype=_MODE_DTYPE)[mode_id],
+        "accel": np.array(accel_names, dtype=_MODE_DTYPE)[accel_id],
+        "mode_id": mode_id,
+        "accel_id": accel_id,
+        "mode_names": mode_names,
+        "accel_names": accel_names,
         "adis": np.array([md.adis_mm for md in uniq], dtype=np.float64)[code],
         "adispos": np.array([md.adispos_mm for md in uniq], dtype=np.float64)[code],
         "ctol": np.array([np.nan if md.contour_tol_mm is None else md.contour_tol_mm
                           for md in uniq], dtype=np.float64)[code],
         "radius": np.where(rnd > 0, rnd, rndm),
     }
+
+
+def _runs(items: list) -> tuple[list, np.ndarray]:
+    """The first item of every run of one object (``is``) in ``items``, and the run
+    index of each item, int, shape (len(items),)."""
+    if not items:
+        return [], np.zeros(0, dtype=np.int64)
+    new = np.fromiter(map(is_not, items[1:], items[:-1]), dtype=bool, count=len(items) - 1)
+    first = [items[0]] + [items[i] for i in (np.flatnonzero(new) + 1).tolist()]
+    return first, np.concatenate(([0], np.cumsum(new)))
+
+
+def _is_in(ids: np.ndarray, names: tuple[str, ...], chosen: tuple[str, ...]) -> np.ndarray:
+    """``names[ids]`` is one of ``chosen``, bool, shape of ``ids`` (by a lookup table)."""
+    return np.array([v in chosen for v in names], dtype=bool)[ids]
 
 
 def round_corners(path: Path, program: Program, machine: Machine) -> Path:
@@ -220,13 +241,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         return path
     ch = machine.channel
     attrs = _block_attributes(program, ch.acceleration_mode)
-    cand = np.flatnonzero(np.isin(attrs["mode"][path.block[:-1]], _ALL_MODES))
+    names = attrs["mode_names"]
+    cand = np.flatnonzero(_is_in(attrs["mode_id"][path.block[:-1]], names, _ALL_MODES))
     if cand.size == 0:
         return path
     a, b = cand, cand + 1                 # segments before and after each corner
     brk = cand + 1                        # break index of each corner
     ka, kb = path.block[a], path.block[b]
     mode_arr = attrs["mode"][ka]
+    mode_id = attrs["mode_id"][ka]
+    accel_id = attrs["accel_id"]
+    soft_id = attrs["accel_names"].index("SOFT") if "SOFT" in attrs["accel_names"] else -1
     mode = tuple(mode_arr.tolist())
     reason = np.full(a.size, -1, dtype=np.int64)
 
@@ -245,7 +270,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     decide((geo_a != geo_b) & (kb - ka <= 1), "geometry axes move in one block only")
     decide(path.stop[brk], "stop between the blocks")
     decide(kb - ka > 1, "block without path motion between")
-    decide(attrs["accel"][ka] != attrs["accel"][kb], "acceleration mode change (BRISK/SOFT)")
+    decide(accel_id[ka] != accel_id[kb], "acceleration mode change (BRISK/SOFT)")
     # --- transitions next to an arc: a tangential one is G645's to round (5.7,
     # :mod:`reference.rounding_tangential`), any other mode passes it as G64 does; a
     # corner next to an arc is a model limit of this version
@@ -258,7 +283,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
             row_max(np.abs(db[:, ~geo])) > MOVING_AXIS_TOL)
     decide(other, "non-geometry axes move: rounding not modelled yet")
-    decide(tang_arc & (mode_arr != "G645"), "tangential transition")
+    decide(tang_arc & ~_is_in(mode_id, names, ("G645",)), "tangential transition")
     trans = np.flatnonzero(tang_arc & (reason < 0))
     reason[trans] = _PENDING              # decided below, apart from the corners
     arc_corner = ~is_line & ~tang_arc
@@ -266,15 +291,19 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     if near_arc.size:                     # at corners next to arcs: the arcs' tangents
         t1, t2 = t1.copy(), t2.copy()
         t1[near_arc], t2[near_arc] = _junction_tangents(path, a[near_arc])
-    decide(is_tangential(t1, t2, FEASIBLE), "tangential transition")
+    tangential = is_tangential(t1, t2, FEASIBLE)
+    decide(tangential, "tangential transition")
+    # the same test between two lines, per break (-1: not computed), for the chains
+    known = np.full(m - 1, -1, dtype=np.int8)
+    known[a[is_line]] = tangential[is_line]
 
     # --- the rounding's shape (5.8, 5.9): under SOFT the axis motion in the rounding
     # area is jerk-limited (MD20480 ten-thousands digit 0), which a curvature jump at its
     # ends would break: a clothoid pair (G2); under BRISK and for RND/RNDM (a programmed
     # radius) the tangent arc
     theta = deflection_angle(t1, t2)
-    g2 = (attrs["accel"][ka] == "SOFT") & np.isin(mode_arr, ROUNDING_MODES)
-    d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_arr, t1, t2, theta,
+    g2 = (accel_id[ka] == soft_id) & _is_in(mode_id, names, ROUNDING_MODES)
+    d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_id, t1, t2, theta,
                                    g2, decide)
     # corners next to arcs: decided and sized apart (reference.rounding_arcs), after the
     # mode's parameters were checked above
@@ -287,7 +316,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     cap = c * np.minimum(path.length[a], path.length[b])
     first, last = a.copy(), b.copy()
     if multi.any():
-        cap, first, last = _across_blocks(path, attrs, a, b, d, cap, c, multi & (reason < 0))
+        cap, first, last = _across_blocks(path, attrs, a, b, d, cap, c, multi & (reason < 0),
+                                          known)
     clamped = d > cap
     d = np.minimum(d, cap)
     decide(~(d > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
@@ -302,7 +332,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     if open_.any():
         o = np.flatnonzero(open_)
         v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
-        soft = attrs["accel"][ka[o]] == "SOFT"
+        soft = accel_id[ka[o]] == soft_id
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
         a1, a2 = np.abs(t1[o]), np.abs(t2[o])
         v_in, v_out = _programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o])
@@ -314,8 +344,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         v_prog = np.minimum(v_in, v_out)
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
-        ovl = np.isin(mode_arr[o], _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
-        radius_mode = np.isin(mode_arr[o], _RADIUS_MODES)
+        ovl = _is_in(mode_id[o], names, _OVERLOAD_CHECKED) & \
+            (not ch.ignore_ovl_factor_for_adis)
+        radius_mode = _is_in(mode_id[o], names, _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
         sub[o] = ovl & (v64[o] >= v_prog)
         decide(sub, "G64 passes the corner without reduction (overload factor)")
@@ -392,7 +423,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
-    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm."""
+    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm. ``mode``:
+    each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -405,12 +437,13 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     how = np.full(k, NONE, dtype=np.int8)
     contour = np.full(k, np.inf)
     use_axis_tol = np.ones(k, bool)
-    how[np.isin(mode, _RADIUS_MODES)] = RADIUS
-    how[mode == "G641"] = ADIS
+    names = attrs["mode_names"]
+    how[_is_in(mode, names, _RADIUS_MODES)] = RADIUS
+    how[_is_in(mode, names, ("G641",))] = ADIS
     dig644 = _digit(sm, 3)
-    how[mode == "G644"] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
+    how[_is_in(mode, names, ("G644",))] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
-        sel = mode == md
+        sel = _is_in(mode, names, (md,))
         dig = _digit(sm, place)
         if dig == 4:
             how[sel] = ADIS
@@ -438,8 +471,11 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
         dev = np.minimum(contour, axis_deviation_limit(t1, t2, tol_k)) * g0
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
-        d_dev = np.where(g2, _clothoid_distance(theta, np.maximum(dev, 0.0)),
-                         distance_for_deviation(theta, np.maximum(dev, 0.0)))
+        dev0 = np.maximum(dev, 0.0)
+        d_dev = np.array(distance_for_deviation(theta, dev0), dtype=np.float64)
+        c = np.flatnonzero(g2)
+        if c.size:
+            d_dev[c] = _clothoid_distance(theta[c], dev0[c])
         d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
@@ -449,7 +485,7 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         d[dyn] = _dynamic_distance(path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn],
                                    theta[dyn], g2[dyn], how[dyn] == FREQ)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
-    multi = np.isin(mode, _ACROSS_BLOCKS) & (how == TOL)
+    multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
                "radius": radius}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
@@ -541,7 +577,8 @@ def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray
     return np.where(np.isfinite(d), d, 0.0)
 
 
-def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def _straight_chains(path: Path, attrs: dict[str, np.ndarray], known: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
     """Maximal runs of line segments that one rounding window may cover, and their lengths.
 
     Two consecutive segments are in one run when both are lines of consecutive program
@@ -550,6 +587,12 @@ def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarr
     agree in group-10 mode, acceleration mode, feed and G0: the blocks of a run are then
     one straight stretch of the contour that the control can replace in part by a
     rounding block without anything else changing along it.
+
+    Parameters
+    ----------
+    known : numpy.ndarray of int8, shape (m - 1,), optional
+        Per break, the tangency already decided by the same rule (1, 0), or -1: the
+        corners' own test (:func:`round_corners`), not repeated here.
 
     Returns
     -------
@@ -561,18 +604,25 @@ def _straight_chains(path: Path, attrs: dict[str, np.ndarray]) -> tuple[np.ndarr
     blk = path.block
     line = path.kind == _LINE
     ok = line[:-1] & line[1:] & ~path.stop[1:-1] & (np.diff(blk) == 1)
-    mode, accel = attrs["mode"], attrs["accel"]
+    mode, accel = attrs["mode_id"], attrs["accel_id"]
     ok &= mode[blk[:-1]] == mode[blk[1:]]
     ok &= accel[blk[:-1]] == accel[blk[1:]]
     ok &= (path.feed[:-1] == path.feed[1:]) & (path.rapid[:-1] == path.rapid[1:])
     sel = np.flatnonzero(ok)
-    ok[sel] = is_tangential(path.d[sel], path.d[sel + 1], FEASIBLE)
+    tang = known[sel] if known is not None else np.full(sel.size, -1, dtype=np.int8)
+    todo = np.flatnonzero(tang < 0)
+    tang = tang > 0
+    if todo.size:
+        j = sel[todo]
+        tang[todo] = is_tangential(path.d[j], path.d[j + 1], FEASIBLE)
+    ok[sel] = tang
     run = np.concatenate(([0], np.cumsum(~ok)))
     return run, np.bincount(run, weights=path.length)
 
 
 def _across_blocks(path: Path, attrs: dict[str, np.ndarray], a: np.ndarray, b: np.ndarray,
-                   d: np.ndarray, cap: np.ndarray, c: float, sel: np.ndarray
+                   d: np.ndarray, cap: np.ndarray, c: float, sel: np.ndarray,
+                   known: np.ndarray | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Clamp and window ends of corners whose rounding may span several short blocks.
 
@@ -603,6 +653,8 @@ def _across_blocks(path: Path, attrs: dict[str, np.ndarray], a: np.ndarray, b: n
         The clamp factor (``rounding_length_clamp``).
     sel : numpy.ndarray of bool, shape (k,)
         Corners that may reach across blocks.
+    known : numpy.ndarray of int8, shape (m - 1,), optional
+        Tangency per break where already decided (:func:`_straight_chains`).
 
     Returns
     -------
@@ -613,8 +665,12 @@ def _across_blocks(path: Path, attrs: dict[str, np.ndarray], a: np.ndarray, b: n
         unless it reaches further; ``d' = min(d, cap)``).
     """
     first, last = a.copy(), b.copy()
-    run, run_len = _straight_chains(path, attrs)
-    o = np.flatnonzero(sel)
+    # only a clamped corner can reach further (``wide <= d``): the chains are needed
+    # only if there is one
+    o = np.flatnonzero(sel & (d > cap))
+    if o.size == 0:
+        return cap, first, last
+    run, run_len = _straight_chains(path, attrs, known)
     wide = np.minimum(c * np.minimum(run_len[run[a[o]]], run_len[run[b[o]]]), d[o])
     reach = wide > np.minimum(cap[o], d[o])
     o, wide = o[reach], wide[reach]
@@ -741,7 +797,11 @@ def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) 
     """
     z = np.zeros_like(d)
     ok = open_ & (d > 0)
-    d_1, e_1 = clothoid_pair_shape(np.where(ok, theta, 1.0))
+    # the pair's shape where it is one (elementwise: the same numbers as on all rows)
+    d_1, e_1 = np.ones_like(d), np.ones_like(d)
+    c = np.flatnonzero(g2)
+    if c.size:
+        d_1[c], e_1[c] = clothoid_pair_shape(np.where(ok[c], theta[c], 1.0))
     with np.errstate(divide="ignore", invalid="ignore"):
         r_arc = d / np.tan(theta / 2.0)
         piece_c = d / d_1
@@ -853,6 +913,14 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
     if a.size == 0:
         return trim_start, trim_end
     sb = path.s_breaks
+    if (np.all(d < sb[a + 1] - sb[a]) and np.all(d < sb[a + 2] - sb[a + 1])
+            and np.all(d <= path.length[a]) and np.all(d <= path.length[a + 1])):
+        # every window within its corner's two segments (the one-block clamp): the
+        # general rule below then cuts exactly ``d`` from those two and nothing elsewhere
+        # (the distance to any other corner is at least a whole segment, more than its d)
+        trim_end[a] = d
+        trim_start[a + 1] = d
+        return trim_start, trim_end
     s0, s1 = sb[:-1], sb[1:]
     corner = sb[a + 1]
     # window whose corner is at or before the segment's start, and whose reach covers it
@@ -867,19 +935,6 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
     reach = np.where(hit, d[ic] - (corner[ic] - s1), 0.0)
     trim_end = np.where(hit & (reach > 0), np.minimum(reach, path.length), 0.0)
     return trim_start, trim_end
-
-
-def _interleave(rows: np.ndarray, pos: np.ndarray, ins: np.ndarray, ins_pos: np.ndarray,
-                total: int) -> np.ndarray:
-    """(total, n) array with ``rows`` at rows ``pos`` and ``ins`` at rows ``ins_pos``
-    (together every row once), written column by column: numpy scatters 1-d columns
-    faster than whole rows (about 25 ns a row), the values are the same."""
-    out = np.empty((total, rows.shape[1]))
-    for j in range(rows.shape[1]):
-        col = out[:, j]
-        col[pos] = rows[:, j]
-        col[ins_pos] = ins[:, j]
-    return out
 
 
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
@@ -946,6 +1001,11 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
                                         - np.repeat(np.cumsum(k_ins) - k_ins, k_ins))
     kept = np.flatnonzero(keep)
     line_pos = first[:-1][kept]
+    # every new row is one old row (kept) or one inserted row: gather them at once
+    # (one take per column set, instead of zeros and two scatters each)
+    src_row = np.empty(total, dtype=np.int64)
+    src_row[line_pos] = kept
+    src_row[arc_pos] = m + np.arange(arc_pos.size)
     new = {}
     # shortened segments: lines, and arcs at G645 transitions (circles: the start angle
     # moves by omega times the trim, the radius, centre and plane stay)
@@ -953,18 +1013,15 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     theta0 = path.theta0 + path.omega * trim_start
     for key in ("origin", "e1", "e2", "d"):
         src = origin if key == "origin" else getattr(path, key)
-        new[key] = _interleave(src.take(kept, axis=0), line_pos, arcs[key], arc_pos,
-                               total)
+        new[key] = np.concatenate((src, arcs[key])).take(src_row, axis=0)
     for key, dtype in (("radius", np.float64), ("omega", np.float64),
                        ("theta0", np.float64), ("length", np.float64),
                        ("block", np.int64), ("kind", np.int8), ("dradius", np.float64),
                        ("sharpness", np.float64)):
-        arr = np.zeros(total, dtype=dtype)
         src = {"length": length, "theta0": theta0}.get(key)
         src = getattr(path, key) if src is None else src
-        arr[line_pos] = src[keep]
-        arr[arc_pos] = arcs[key]
-        new[key] = arr
+        new[key] = np.concatenate((src.astype(dtype, copy=False),
+                                   arcs[key].astype(dtype, copy=False))).take(src_row)
     per = np.repeat(np.arange(a.size), k_ins)               # corner of each inserted row
     feed = np.zeros(total)
     feed[line_pos] = path.feed[keep]
