@@ -4,8 +4,9 @@ A seeded CAM-like polyline of 10^4 lines (0.5..5 mm, turns of 5..120 degrees, F6
 is planned by the heuristic under G64 and under each rounding mode, on the default
 machine with BRISK and SOFT; a seeded chain of 10^4 lines and tangent arcs under G645
 (tangential transitions with curvature jumps), and the same chain with a corner where
-each line leaves its arc (corners next to arcs); then the short-segment program (tests/data/
-lcnc_short_segments_0.001.ngc converted to G642 by tests/corpus_sinumerik.py, 3000 blocks of 0.0254 mm under G642) against itself under G64
+each line leaves its arc (corners next to arcs); then the short-segment program
+(../shared/corpus/lcnc_short_segments_0.001.ngc converted to G642 by
+tests/reference/corpus_sinumerik.py, 3000 blocks of 0.0254 mm) against itself under G64
 on both bundled machines. Every row is a ratio against the same program under G64,
 measured in the same run, of the wall time per block (the smallest of 7 runs: on a
 machine shared with other work the smallest is the least disturbed; medians of 3 moved
