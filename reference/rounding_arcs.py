@@ -42,13 +42,13 @@ from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
-from .core.limits import AxisArrays
 from .core.rounding import (REASON_CODE, ArcFillet, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
                             line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
+from .rounding_tangential import line_arc_pairs
 
 _LINE = KIND_CODES.index("line")
 _ARC = KIND_CODES.index("arc")
@@ -149,18 +149,13 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     ArcCorners
     """
     k = a.size
-    b = a + 1
+    b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
         reason[(reason < 0) & mask] = REASON_CODE[why]
 
-    kind_a, kind_b = path.kind[a], path.kind[b]
-    line_arc = (kind_a == _LINE) & (kind_b == _ARC)
-    arc_line = (kind_a == _ARC) & (kind_b == _LINE)
     decide(~(line_arc | arc_line), "corner between two arcs: rounding not modelled yet")
-    arc = np.where(line_arc, b, a)
-    line = np.where(line_arc, a, b)
     E1, E2 = path.e1.take(arc, axis=0), path.e2.take(arc, axis=0)
     t_line = path.d.take(line, axis=0)
     # the line in the arc's plane (OFF_PLANE_MAX)

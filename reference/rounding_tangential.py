@@ -93,6 +93,32 @@ class Transitions:
     rows: dict
 
 
+
+def line_arc_pairs(path: Path, a: np.ndarray):
+    """The two segments at breaks ``a``/``a + 1`` as a line and an arc, when they are.
+
+    Parameters
+    ----------
+    path : Path
+    a : numpy.ndarray of int, shape (k,)
+        Segment before each break.
+
+    Returns
+    -------
+    b : numpy.ndarray of int, shape (k,)
+        ``a + 1``.
+    line_arc, arc_line : numpy.ndarray of bool, shape (k,)
+        A line into an arc, an arc into a line.
+    arc, line : numpy.ndarray of int, shape (k,)
+        Which of the two is the arc and which the line (meaningful where either flag is
+        set).
+    """
+    b = a + 1
+    kind_a, kind_b = path.kind[a], path.kind[b]
+    line_arc = (kind_a == _LINE) & (kind_b == _ARC)
+    arc_line = (kind_a == _ARC) & (kind_b == _LINE)
+    return b, line_arc, arc_line, np.where(line_arc, b, a), np.where(line_arc, a, b)
+
 def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                            accel: np.ndarray, centripetal_share: float,
                            jerk_share: float, time_loss) -> Transitions:
@@ -120,17 +146,12 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     Transitions
     """
     k = a.size
-    b = a + 1
+    b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
         reason[(reason < 0) & mask] = REASON_CODE[why]
 
-    kind_a, kind_b = path.kind[a], path.kind[b]
-    line_arc = (kind_a == _LINE) & (kind_b == _ARC)
-    arc_line = (kind_a == _ARC) & (kind_b == _LINE)
-    arc = np.where(line_arc, b, a)
-    line = np.where(line_arc, a, b)
     decide(~(line_arc | arc_line),
            "tangential transition between arcs: rounding not modelled yet")
     circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
