@@ -67,8 +67,8 @@ from reference.core.limits import AxisArrays
 from reference.core.phases import FREQ_ACCEL_TOL_REL, min_phase_duration, moving_axes_by_segment
 from reference.core.tolerances import POS_TOL_MM, RATIO_TOL, VEL_TOL_MM_S
 
-__all__ = ["freq_lower_bound", "piece_lower_bounds", "rest_pieces", "segment_periods",
-           "segment_speed_caps"]
+__all__ = ["freq_lower_bound", "path_rate_bounds", "piece_lower_bounds", "rest_pieces",
+           "segment_periods", "segment_speed_caps"]
 
 
 def rest_pieces(path: Path, extra_breaks: np.ndarray | None = None) -> np.ndarray:
@@ -95,20 +95,37 @@ def _neighbourhood_max(x: np.ndarray, lo: int, hi: int) -> float:
     return float(np.max(x[max(lo - 1, 0):min(hi + 1, x.size)]))
 
 
+def path_rate_bounds(path: Path, per_axis: np.ndarray) -> np.ndarray:
+    """Largest path rate (speed or acceleration) a per-axis bound allows, per segment.
+
+    ``min_i x_i / |d_i|`` on lines (constant unit direction ``d``); ``sqrt(n) max_i x_i``
+    on arcs, helices, spirals and clothoids (some ``|q'_i| >= 1/sqrt(n)`` at every point,
+    ``q'`` being a unit vector).
+
+    Parameters
+    ----------
+    path : Path
+    per_axis : numpy.ndarray, shape (n,)
+        Per-axis bound (``v_max`` or ``a_max``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    curved = (path.radius * np.abs(path.omega) > 0) | (path.sharpness != 0)
+    with np.errstate(divide="ignore"):
+        line = np.min(np.where(np.abs(path.d) > 0, per_axis[None, :] / np.abs(path.d),
+                               np.inf), axis=1)
+    return np.where(curved, math.sqrt(path.n_axes) * float(np.max(per_axis)), line)
+
+
 def segment_speed_caps(path: Path, lim: AxisArrays) -> np.ndarray:
     """Upper bound on the path speed any accepted profile reaches on each segment, mm/s.
 
-    ``min(F, min_i V_i/|d_i|)`` on lines, ``min(F, sqrt(n) max_i V_i)`` on curves, times
-    ``1 + RATIO_TOL`` (the checker's slack). Shape (m,).
+    ``min(F, path_rate_bounds(v_max))``, times ``1 + RATIO_TOL`` (the checker's slack).
+    Shape (m,).
     """
-    # a line has a constant unit direction d; arcs, helices, spirals and clothoids turn
-    curved = (path.radius * np.abs(path.omega) > 0) | (path.sharpness != 0)
-    with np.errstate(divide="ignore"):
-        line_cap = np.min(np.where(np.abs(path.d) > 0, lim.v_max[None, :] / np.abs(path.d),
-                                   np.inf), axis=1)
-    curve_cap = math.sqrt(path.n_axes) * float(np.max(lim.v_max))
-    cap = np.where(curved, curve_cap, line_cap)
-    return np.minimum(cap, path.feed) * (1.0 + RATIO_TOL)
+    return np.minimum(path_rate_bounds(path, lim.v_max), path.feed) * (1.0 + RATIO_TOL)
 
 
 def piece_lower_bounds(path: Path, lim: AxisArrays) -> np.ndarray:

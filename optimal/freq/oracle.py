@@ -34,25 +34,10 @@ from reference.core.rows import block_motion, block_rows
 
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
-from .lower import freq_lower_bound
-from .lower import segment_periods
-from .upper import eroded_plan, fir_filtered, scaled, verified
+from .lower import freq_lower_bound, segment_periods
+from .upper import ERODED_OPENINGS, eroded_plans, fir_filtered, scaled, verified
 
 ProgressFn = Callable[..., object]
-
-#: Factors on the axis accelerations of extra acc solves whose FIR-filtered optima are
-#: candidates (the optimum itself is always one). Raised accelerations give shorter
-#: ramps, which leave more of each phase to the filter; since the eroded-caps candidate
-#: (optimal.freq.upper.eroded_plan) they won on none of the corpus programs or hand
-#: cases, so none is solved by default (each costs one acc solve).
-FIR_ACCEL_FACTORS: tuple[float, ...] = ()
-
-
-def _raised(limits: MachineLimits, g: float) -> MachineLimits:
-    from dataclasses import replace as dc_replace
-    return dc_replace(limits, axes=tuple(dc_replace(a, a_max=a.a_max * g)
-                                         for a in limits.axes))
-
 
 #: Default requested gap (DESIGN/issue: 2 % where achievable).
 DEFAULT_FREQ_GAP_TOL = 2e-2
@@ -107,11 +92,6 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         acc = solve(path, limits, "acc", holds=NO_HOLDS)
     else:
         base_sol = acc = solve(path, limits, "acc", holds=NO_HOLDS, progress=sub)
-    # FIR candidates from acc optima with raised accelerations too: their shorter ramps
-    # leave more of each phase to the filter (optimal.freq.upper.fir_filtered)
-    accs = [acc]
-    for g in FIR_ACCEL_FACTORS:
-        accs.append(solve(path, _raised(limits, g), "acc", holds=NO_HOLDS, tol=1e-2))
     moving = path.moving_axes()
     work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
     tb = time.perf_counter()
@@ -125,30 +105,28 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         c = scaled(path, limits, base_sol.profile, name)
         if c is not None:
             cands.append(c)
-    for g, a_sol in zip((1.0,) + FIR_ACCEL_FACTORS, accs):
-        if a_sol.profile is None:
-            continue
-        prof = a_sol.profile
+    if acc.profile is not None:
+        prof = acc.profile
         if np.any(prof.j != 0.0):
             # the acc optimum's pieces with jerk (on curves) as constant-acceleration
             # pieces through the same knots (v^2 linear in s between them): the filter's
             # exact integration needs that form; the checker judges the result anyway
             prof = Profile.from_path_velocity(prof.s, prof.v, prof.block)
-        c = verified(f"fir (acc x{g:g})", path, limits,
+        c = verified("fir (acc)", path, limits,
                      fir_filtered(path, limits, prof, base == "jerk"), name)
         if c is not None:
             cands.append(c)
-    # the FIR of a motion under the caps eroded by the window (optimal.freq.upper.eroded_plan):
-    # keeps corner, feed and curvature caps where the plain filtered optima overshoot them
-    lim_w = limits.for_axes(work.axes)
-    T_max = float(np.max(segment_periods(work, lim_w), initial=0.0))
-    for opening in ("time", "space") if T_max > 0 else ():
-        try:
-            u = eroded_plan(path, limits, T_max, base == "jerk", opening)
-        except ProfileError:
-            # the eroded caps leave an interval at zero speed at both ends (cannot be
-            # crossed): no candidate from this construction
-            continue
+    # the FIR of motions under the caps eroded by the window (optimal.freq.upper.
+    # eroded_plans): keeps corner, feed and curvature caps where the filtered optimum
+    # overshoots them
+    T_max = float(np.max(segment_periods(work, limits.for_axes(work.axes)), initial=0.0))
+    try:
+        plans = eroded_plans(path, limits, T_max, base == "jerk") if T_max > 0 else ()
+    except ProfileError:
+        # the eroded caps leave an interval at zero speed at both ends (cannot be
+        # crossed): no candidate from this construction
+        plans = ()
+    for opening, u in zip(ERODED_OPENINGS, plans):
         c = verified(f"fir (eroded caps, {opening} opening)", path, limits,
                      fir_filtered(path, limits, u.profile, base == "jerk", u.rest_breaks),
                      name, u.rest_breaks)

@@ -25,7 +25,7 @@ whatever the candidate was). The faster accepted one is the upper bound.
    leaves shorter phases. Each of these shows in the checker's report and is paid for
    by the time scaling. Pieces are filtered separately so that every stop stays at rest.
 
-3. **A motion under the caps eroded for the filter, then filtered** (:func:`eroded_plan`,
+3. **A motion under the caps eroded for the filter, then filtered** (:func:`eroded_plans`,
    :func:`cone_envelope`): the speed caps (feed, axis speeds, corners, curvature) lowered
    so that the moving average keeps them where it arrives, dips widened and bumps cut so
    that the filter leaves no short phase, short phases stretched as the control's
@@ -56,9 +56,10 @@ from reference.core.phases import (acceleration_phases, min_phase_duration,
 from reference.core.profile import Profile
 from reference.core.rules import curvature_jump_speed_cap
 
-from .lower import rest_pieces, segment_periods
+from .lower import path_rate_bounds, rest_pieces, segment_periods
 
-__all__ = ["Candidate", "fir_filtered", "scaled", "verified"]
+__all__ = ["Candidate", "ErodedPlan", "cone_envelope", "eroded_plans", "fir_filtered", "scaled",
+           "verified"]
 
 
 
@@ -244,25 +245,28 @@ def _state(prof: Profile, t: np.ndarray, t0: float, t1: float):
     return s, np.where(inside, v, z), np.where(inside, a, z), np.where(inside, j, z)
 
 
-#: Intervals of the base grid of :func:`eroded_plan` per erosion distance ``V W`` (``V``
+#: Intervals of the base grid of :func:`eroded_plans` per erosion distance ``V W`` (``V``
 #: the largest speed cap), between the two bounds below; nodes are added where the caps
 #: change (around every corner), so this only sets the resolution of curvature caps.
 ERODED_GRID_PER_DISTANCE = 8
 ERODED_GRID_MIN, ERODED_GRID_MAX = 2_000, 200_000
-#: Smallest tangential acceleration the passes of :func:`eroded_plan` use, as a fraction
+#: Smallest tangential acceleration the passes of :func:`eroded_plans` use, as a fraction
 #: of the smallest axis acceleration: where the caps leave none (a speed at the curvature
 #: limit), the motion still moves, and the checker's time scaling pays for it.
 ERODED_MIN_ACCEL_SHARE = 0.05
-#: Rounds in which :func:`eroded_plan` re-evaluates the tangential acceleration at the
+#: Rounds in which :func:`eroded_plans` re-evaluates the tangential acceleration at the
 #: speeds its passes reached (the checker judges the result; more rounds change little).
 TANGENTIAL_ROUNDS = 2
-#: Bisection steps of the cone envelope in :func:`eroded_plan` (relative resolution
+#: Bisection steps of the cone envelope in :func:`eroded_plans` (relative resolution
 #: 2^-48 of the largest cap: below round-off of the speeds it feeds).
 ENVELOPE_BISECTIONS = 48
-#: Rounds of dip widening and bump cutting in :func:`eroded_plan` (each followed by the
+#: Rounds of dip widening and bump cutting in :func:`eroded_plans` (each followed by the
 #: acceleration passes, which can leave new short features behind; two settle the corpus).
 REGULARISE_ROUNDS = 2
-#: Rounds of stretching u's short phases in :func:`eroded_plan`, and the margin they aim
+#: The two bump cuts of :func:`eroded_plans` (an opening in time and one in path
+#: length); neither is always faster, so both are candidates.
+ERODED_OPENINGS = ("time", "space")
+#: Rounds of stretching u's short phases in :func:`eroded_plans`, and the margin they aim
 #: above the rule (so that round-off does not leave a phase a hair short).
 ADAPT_ROUNDS = 4
 ADAPT_MARGIN = 1e-3
@@ -270,7 +274,7 @@ ADAPT_MARGIN = 1e-3
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ErodedPlan:
-    """Input motion of the FIR candidate (:func:`eroded_plan`).
+    """Input motion of the FIR candidate (:func:`eroded_plans`).
 
     Attributes
     ----------
@@ -329,7 +333,7 @@ def _passes(b: np.ndarray, step: np.ndarray) -> np.ndarray:
 def cone_envelope(s: np.ndarray, cap: np.ndarray, window_s: float) -> np.ndarray:
     """``c(p) = min over nodes q of max(cap(q), |s_p - s_q| / W)``, at every node.
 
-    A motion ``u <= c`` has the property :func:`eroded_plan` needs: wherever
+    A motion ``u <= c`` has the property :func:`eroded_plans` needs: wherever
     ``|s_p - s_q| < u(p) W``, ``u(p) <= cap(q)``. Computed per node by bisection on
     ``y``: the smallest ``y`` with ``min(cap over |s - s_p| <= y W) <= y`` (the left side
     falls and the right side rises with ``y``).
@@ -380,8 +384,8 @@ def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
     return Grid(s=s, segment=seg, break_node=np.searchsorted(s, sb))
 
 
-def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
-                jerk_limited: bool, opening: str = "time") -> ErodedPlan:
+def eroded_plans(path: Path, limits: MachineLimits, period_s: float, jerk_limited: bool,
+                 openings: tuple[str, ...] = ERODED_OPENINGS) -> tuple[ErodedPlan, ...]:
     """A motion whose moving average keeps every speed cap *where it arrives*: the input
     of the FIR candidate on paths with corners and curves.
 
@@ -407,13 +411,15 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     jerk_limited : bool
         The filter's window also spreads ``u``'s acceleration over ``a / J``
         (:func:`fir_filtered`); the erosion is for the larger window then.
-    opening : {"time", "space"}
-        How bumps narrower than the window are cut (see the comment in the code): the
-        oracle tries both, as neither is always faster.
+    openings : tuple of {"time", "space"}
+        How bumps narrower than the window are cut (:func:`_regularised`): the oracle
+        tries both, as neither is always faster. The caps, their erosion and the first
+        passes are shared.
 
     Returns
     -------
-    ErodedPlan
+    tuple of ErodedPlan
+        One per opening, in order.
     """
     from dataclasses import replace as dc_replace
 
@@ -425,15 +431,10 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     free = dc_replace(work, stop=np.zeros_like(work.stop))
     v_j, _ = junction_speed_caps(free, lim, permissive=False)
     rest = np.flatnonzero(np.isfinite(v_j) & (v_j <= 0.0))
-    # the largest path acceleration (lines: min_j A_j/|d_j|; curves: sqrt(n) max A) sets
-    # the spread a/J of the filter
-    curved = (work.radius * np.abs(work.omega) > 0) | (work.sharpness != 0)
-    with np.errstate(divide="ignore"):
-        a_line = np.min(np.where(np.abs(work.d) > 0, lim.a_max[None, :] / np.abs(work.d),
-                                 np.inf), axis=1)
-    a_path = float(np.max(np.where(curved, np.sqrt(work.n_axes) * np.max(lim.a_max), a_line)))
+    # the largest path acceleration sets the spread a/J of the filter
+    a_path = float(np.max(path_rate_bounds(work, lim.a_max)))
     W = max(period_s, a_path / float(np.min(lim.j_max))) if jerk_limited else period_s
-    vcap = float(np.max(np.minimum(work.feed, np.sqrt(work.n_axes) * np.max(lim.v_max))))
+    vcap = float(np.max(np.minimum(path_rate_bounds(work, lim.v_max), work.feed)))
     L = float(work.total_length)
     n = int(np.clip(ERODED_GRID_PER_DISTANCE * L / max(vcap * W, 1e-9), ERODED_GRID_MIN,
                     ERODED_GRID_MAX))
@@ -456,7 +457,6 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
     rest_nodes = np.concatenate((grid.break_node[work.stop], grid.break_node[rest]))
     cap[grid.break_node[rest]] = np.inf          # rests are piece ends, not caps
     b = cone_envelope(grid.s, cap, W) ** 2
-    b = cone_envelope(grid.s, cap, W) ** 2
     b[rest_nodes] = 0.0
     # tangential acceleration the axes have left beside the curvature term at the speed
     # reached, per interval (both ends): first at the eroded caps (the least), then at
@@ -472,17 +472,34 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         rem1 = np.where(np.abs(dq1) > 0, rem1, np.inf).min(axis=1)
         return 2.0 * np.maximum(np.minimum(rem0, rem1), floor) * ds_n
 
-    b_caps = b
-    step = steps(b_caps)
-    b = _passes(b_caps, step)
+    b_eroded = b
+    step = steps(b_eroded)
+    b = _passes(b_eroded, step)
     for _ in range(TANGENTIAL_ROUNDS):
         step = steps(b)
-        b = _passes(b_caps, step)
-    # a dip or a bump that u crosses in less than W leaves phases of its own width after
-    # the filter (a moving average spreads a step over W, not a pulse): dips are widened
-    # to plateaus crossed in W (the cone envelope of u itself) and narrower bumps cut
-    # (an opening of width W in time), then the passes again
-    s_n = grid.s
+        b = _passes(b_eroded, step)
+    blocks = work.block[grid.segment]
+    spread = a_path / float(np.min(lim.j_max)) if jerk_limited else 0.0
+    plans = []
+    for opening in openings:
+        b_o = _regularised(grid.s, b, step, rest_nodes, vcap, W, opening)
+        b_o = _adapted(work, lim, grid, b_o, step.copy(), blocks, spread)
+        prof = Profile.from_path_velocity(grid.s, np.sqrt(np.maximum(b_o, 0.0)), blocks)
+        plans.append(ErodedPlan(profile=prof, rest_breaks=rest, window_s=W))
+    return tuple(plans)
+
+
+def _regularised(s_n: np.ndarray, b: np.ndarray, step: np.ndarray, rest_nodes: np.ndarray,
+                 vcap: float, W: float, opening: str) -> np.ndarray:
+    """Dips widened and bumps cut (see :func:`eroded_plans`); returns ``b`` after the
+    passes, shape (N,).
+
+    A dip or a bump that u crosses in less than ``W`` leaves phases of its own width after
+    the filter (a moving average spreads a step over ``W``, not a pulse): dips become
+    plateaus crossed in ``W`` (the cone envelope of u itself) and narrower bumps are cut
+    by a flat opening, then the passes run again.
+    """
+    ds_n = np.diff(s_n)
     for _ in range(REGULARISE_ROUNDS):
         v = np.sqrt(np.maximum(b, 0.0))
         # the sources are u's dips: runs of equal speed with a higher run on both sides
@@ -493,8 +510,6 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         dip = np.zeros(rv.size, bool)
         dip[1:-1] = (rv[:-2] > rv[1:-1]) & (rv[2:] > rv[1:-1])
         low = np.repeat(dip, np.diff(np.concatenate((starts, [v.size]))))
-        v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
-        v_top = float(np.max(v))
         v = np.minimum(cone_envelope(s_n, np.where(low, v, vcap), W), v)
         v_top = float(np.max(v))
         # the bumps are cut by a flat opening (constant width in its parameter, so that
@@ -517,15 +532,20 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
         opened = -_window_min(-_window_min(v, lo, hi), lo, hi)
         b = np.minimum(b, np.minimum(opened, v) ** 2)
         b[rest_nodes] = 0.0
-        b_env = b
         b = _passes(b, step)
-    # the rule on u itself, as the control's adaptation does it: a phase that is shorter
-    # than its 1/f (less the filter's jerk spread, which lengthens every phase) gets the
-    # constant acceleration dv / duration that makes it last that long; repeated, as a
-    # slower ramp can change its neighbours
-    spread = a_path / float(np.min(lim.j_max)) if jerk_limited else 0.0
+    return b
+
+
+def _adapted(work: Path, lim, grid, b: np.ndarray, step: np.ndarray, blocks: np.ndarray,
+             spread: float) -> np.ndarray:
+    """The rule on u itself, as the control's adaptation does it (see
+    :func:`eroded_plans`): a phase shorter than its ``1/f`` less the filter's jerk
+    ``spread`` (which lengthens every phase) gets the constant acceleration that makes it
+    last that long; repeated, as a slower ramp can change its neighbours. ``step`` is
+    changed in place; returns ``b``, shape (N,)."""
+    s_n = grid.s
     ds = np.diff(s_n)
-    blocks = work.block[grid.segment]
+    b_env = b
     for _ in range(ADAPT_ROUNDS):
         prof = Profile.from_path_velocity(s_n, np.sqrt(np.maximum(b, 0.0)), blocks)
         ph = acceleration_phases(prof)
@@ -546,5 +566,4 @@ def eroded_plan(path: Path, limits: MachineLimits, period_s: float,
                              a_new[p_])
             step[sl] = 2.0 * a_set * ds[sl]
         b = _passes(b_env, step)
-    prof = Profile.from_path_velocity(s_n, np.sqrt(np.maximum(b, 0.0)), blocks)
-    return ErodedPlan(profile=prof, rest_breaks=rest, window_s=W)
+    return b

@@ -142,3 +142,20 @@ def rows_where(mask: np.ndarray):
     if mask.all():
         return slice(None)
     return np.flatnonzero(mask) if mask.any() else None
+
+
+def concat_ranges(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Concatenation of ``arange(a, b)`` for all pairs ``(a, b)``, vectorised.
+
+    Parameters
+    ----------
+    starts, ends : numpy.ndarray of int, shape (k,)
+        ``ends >= starts``.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (sum(ends - starts),)
+    """
+    n = ends - starts
+    off = np.repeat(starts - np.concatenate(([0], np.cumsum(n)[:-1])), n)
+    return np.arange(n.sum()) + off

@@ -124,6 +124,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from .arrays import concat_ranges
 from .errors import ProfileError
 from .geometry import Path, clothoid_derivative_norms, plane_amplitudes
 from .limits import AxisArrays, MachineLimits
@@ -877,7 +878,7 @@ def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
         k_lo = np.clip(np.searchsorted(p.s, c_sb - win, side="left"), 0, K)
         k_hi = np.maximum(np.searchsorted(p.s, c_sb + win, side="right"), k_lo + 1)
         k_lo = np.minimum(k_lo, k_hi - 1)
-        knots = _ranges(k_lo, k_hi)
+        knots = concat_ranges(k_lo, k_hi)
         v_b[lo:lo + c_sb.size] = np.minimum.reduceat(
             np.abs(p.v[knots]), np.concatenate(([0], np.cumsum(k_hi - k_lo)[:-1])))
         k_first[lo:lo + c_sb.size] = k_lo
@@ -920,7 +921,7 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
         for r0 in range(0, sel.size, _WORK_CHUNK):
             q = sel[r0:r0 + _WORK_CHUNK]
             n_r = ph.last[q] - ph.first[q] + 1
-            idx = _ranges(ph.first[q], ph.last[q] + 1)
+            idx = concat_ranges(ph.first[q], ph.last[q] + 1)
             np.maximum.at(w.per_block, path.block[ctx.seg[idx]], np.repeat(ratio[q], n_r))
     i = int(np.argmax(ratio))
     k = int(ph.first[i])
@@ -932,11 +933,6 @@ def _check_frequency(ctx: _Ctx, w: _Worst) -> None:
     w.axis = path.axes[int(ax[i])]
 
 
-def _ranges(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Concatenation of ``arange(a, b)`` for all pairs, vectorised."""
-    n = ends - starts
-    off = np.repeat(starts - np.concatenate(([0], np.cumsum(n)[:-1])), n)
-    return np.arange(n.sum()) + off
 
 
 # ===================================================================== time scaling

@@ -64,7 +64,7 @@ import numpy as np
 from .arrays import row_dots, row_norms
 from .errors import PathError
 from .rounding import RoundingTable
-from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, POS_TOL_MM
+from .tolerances import ARC_SPIRAL_MIN_MM, MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL, POS_TOL_MM
 
 SegmentKind = Literal["line", "arc", "rounding", "trc", "tlift"]
 KIND_CODES: tuple[str, ...] = ("line", "arc", "rounding", "trc", "tlift")
@@ -553,6 +553,37 @@ def plane_amplitudes(path: "Path") -> PlaneAmplitudes:
     return PlaneAmplitudes(speed, curvature, jerk_t, jerk_n, omega_max)
 
 
+
+
+def axis_tangent_amplitudes(path: "Path", amp: PlaneAmplitudes | None = None
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Per segment and axis, the two parts of ``|q'_i|``: constant and rotating.
+
+    Parameters
+    ----------
+    path : Path
+    amp : PlaneAmplitudes, optional
+        :func:`plane_amplitudes` of ``path`` when already computed.
+
+    Returns
+    -------
+    D, P : numpy.ndarray, shape (m, n)
+        ``|d_i|`` and ``sqrt(e1_i^2 + e2_i^2)`` times the in-plane speed amplitude (its
+        supremum on spirals and clothoids), so ``|q'_i| <= D + P`` on the whole segment.
+    """
+    if amp is None:
+        amp = plane_amplitudes(path)
+    rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
+    return np.abs(path.d), rho * amp.speed[:, None]
+
+
+def moving_axes(D: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """The rule for which axes move on a segment: ``D + P > MOVING_AXIS_TOL``.
+
+    One rule for the heuristic's limits and the checker's frequency rule (which axes'
+    LOOKAH_FREQUENCY applies). ``D, P`` from :func:`axis_tangent_amplitudes`; shape (m, n).
+    """
+    return (D + P) > MOVING_AXIS_TOL
 def _path_length(delta: np.ndarray, geometry: np.ndarray) -> np.ndarray:
     """Length of linear moves ``delta`` (shape ``(m, n)``) by the path-length rule."""
     geo = np.sqrt(np.sum(delta[:, geometry] ** 2, axis=1))

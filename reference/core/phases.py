@@ -53,10 +53,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import Path
+from .arrays import concat_ranges
+from .geometry import Path, axis_tangent_amplitudes, moving_axes
 from .limits import AxisArrays
 from .profile import Profile
-from .tolerances import MOVING_AXIS_TOL
 
 __all__ = ["FREQ_ACCEL_TOL_REL", "Phases", "acceleration_phases", "min_phase_duration",
            "moving_axes_by_segment", "phase_frequencies"]
@@ -232,7 +232,7 @@ def _pulse_moments(a0: np.ndarray, j: np.ndarray, t: np.ndarray, parent: np.ndar
     n_p = ends - starts
     for lo in range(0, P, _STEP):
         hi = min(P, lo + _STEP)
-        idx = _ranges(starts[lo:hi], ends[lo:hi])
+        idx = concat_ranges(starts[lo:hi], ends[lo:hi])
         which = np.repeat(np.arange(hi - lo), n_p[lo:hi])
         k = parent[idx]
         c0 = a0[k] * sign[idx]
@@ -262,12 +262,10 @@ def moving_axes_by_segment(path: Path) -> np.ndarray:
     Returns
     -------
     numpy.ndarray of bool, shape (m, n_axes)
-        True where the axis' direction component, or its circular amplitude on an arc or
-        helix, exceeds :data:`~reference.core.tolerances.MOVING_AXIS_TOL`.
+        :func:`reference.core.geometry.moving_axes` (the rule the heuristic's limits use
+        too).
     """
-    rw = path.radius * np.abs(path.omega)
-    reach = np.abs(path.d) + rw[:, None] * (np.abs(path.e1) + np.abs(path.e2))
-    return reach > MOVING_AXIS_TOL
+    return moving_axes(*axis_tangent_amplitudes(path))
 
 
 def phase_frequencies(path: Path, lim: AxisArrays, phases: Phases,
@@ -302,7 +300,7 @@ def phase_frequencies(path: Path, lim: AxisArrays, phases: Phases,
         hi = min(P, lo + _STEP)
         first, last = phases.first[lo:hi], phases.last[lo:hi]
         n_r = last - first + 1
-        idx = _ranges(first, last + 1)
+        idx = concat_ranges(first, last + 1)
         run = np.maximum.reduceat(seg_moving[interval_segment[idx]],
                                   np.concatenate(([0], np.cumsum(n_r)[:-1])), axis=0)
         f = np.where(run.astype(bool), lim.frequency_hz[None, :], np.inf)
@@ -318,8 +316,3 @@ def min_phase_duration(f: np.ndarray | float) -> np.ndarray:
         return np.where(np.isfinite(f), 1.0 / f, 0.0)
 
 
-def _ranges(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Concatenation of ``arange(a, b)`` for all pairs, vectorised."""
-    n = ends - starts
-    off = np.repeat(starts - np.concatenate(([0], np.cumsum(n)[:-1])), n)
-    return np.arange(n.sum()) + off

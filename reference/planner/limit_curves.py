@@ -47,10 +47,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.arrays import row_argmin, row_min, rows_where
-from ..core.geometry import Path, plane_amplitudes
+from ..core.geometry import Path, axis_tangent_amplitudes, moving_axes, plane_amplitudes
 from ..machine import Machine
 from . import causes as C
-from ..core.tolerances import MOVING_AXIS_TOL
 from .parameters import PlannerParameters
 from .drive import drive_reduction
 from .stops import ACCEL_MODES, MODE_CODE, SegmentModes
@@ -102,17 +101,14 @@ def axis_amplitudes(path: Path) -> tuple[np.ndarray, ...]:
     derived from them holds on the whole segment.
     """
     rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
-    rw = np.abs(path.radius * path.omega)[:, None]
     w = np.abs(path.omega)[:, None]
-    D = np.abs(path.d)
-    P = rho * rw
+    amp = plane_amplitudes(path)
+    D, P = axis_tangent_amplitudes(path, amp)
     Q = P * w
     R = Q * w
     Rn = np.zeros_like(R)
     sp = np.flatnonzero((path.dradius != 0) | (path.sharpness != 0))
     if sp.size:
-        amp = plane_amplitudes(path)
-        P[sp] = rho[sp] * amp.speed[sp, None]
         Q[sp] = rho[sp] * amp.curvature[sp, None]
         R[sp] = rho[sp] * amp.jerk_t[sp, None]
         Rn[sp] = rho[sp] * amp.jerk_n[sp, None]
@@ -187,7 +183,7 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
     m = path.n_segments
     lim, A, J = _axis_factors(path, machine, modes)
     D, P, Q, R, Rn = axis_amplitudes(path)
-    moving = (D + P) > MOVING_AXIS_TOL
+    moving = moving_axes(D, P)
     inf = np.full(m, np.inf)
     soft = modes.jerk_limited
     with np.errstate(divide="ignore", invalid="ignore"):
