@@ -9,8 +9,9 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
    (proof there), plus the holds;
 3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
-   (the base optimum slowed down, the filtered acc optimum, the filtered eroded-caps
-   motion);
+   (the base optimum slowed down, the filtered acc optimum, the motion under the caps
+   adapted to the rule: unfiltered for ``acc+freq``, and filtered with the windows of
+   :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each);
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -35,7 +36,7 @@ from reference.core.rows import block_motion, block_rows
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from .lower import freq_lower_bound, segment_periods
-from .upper import ERODED_OPENINGS, eroded_plans, fir_filtered, scaled, verified
+from .upper import candidate_windows, eroded_plans, fir_filtered, scaled, verified
 
 ProgressFn = Callable[..., object]
 
@@ -116,20 +117,22 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                      fir_filtered(path, limits, prof, base == "jerk"), name)
         if c is not None:
             cands.append(c)
-    # the FIR of motions under the caps eroded by the window (optimal.freq.upper.
-    # eroded_plans): keeps corner, feed and curvature caps where the filtered optimum
-    # overshoots them
-    T_max = float(np.max(segment_periods(work, limits.for_axes(work.axes)), initial=0.0))
-    try:
-        plans = eroded_plans(path, limits, T_max, base == "jerk") if T_max > 0 else ()
-    except ProfileError:
-        # the eroded caps leave an interval at zero speed at both ends (cannot be
-        # crossed): no candidate from this construction
-        plans = ()
-    for opening, u in zip(ERODED_OPENINGS, plans):
-        c = verified(f"fir (eroded caps, {opening} opening)", path, limits,
-                     fir_filtered(path, limits, u.profile, base == "jerk", u.rest_breaks),
-                     name, u.rest_breaks)
+    # motions under the caps, adapted to the rule (optimal.freq.upper.eroded_plans):
+    # unfiltered for acc+freq, and through moving averages of a few windows (caps eroded
+    # for each, so that the filtered motion keeps them where it arrives)
+    sub_lim = limits.for_axes(work.axes)
+    T_max = float(np.max(segment_periods(work, sub_lim), initial=0.0))
+    for W in (candidate_windows(work, sub_lim, T_max, base == "jerk") if T_max > 0 else ()):
+        try:
+            u = eroded_plans(path, limits, T_max, W, base == "jerk")
+        except ProfileError:
+            # the eroded caps leave an interval at zero speed at both ends (cannot be
+            # crossed): no candidate from this construction
+            continue
+        prof = fir_filtered(path, limits, u.profile, base == "jerk", u.rest_breaks,
+                            window_s=W) if W > 0 else u.profile
+        label = f"fir {W * 1e3:.3g} ms (eroded caps)" if W > 0 else "adapted caps"
+        c = verified(label, path, limits, prof, name, u.rest_breaks)
         if c is not None:
             cands.append(c)
     t_check = time.perf_counter() - tc

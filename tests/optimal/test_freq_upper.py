@@ -1,25 +1,32 @@
 """Building blocks of the frequency oracle's upper bound (optimal.freq.upper), each
-against a brute-force evaluation of its definition, and the closed form on lines."""
+against a brute-force evaluation of its definition or, for the eroded caps, against a
+dense simulation of the moving average they are built for."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from optimal.freq.upper import _passes, _window_min, cone_envelope
+from optimal.freq.upper import _passes, _window_min, window_caps
+from reference.core.profile import Profile
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_cone_envelope_is_its_definition(seed):
-    # c(p) = min over q of max(cap(q), |s_p - s_q| / W), by an O(N^2) table
+def test_window_caps_is_its_definition(seed):
+    # c(p) = min cap(q) over the q whose band |s - s_q| <= cap(q) W / 2, widened by one
+    # node on each side, holds p: by an O(N^2) table
     rng = np.random.default_rng(seed)
     s = np.sort(rng.uniform(0.0, 50.0, 300))
     cap = rng.uniform(0.0, 200.0, 300)
     cap[rng.integers(0, 300, 30)] = rng.uniform(0.0, 5.0, 30)    # a few corners
+    cap[rng.integers(0, 300, 10)] = np.inf
     W = 0.05
-    ref = np.min(np.maximum(cap[None, :], np.abs(s[:, None] - s[None, :]) / W), axis=1)
-    got = cone_envelope(s, cap, W)
-    np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-9)
+    ref = cap.copy()
+    for q in np.flatnonzero(np.isfinite(cap) & (cap > 0)):
+        inside = np.flatnonzero(np.abs(s - s[q]) <= cap[q] * W / 2)
+        lo, hi = max(inside.min() - 1, 0), min(inside.max() + 1, s.size - 1)
+        ref[lo:hi + 1] = np.minimum(ref[lo:hi + 1], cap[q])
+    np.testing.assert_array_equal(window_caps(s, cap, W), ref)
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -45,3 +52,44 @@ def test_passes_are_the_largest_profile_under_the_caps(seed):
     for i in range(398, -1, -1):
         ref[i] = min(ref[i], ref[i + 1] + step[i])
     np.testing.assert_allclose(_passes(b, step), ref, rtol=1e-12, atol=1e-9)
+
+
+def _moving_average_at_caps(s, cap, W, seed):
+    """Speed of the moving average (window W) of a motion under ``window_caps``, where
+    the filtered motion passes each capped node, and the caps there: by a dense time
+    simulation, independent of how the caps were computed. The motion: the largest
+    speed under the eroded caps with |dv^2/ds| <= 2 A, at rest at both ends."""
+    u_cap = window_caps(s, cap, W)
+    b = np.minimum(u_cap, np.max(cap[np.isfinite(cap)])) ** 2
+    b[[0, -1]] = 0.0
+    b = _passes(b, 2.0 * 2000.0 * np.diff(s))
+    prof = Profile.from_path_velocity(s, np.sqrt(b))
+    dt = 2e-5
+    t = np.arange(-W, prof.duration + W, dt)
+    pos, _, _, _ = prof.state(np.clip(t, 0.0, prof.duration))
+    pos = np.where(t < 0.0, 0.0, pos)
+    k = int(round(W / dt))
+    # v_out(t) = (s_u(t) - s_u(t - W)) / W; s_out(t) = mean of s_u over [t - W, t]
+    v_out = (pos[k:] - pos[:-k]) / W
+    c = np.concatenate(([0.0], np.cumsum(0.5 * (pos[1:] + pos[:-1]) * dt)))
+    s_out = (c[k:] - c[:-k]) / W
+    q = np.flatnonzero(np.isfinite(cap) & (cap > 0))
+    q = q[(s[q] > s_out[0]) & (s[q] < s_out[-1])]
+    i = np.searchsorted(s_out, s[q])           # s_out increases (u > 0 inside)
+    v_at = np.maximum(v_out[i - 1], v_out[i])  # both samples around the crossing
+    return v_at, cap[q], u_cap
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_window_caps_keep_every_cap_after_the_moving_average(seed):
+    # the guarantee of window_caps (band or cone per cap), by simulating the filter
+    rng = np.random.default_rng(seed)
+    s = np.concatenate(([0.0], np.sort(rng.uniform(0.0, 60.0, 400)), [60.0]))
+    cap = rng.uniform(40.0, 120.0, s.size)
+    corners = rng.integers(5, s.size - 5, 12)
+    cap[corners] = rng.uniform(0.5, 20.0, corners.size)     # slow corners
+    cap[[0, -1]] = 0.0
+    v_at, c_at, u_cap = _moving_average_at_caps(s, cap, 0.05, seed)
+    assert np.all(u_cap <= cap)
+    # sampling: two samples of 2e-5 s around each crossing, at most 2000 mm/s^2 apart
+    np.testing.assert_array_less(v_at, c_at + 2000.0 * 2e-5 * 2 + 1e-9)
