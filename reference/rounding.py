@@ -29,10 +29,11 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
    pairs that takes up the classical shift and a curvature ramp onto the arc,
    :mod:`reference.core.transition`); other modes name it "tangential transition".
-   A corner between a line and a circular arc is rounded by a tangent fillet
-   (:func:`reference.rounding_arcs.arc_corners`, sized by the same mode parameters).
-   Model limits of this version: corners between two arcs, next to helices, and
-   corners where non-geometry axes move are passed as under G64, named;
+   A corner between a line and a circular arc, or between two circular arcs in one
+   plane, is rounded by a tangent fillet (:func:`reference.rounding_arcs.arc_corners`,
+   sized by the same mode parameters). Model limits of this version: corners next to
+   helices, between arcs in different planes, and corners where non-geometry axes move
+   are passed as under G64, named;
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
 
    * G641: ``d = ADIS`` (G1/G2/G3), ``ADISPOS`` (G0), the smaller if one block is G0;
@@ -73,10 +74,10 @@ Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions, and the rounding of corners next to arcs,
-are modelled between a line and a circle only (arc into arc, helices and spirals are
-named and passed as G64; a corner next to an arc gets a tangent arc, G1, also under
-SOFT); a window
+G645's rounding of tangential transitions is modelled between a line and a circle only,
+the rounding of corners next to arcs between a line and a circle and between two
+circles in one plane (tangential arc into arc, helices and spirals are named and passed
+as G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
