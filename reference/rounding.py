@@ -424,7 +424,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
-    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm. ``mode``:
+    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), ``dyn_radius``
+    and ``dyn_length`` (G644 2xxx/3xxx, :func:`_dynamic_distance`), mm. ``mode``:
     each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
@@ -482,13 +483,15 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
     # G644 2xxx (frequency) and 3xxx (maximum dynamics): sized by the path velocity
     dyn = np.flatnonzero((how == FREQ) | (how == DYN))
+    dyn_radius, dyn_length = np.zeros(k), np.zeros(k)
     if dyn.size:
-        d[dyn] = _dynamic_distance(path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn],
-                                   theta[dyn], g2[dyn], how[dyn] == FREQ)
+        d[dyn], dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
+            path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn], theta[dyn], g2[dyn],
+            how[dyn] == FREQ)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "radius": radius}
+               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 
@@ -520,9 +523,14 @@ def _plane_weights(t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray,
                       t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, g2: np.ndarray,
-                      freq: np.ndarray) -> np.ndarray:
+                      freq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Tangent distance of G644 with SMOOTHING_MODE 3xxx (``freq`` False) or 2xxx
-    (``freq`` True), before the block-length clamp, mm, shape (k,).
+    (``freq`` True), before the block-length clamp, mm, shape (k,); and for a tangent
+    arc whose turn is not known in advance (the fillets at arc corners,
+    :mod:`reference.rounding_arcs`) the same rules as the smallest radius (3xxx:
+    ``1 / K_a``, under SOFT also ``1 / sqrt(K_j)``, the fillet staying an arc; 2xxx: 0)
+    and the length the arc must have (3xxx ``v T_ipo``, 2xxx ``v T``), mm, shape (k,)
+    each.
 
     Both are sized by "the current path velocity" (B1 excerpt), here the programmed speed
     ``v`` of the slower line (:func:`_programmed_speeds`):
@@ -575,7 +583,10 @@ def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray
         piece = np.where(freq, length / 2.0, l_dyn)
         d_1, _ = clothoid_pair_shape(np.clip(theta, 1e-300, None))
         d = np.where(g2, piece * d_1, radius * np.tan(theta / 2.0))
-    return np.where(np.isfinite(d), d, 0.0)
+        r_min = np.where(freq, 0.0, np.where(g2, np.maximum(1.0 / k_a, 1.0 / np.sqrt(k_j)),
+                                              1.0 / k_a))
+    return (np.where(np.isfinite(d), d, 0.0), r_min,
+            np.where(freq, length, v * t_ipo))
 
 
 def _straight_chains(path: Path, attrs: dict[str, np.ndarray], known: np.ndarray | None = None

@@ -30,6 +30,11 @@ corner; past that branch the fillet does not exist and the limit counts as broke
   ``|C_i - M_i| <= tol_i`` and ``|C - M| <=`` the contour tolerance where one applies
   (``M`` the fillet's point nearest the corner ``C``, as at line-line corners), G0
   tolerances times MD20560, by a root search on ``log r``;
+* G644 2xxx/3xxx: the dynamic size of :func:`reference.rounding._dynamic_distance`
+  for a tangent arc, whose turn here depends on ``r``: 3xxx the smallest fillet the
+  axes pass at the programmed speed (centripetal, under SOFT the path jerk on the
+  fillet, at least ``v T_ipo`` long), 2xxx the fillet ``v T`` long (``T`` from
+  LOOKAH_FREQUENCY), by the same root search on ``log r`` (its length ``r sweep(r)``);
 * the block-length clamp on both sides (``c`` times each participating block's length,
   along the arc for an arc, 5.3), in closed form. Between two circles the replaced
   length grows with ``r`` only up to the largest fillet (the two circles may cross a
@@ -40,8 +45,7 @@ Model limits, named: the fillet is G1 (curvature jumps at its ends; under SOFT t
 curvature-jump rule of 6.3 caps the speed there, as it does for a BRISK-shaped
 rounding), where the line-line corners get a clothoid pair under SOFT; corners next to
 a helix or spiral, whose line leaves the arc's plane or whose two arcs lie in different
-planes, corners next to inserted TRC/TLIFT blocks, and G644's dynamic digits (2xxx,
-3xxx) at arc corners are passed as under G64.
+planes, and corners next to inserted TRC/TLIFT blocks are passed as under G64.
 
 Speeds as at line-line corners (:mod:`reference.rounding`): G641/G642/G645 round only
 where G64 must slow down (overload factor, 4.3); every mode but RND/RNDM only where the
@@ -193,8 +197,6 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
            "corner next to a helix or spiral, or out of the arc's plane: rounding not "
            "modelled yet")
     how = targets["how"]
-    decide((how == HOW_FREQ) | (how == HOW_DYN),
-           "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet")
 
     # plane coordinates: the corner at the origin, the construction traversed from the
     # line into the arc (arc into line: backwards), from the first arc into the second
@@ -237,7 +239,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         ro, r_cap, tol_ok = _radius_by_mode(
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
-            cap_first[i], cap_second[i])
+            cap_first[i], cap_second[i], targets["dyn_radius"][i],
+            targets["dyn_length"][i])
         clamped[i] = ro >= r_cap
         f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
         r[i] = ro
@@ -482,10 +485,13 @@ def _put(into: _Fillet, i: np.ndarray, part: _Fillet) -> None:
 def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray,
                     rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
-                    cap_second: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The largest fillet radius within the mode's limits and the block-length clamp,
-    mm, shape (k,) (0: none); the clamp's radius; and whether the tolerance holds at
-    the radius found (True where no tolerance applies)."""
+                    cap_second: np.ndarray, dyn_radius: np.ndarray,
+                    dyn_length: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
+    the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
+    dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
+    and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
+    the tolerance holds at the radius found (True where no tolerance applies)."""
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
@@ -513,6 +519,19 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
 
         ro[tl] = _tolerance_radius(ratio, tc, r_cap[tl])
         tol_ok[tl] = ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *tc) <= 0.0
+    # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
+    # about like r: the same search, the largest r not longer), at least dyn_radius,
+    # then clamped
+    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN))
+    if dy.size:
+        n_geo = len(cols)
+        dc = (*(col[dy] for col in cols), dyn_length[dy])
+
+        def too_long(x, *c):
+            return _log_length_ratio(x, *c, n_geo=n_geo, fillet=fam.fillet)
+
+        r_len = _tolerance_radius(too_long, dc, r_cap[dy])
+        ro[dy] = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
     ro = np.where(np.isfinite(ro), ro, 0.0)
     return ro, r_cap, tol_ok
 
@@ -569,6 +588,17 @@ def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,
         return np.where(soft, np.minimum(v_arc, row_min(np.where(
             moving, np.cbrt(jerk_share * lim.j_max[None, :] * (radius * radius)[:, None]
                             / wr), np.inf))), v_arc)
+
+
+def _log_length_ratio(x: np.ndarray, *cols, n_geo: int, fillet: Callable) -> np.ndarray:
+    """``log(r sweep / L)`` of the fillets of radius ``r = exp(x)`` (their length against
+    the target ``L``, the last column), elementwise over 1-d columns;
+    :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist."""
+    r = np.exp(x)
+    f = fillet(r, *cols[:n_geo])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(f.valid, np.log(np.maximum(r * f.sweep / cols[n_geo], 1e-300)),
+                        NO_FILLET_LOG_RATIO)
 
 
 def _log_tol_ratio(x: np.ndarray, *cols, n_axes: int, n_geo: int,

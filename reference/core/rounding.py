@@ -63,6 +63,8 @@ ROUNDING_REASONS: tuple[str, ...] = (
     # corners next to arcs (reference.rounding_arcs): model limits
     "corner next to a helix or spiral, or out of the arc's plane: rounding not modelled "
     "yet",                                                            # 19
+    # no longer given (G644 2xxx/3xxx at arc corners are modelled); kept so that the
+    # codes of the reasons after it stay
     "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet",  # 20
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}

@@ -28,18 +28,19 @@ The replaced arc length is ``5 atan(mu / (5 -+ mu))`` on each arc, the fillet tu
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
 import pytest
-from scipy.optimize import root
+from scipy.optimize import brentq, root
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
 from reference.core.rounding import (circle_circle_fillet, circle_fillet_largest_radius,
                                      circle_fillet_radius_for_trim,
                                      circle_fillet_radius_within)
-from reference.machine import load_machine
+from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
@@ -358,3 +359,70 @@ def test_arc_arc_corners_keep_the_limits_and_do_not_slow_the_program(mfile, mode
             assert_tangent_everywhere(path)
     if "RNDM" not in mode:
         assert times[mode] <= times["G64"] * (1 + 1e-9)
+
+
+# G644 with the dynamic digits at arc corners: the test machine at F3000 (v = 50 mm/s,
+# MAX_AX_ACCEL 2 m/s^2, MAX_AX_JERK 40 m/s^3, an XY plane: both axes weigh 1)
+V_F3000, A_TEST, J_TEST = 50.0, 2000.0, 40000.0
+
+
+@pytest.mark.parametrize("accel", ["BRISK", "SOFT"])
+def test_g644_3xxx_at_arc_corners_is_the_smallest_fillet_passed_at_the_path_velocity(
+        accel):
+    """B1 excerpt (G644, 3xxx): "Any axis that has a velocity jump at a corner traverses
+    around the corner with the maximum possible dynamic response ... neither the maximum
+    deviations nor the rounding distance are checked. The resulting deviations or
+    rounding distances are determined exclusively by the dynamic limits of the
+    respective axis and the current path velocity." By hand, with the shares the
+    heuristic grants a curved segment (0.75 A centripetal, 0.5 J jerk): the fillet's
+    radius is v^2 / (0.75 A) = 1.667 mm under BRISK, under SOFT (the fillet stays an
+    arc) also at least sqrt(v^3 / (0.5 J)) = 2.5 mm, at the OUTSIDE corner between two
+    arcs and at a line-arc corner (test_rounding_arcs: the line y = 0 into the
+    clockwise arc about (25, 0)); both fillets are longer than v T_ipo = 0.2 mm, so the
+    IPO cycle does not decide. The tolerance (MD33100 0.01 mm) is not checked. Under
+    SOFT the fillet's curvature jumps at its ends (6.3) are allowed the largest
+    PATH_TRANS_JERK_LIM, so that they do not decide the speed (with the axis jerk there
+    they would allow 17 mm/s, and stopping at the corner is estimated the faster)."""
+    from test_rounding_arcs import BASE, LINE_ARC
+    from test_rounding_arcs import hand as line_hand
+    r = V_F3000 ** 2 / (0.75 * A_TEST)
+    spec = copy.deepcopy(BASE)
+    spec["channel"].update(SMOOTHING_MODE=3000)
+    if accel == "SOFT":
+        r = max(r, math.sqrt(V_F3000 ** 3 / (0.5 * J_TEST)))
+        assert r == pytest.approx(2.5, rel=1e-12)              # the jerk decides
+        for ax in spec["axis"].values():
+            ax["PATH_TRANS_JERK_LIM"] = 1e5
+    mach = machine_from_dict(spec)
+    for body, dev in ((OUTSIDE.format(w=""), hand("outside", r)["deviation"]),
+                      (LINE_ARC, line_hand(r)["deviation"])):
+        path = build_path(parse_text(f"G17 G90 G644 {accel} F3000\n" + body), mach)
+        t = path.rounding
+        assert reasons(path)[-1] == "rounded"
+        assert t.radius_mm[-1] == pytest.approx(r, rel=1e-12)
+        assert t.deviation_mm[-1] == pytest.approx(dev, rel=1e-9)
+        assert t.deviation_mm[-1] > 0.01 * math.sqrt(2)          # not checked
+        assert t.length_mm[-1] > V_F3000 * 0.004
+        # passed at the programmed speed
+        assert t.v_round[-1] == pytest.approx(V_F3000, rel=1e-12)
+        assert_tangent_everywhere(path)
+
+
+def test_g644_2xxx_at_an_arc_corner_lasts_one_period_of_the_lowest_frequency():
+    """B1 excerpt (G644, 2xxx): "the rounding distance is limited to a minimum value,
+    which results from the maximum permissible excitation frequency and the current
+    path velocity"; spec 5.8 "2xxx: T_i >= 1/f_i". X at 20 Hz, Y at 10 Hz: the fillet at
+    the OUTSIDE corner lasts 1/10 s at F1200, 2 mm of path; its radius by root finding
+    on the hand formulas (length r (pi/2 - 2 atan(mu / (5 + mu))))."""
+    from test_rounding_arcs import BASE
+    spec = copy.deepcopy(BASE)
+    spec["channel"].update(SMOOTHING_MODE=2000)
+    for ax, f in (("X", 20.0), ("Y", 10.0), ("Z", 20.0)):
+        spec["axis"][ax]["LOOKAH_FREQUENCY"] = f
+    mach = machine_from_dict(spec)
+    path = build_path(parse_text("G17 G90 G644 BRISK F1200\n" + OUTSIDE.format(w="")), mach)
+    t = path.rounding
+    assert reasons(path)[-1] == "rounded"
+    assert t.length_mm[-1] == pytest.approx(20.0 / 10.0, rel=1e-9)
+    r = brentq(lambda x: x * hand("outside", x)["sweep"] - 2.0, 0.1, 5.0, xtol=1e-14)
+    assert t.radius_mm[-1] == pytest.approx(r, rel=1e-9)
