@@ -76,10 +76,11 @@ _LINE = KIND_CODES.index("line")
 _ARC = KIND_CODES.index("arc")
 _ROUNDING = KIND_CODES.index("rounding")
 
-#: A line counts as lying in its arc's plane when its direction leaves the plane by at
-#: most this (the sine of the angle): the fillet is built in the plane and starts on the
-#: line's projection, at most ``OFF_PLANE_MAX`` times the replaced length (at most half
-#: the block) off the line, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
+#: A line counts as lying in its arc's plane, and a second arc in the first's, when its
+#: direction (its plane vectors) leaves the plane by at most this (the sine of the
+#: angle): the fillet is built in the plane and meets the line's projection (the second
+#: circle's), at most ``OFF_PLANE_MAX`` times the replaced length (at most half the
+#: block) off it, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
 OFF_PLANE_MAX = 1e-9
 
 #: Fillet radii are searched in ``[R_MIN_MM, R_MAX_MM]`` (log scale): below a nanometre
@@ -142,8 +143,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                 mode: np.ndarray, t1: np.ndarray, t2: np.ndarray, targets: dict,
                 accel: np.ndarray, centripetal_share: float, jerk_share: float,
                 time_loss) -> ArcCorners:
-    """Decide and size the rounding of corners after segments ``a`` (one of ``a``,
-    ``a + 1`` an arc, the corner not tangential).
+    """Decide and size the rounding of corners after segments ``a`` (one or both of
+    ``a``, ``a + 1`` an arc, the corner not tangential).
 
     Parameters
     ----------
@@ -159,7 +160,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         Per corner, from :func:`reference.rounding._distances`: ``how`` (HOW_ codes),
         ``dist`` (ADIS/ADISPOS, mm), ``contour`` (contour tolerance, mm, ``inf``: none),
         ``axis_tol`` (per-axis tolerance, shape (k, n), mm, ``inf``: none), ``g0``
-        (tolerance factor), ``radius`` (programmed radius, mm).
+        (tolerance factor), ``radius`` (programmed radius, mm), ``dyn_radius``,
+        ``dyn_length`` (G644 2xxx/3xxx: smallest radius and length, mm).
     accel : numpy.ndarray of str, shape (k,)
     centripetal_share, jerk_share : float
         The corner rounding's shares of the axis acceleration and jerk.
@@ -431,7 +433,7 @@ def _lc(cols):
 
 def _lc_fillet(r, *cols) -> _Fillet:
     t, centre, radius, sense = _lc(cols)
-    f = line_circle_fillet(r, *_lc(cols))
+    f = line_circle_fillet(r, t, centre, radius, sense)
     start_dir = f.start / np.where(row_norms(f.start) > 0, row_norms(f.start), 1.0)[:, None]
     # direction of travel at the construction's start: along the line towards the
     # corner, i.e. -start / |start| (the start is at x t with x < 0)
