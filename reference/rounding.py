@@ -29,10 +29,11 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
    pairs that takes up the classical shift and a curvature ramp onto the arc,
    :mod:`reference.core.transition`); other modes name it "tangential transition".
-   A corner between a line and a circular arc is rounded by a tangent fillet
-   (:func:`reference.rounding_arcs.arc_corners`, sized by the same mode parameters).
-   Model limits of this version: corners between two arcs, next to helices, and
-   corners where non-geometry axes move are passed as under G64, named;
+   A corner between a line and a circular arc, or between two circular arcs in one
+   plane, is rounded by a tangent fillet (:func:`reference.rounding_arcs.arc_corners`,
+   sized by the same mode parameters). Model limits of this version: corners next to
+   helices, between arcs in different planes, and corners where non-geometry axes move
+   are passed as under G64, named;
 4. the rounding distance ``d`` by mode (5.3 .. 5.7):
 
    * G641: ``d = ADIS`` (G1/G2/G3), ``ADISPOS`` (G0), the smaller if one block is G0;
@@ -73,10 +74,10 @@ Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions, and the rounding of corners next to arcs,
-are modelled between a line and a circle only (arc into arc, helices and spirals are
-named and passed as G64; a corner next to an arc gets a tangent arc, G1, also under
-SOFT); a window
+G645's rounding of tangential transitions is modelled between a line and a circle only,
+the rounding of corners next to arcs between a line and a circle and between two
+circles in one plane (tangential arc into arc, helices and spirals are named and passed
+as G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
@@ -423,7 +424,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
-    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), mm. ``mode``:
+    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), ``dyn_radius``
+    and ``dyn_length`` (G644 2xxx/3xxx, :func:`_dynamic_distance`), mm. ``mode``:
     each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
@@ -481,13 +483,15 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
     # G644 2xxx (frequency) and 3xxx (maximum dynamics): sized by the path velocity
     dyn = np.flatnonzero((how == FREQ) | (how == DYN))
+    dyn_radius, dyn_length = np.zeros(k), np.zeros(k)
     if dyn.size:
-        d[dyn] = _dynamic_distance(path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn],
-                                   theta[dyn], g2[dyn], how[dyn] == FREQ)
+        d[dyn], dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
+            path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn], theta[dyn], g2[dyn],
+            how[dyn] == FREQ)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "radius": radius}
+               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 
@@ -519,9 +523,14 @@ def _plane_weights(t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray,
                       t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, g2: np.ndarray,
-                      freq: np.ndarray) -> np.ndarray:
+                      freq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Tangent distance of G644 with SMOOTHING_MODE 3xxx (``freq`` False) or 2xxx
-    (``freq`` True), before the block-length clamp, mm, shape (k,).
+    (``freq`` True), before the block-length clamp, mm, shape (k,); and for a tangent
+    arc whose turn is not known in advance (the fillets at arc corners,
+    :mod:`reference.rounding_arcs`) the same rules as the smallest radius (3xxx:
+    ``1 / K_a``, under SOFT also ``1 / sqrt(K_j)``, the fillet staying an arc; 2xxx: 0)
+    and the length the arc must have (3xxx ``v T_ipo``, 2xxx ``v T``), mm, shape (k,)
+    each.
 
     Both are sized by "the current path velocity" (B1 excerpt), here the programmed speed
     ``v`` of the slower line (:func:`_programmed_speeds`):
@@ -574,7 +583,10 @@ def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray
         piece = np.where(freq, length / 2.0, l_dyn)
         d_1, _ = clothoid_pair_shape(np.clip(theta, 1e-300, None))
         d = np.where(g2, piece * d_1, radius * np.tan(theta / 2.0))
-    return np.where(np.isfinite(d), d, 0.0)
+        r_min = np.where(freq, 0.0, np.where(g2, np.maximum(1.0 / k_a, 1.0 / np.sqrt(k_j)),
+                                              1.0 / k_a))
+    return (np.where(np.isfinite(d), d, 0.0), r_min,
+            np.where(freq, length, v * t_ipo))
 
 
 def _straight_chains(path: Path, attrs: dict[str, np.ndarray], known: np.ndarray | None = None

@@ -1,40 +1,61 @@
-"""Corner rounding, part: corners between a line and a circular arc (G641..G645, RND/RNDM).
+"""Corner rounding, part: corners next to circular arcs (G641..G645, RND/RNDM).
 
-The rounding of a corner next to an arc is the tangent arc of radius ``r`` between the
-line and the circle (:func:`reference.core.rounding.line_circle_fillet`, exact closed
-form for a given ``r``): "RND inserts a tangent circle" and the rounding "replaces the
-area near the original angular transition" (5.1). The arc is shortened by the arc
-length the fillet replaces (its start angle moves, so it stays the exact arc), the line
-by its tangent length; both lengths differ, unlike at a line-line corner.
+The rounding of a corner next to an arc is a tangent arc of radius ``r``: "RND inserts a
+tangent circle" and the rounding "replaces the area near the original angular
+transition" (5.1). Two kinds of corner, each with an exact closed form for a given ``r``
+(:mod:`reference.core.rounding`):
 
-The radius by mode is the largest ``r`` that keeps every limit of the mode, found by
-bisection on ``log r`` (the trims, the deviation and ``r`` itself grow with ``r`` on the
-branch that shrinks to the corner; past that branch the fillet does not exist and the
-limit counts as broken):
+* a line and an arc (either order): the fillet between the line and the circle
+  (:func:`~reference.core.rounding.line_circle_fillet`); the line is shortened by its
+  tangent length, the arc by the arc length the fillet replaces;
+* two arcs in one plane: the fillet tangent to both circles
+  (:func:`~reference.core.rounding.circle_circle_fillet`): on the side the corner turns
+  to, inside a circle that turns the same way and outside one that turns the other way,
+  the one of the candidate tangent circles that shrinks to the corner with ``r`` and
+  turns by the angle the contour turns between its ends; both arcs are shortened by the
+  arc lengths it replaces.
+
+A shortened arc only has its start angle or length changed, so it stays the exact arc;
+the lengths replaced on the two sides differ, unlike at a line-line corner.
+
+The radius by mode is the largest ``r`` that keeps every limit of the mode (the trims,
+the deviation and ``r`` itself grow with ``r`` on the branch that shrinks to the
+corner; past that branch the fillet does not exist and the limit counts as broken):
 
 * RND/RNDM: ``r <= R_prog`` (the programmed radius exactly where nothing else limits);
 * G641 / ADIS digits: both trims ``<= ADIS`` (ADISPOS for G0, 5.3: "the earliest point
-  before the block end where rounding may start, and the latest point after it");
+  before the block end where rounding may start, and the latest point after it"; "for
+  arcs, measure along the arc"), in closed form;
 * tolerance modes (G642, G643, G645 at corners, G644 0xxx/4xxx): per axis
   ``|C_i - M_i| <= tol_i`` and ``|C - M| <=`` the contour tolerance where one applies
   (``M`` the fillet's point nearest the corner ``C``, as at line-line corners), G0
-  tolerances times MD20560;
-* the block-length clamp on both sides (``c`` times the line, ``c`` times the arc's
-  length, 5.3).
+  tolerances times MD20560, by a root search on ``log r``;
+* G644 2xxx/3xxx: the dynamic size of :func:`reference.rounding._dynamic_distance`
+  for a tangent arc, whose turn here depends on ``r``: 3xxx the smallest fillet the
+  axes pass at the programmed speed (centripetal, under SOFT the path jerk on the
+  fillet, at least ``v T_ipo`` long), 2xxx the fillet ``v T`` long (``T`` from
+  LOOKAH_FREQUENCY), by the same root search on ``log r`` (its length ``r sweep(r)``);
+* the block-length clamp on both sides (``c`` times each participating block's length,
+  along the arc for an arc, 5.3), in closed form. Between two circles the replaced
+  length grows with ``r`` only up to the largest fillet (the two circles may cross a
+  second time); a limit beyond what the largest fillet replaces does not bind
+  (:func:`~reference.core.rounding.circle_fillet_radius_within`).
 
 Model limits, named: the fillet is G1 (curvature jumps at its ends; under SOFT the
 curvature-jump rule of 6.3 caps the speed there, as it does for a BRISK-shaped
-rounding), where the line-line corners get a clothoid pair under SOFT; corners between
-two arcs, next to a helix or spiral, or whose line leaves the arc's plane, and G644's
-dynamic digits (2xxx, 3xxx) at arc corners are passed as under G64.
+rounding), where the line-line corners get a clothoid pair under SOFT; corners next to
+a helix or spiral, whose line leaves the arc's plane or whose two arcs lie in different
+planes, and corners next to inserted TRC/TLIFT blocks are passed as under G64.
 
 Speeds as at line-line corners (:mod:`reference.rounding`): G641/G642/G645 round only
 where G64 must slow down (overload factor, 4.3); every mode but RND/RNDM only where the
-corner's time estimate favours the rounding (5.2 group 2).
+corner's time estimate favours the rounding (5.2 group 2), each side ramping to the
+speed its own element allows (an arc: what the heuristic grants its curvature).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +63,8 @@ from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
-from .core.rounding import (REASON_CODE, ArcFillet, fillet_deviation,
+from .core.rounding import (REASON_CODE, circle_circle_fillet, circle_fillet_deviation,
+                            circle_fillet_radius_within, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
                             line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
@@ -54,10 +76,11 @@ _LINE = KIND_CODES.index("line")
 _ARC = KIND_CODES.index("arc")
 _ROUNDING = KIND_CODES.index("rounding")
 
-#: A line counts as lying in its arc's plane when its direction leaves the plane by at
-#: most this (the sine of the angle): the fillet is built in the plane and starts on the
-#: line's projection, at most ``OFF_PLANE_MAX`` times the replaced length (at most half
-#: the block) off the line, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
+#: A line counts as lying in its arc's plane, and a second arc in the first's, when its
+#: direction (its plane vectors) leaves the plane by at most this (the sine of the
+#: angle): the fillet is built in the plane and meets the line's projection (the second
+#: circle's), at most ``OFF_PLANE_MAX`` times the replaced length (at most half the
+#: block) off it, which stays below POS_TOL_MM (1e-6 mm) for blocks up to 2 m.
 OFF_PLANE_MAX = 1e-9
 
 #: Fillet radii are searched in ``[R_MIN_MM, R_MAX_MM]`` (log scale): below a nanometre
@@ -120,8 +143,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                 mode: np.ndarray, t1: np.ndarray, t2: np.ndarray, targets: dict,
                 accel: np.ndarray, centripetal_share: float, jerk_share: float,
                 time_loss) -> ArcCorners:
-    """Decide and size the rounding of corners after segments ``a`` (one of ``a``,
-    ``a + 1`` an arc, the corner not tangential).
+    """Decide and size the rounding of corners after segments ``a`` (one or both of
+    ``a``, ``a + 1`` an arc, the corner not tangential).
 
     Parameters
     ----------
@@ -137,7 +160,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         Per corner, from :func:`reference.rounding._distances`: ``how`` (HOW_ codes),
         ``dist`` (ADIS/ADISPOS, mm), ``contour`` (contour tolerance, mm, ``inf``: none),
         ``axis_tol`` (per-axis tolerance, shape (k, n), mm, ``inf``: none), ``g0``
-        (tolerance factor), ``radius`` (programmed radius, mm).
+        (tolerance factor), ``radius`` (programmed radius, mm), ``dyn_radius``,
+        ``dyn_length`` (G644 2xxx/3xxx: smallest radius and length, mm).
     accel : numpy.ndarray of str, shape (k,)
     centripetal_share, jerk_share : float
         The corner rounding's shares of the axis acceleration and jerk.
@@ -150,28 +174,34 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     """
     k = a.size
     b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
+    arc_arc = (path.kind[a] == _ARC) & (path.kind[b] == _ARC)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
         reason[(reason < 0) & mask] = REASON_CODE[why]
 
-    decide(~(line_arc | arc_line), "corner between two arcs: rounding not modelled yet")
+    decide(~(line_arc | arc_line | arc_arc), "corner next to an inserted block (TRC, "
+           "TLIFT): rounding not modelled yet")
     E1, E2 = path.e1.take(arc, axis=0), path.e2.take(arc, axis=0)
     t_line = path.d.take(line, axis=0)
     # the line in the arc's plane (OFF_PLANE_MAX)
     off = row_norms(t_line - row_dots(t_line, E1)[:, None] * E1
                     - row_dots(t_line, E2)[:, None] * E2)
-    circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
-              & ~(np.abs(path.d.take(arc, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+    # between two arcs (``arc`` is the first, ``line`` the second): the second's plane
+    # vectors in the first's plane
+    E1b, E2b = path.e1.take(b, axis=0), path.e2.take(b, axis=0)
+    off_b = np.maximum(
+        row_norms(E1b - row_dots(E1b, E1)[:, None] * E1 - row_dots(E1b, E2)[:, None] * E2),
+        row_norms(E2b - row_dots(E2b, E1)[:, None] * E1 - row_dots(E2b, E2)[:, None] * E2))
+    off = np.where(arc_arc, off_b, off)
+    circle = _is_circle(path, arc) & np.where(arc_arc, _is_circle(path, b), True)
     decide(~circle | ~(off <= OFF_PLANE_MAX),
            "corner next to a helix or spiral, or out of the arc's plane: rounding not "
            "modelled yet")
     how = targets["how"]
-    decide((how == HOW_FREQ) | (how == HOW_DYN),
-           "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet")
 
     # plane coordinates: the corner at the origin, the construction traversed from the
-    # line into the arc (arc into line: backwards)
+    # line into the arc (arc into line: backwards), from the first arc into the second
     R = path.radius[arc]
     w = path.omega[arc]
     at = np.where(line_arc, 0.0, path.length[arc])
@@ -185,95 +215,49 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     centre = -R[:, None] * radial
     sense = np.where(line_arc, np.sign(w), -np.sign(w))
     c = machine.channel.rounding_length_clamp
-    cap_line = c * path.length[line]
-    cap_arc = c * path.length[arc]
+    # the two elements in the construction's order (line-arc: the line first)
+    cap_first = c * path.length[np.where(arc_arc, a, line)]
+    cap_second = c * path.length[np.where(arc_arc, b, arc)]
 
     v_g64 = np.full(k, np.nan)
     v_round = np.full(k, np.nan)
     r = np.zeros(k)
-    fil = None
     o = np.flatnonzero(reason < 0)
+    fil = _empty_fillet(o.size)
     clamped = np.zeros(k, bool)
-    if o.size:
-        tol = targets["axis_tol"][o]
-        cont = targets["contour"][o]
-        g0 = targets["g0"][o]
-        dist = targets["dist"][o]
-        rad = targets["radius"][o]
-        ho = how[o]
-        E1o, E2o = E1[o], E2[o]
-
-        geo = (t2d[o], centre[o], R[o], sense[o])
-        # the replaced lengths grow with r: the largest r within a length on each side
-        # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
-        # round-off of the closed form cannot put a trim above its limit
-        with np.errstate(invalid="ignore"):
-            r_cap = np.fmin(_positive(fillet_radius_for_line_trim(cap_line[o], *geo)),
-                            _positive(fillet_radius_for_arc_trim(cap_arc[o], *geo)))
-            r_adis = np.fmin(_positive(fillet_radius_for_line_trim(dist, *geo)),
-                             _positive(fillet_radius_for_arc_trim(dist, *geo)))
-        r_cap *= 1.0 - CLOSED_FORM_MARGIN
-        r_adis *= 1.0 - CLOSED_FORM_MARGIN
-        ro = np.select([ho == HOW_ADIS, ho == HOW_RADIUS], [r_adis, rad], np.inf)
-        ro = np.fmin(ro, r_cap)
-        # tolerances: the root of log(ratio) in log r below the clamp (the deviation
-        # grows with r), bracketed (Chandrupatla's method, scipy)
-        tl = np.flatnonzero(ho == HOW_TOL)
-        if tl.size:
-            n_ax = E1o.shape[1]
-            cols = (*geo[0][tl].T, *geo[1][tl].T, geo[2][tl], geo[3][tl], *E1o[tl].T,
-                    *E2o[tl].T, *(tol[tl] * g0[tl, None]).T, cont[tl] * g0[tl])
-            hi = np.log(np.where(np.isfinite(r_cap[tl]), r_cap[tl], R_MAX_MM))
-            lo = np.full(tl.size, np.log(R_MIN_MM))
-            f_hi = _log_tol_ratio(hi, *cols, n_axes=n_ax)
-            top = f_hi <= 0.0
-            ro[tl] = np.where(top, r_cap[tl], 0.0)
-            # the deviation grows about like r, so f = log(ratio) is nearly linear in
-            # log r: secant steps from hi and hi - f(hi) reach the root to round-off in
-            # a few steps; kept where they end inside the tolerance and within
-            # ROOT_XATOL of the root (f in [-ROOT_XATOL, 0]), the others go to the
-            # bracketed search below
-            ok = np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top
-            x0, f0 = hi, np.where(ok, f_hi, 1.0)
-            x = np.where(ok, hi - f0, hi)
-            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
-            for _ in range(SECANT_STEPS):
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    slope = (f_x - f0) / (x - x0)
-                move = ok & np.isfinite(slope) & (slope > 0) & (f_x != 0.0)
-                x0, f0 = x, f_x
-                x = np.where(move, np.minimum(x - f_x / np.where(move, slope, 1.0), hi), x)
-                f_x = np.where(move, _log_tol_ratio(x, *cols, n_axes=n_ax), f_x)
-            # half ROOT_XATOL inside the tolerance: r = exp(x) and log(r) differ by
-            # round-off, which must not carry the kept radius across the limit
-            x = x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0
-            f_x = _log_tol_ratio(x, *cols, n_axes=n_ax)
-            done = ok & (f_x <= 0.0) & (f_x >= -2.0 * ROOT_XATOL)
-            ro[tl[done]] = np.exp(x[done])
-            sol = np.flatnonzero(~top & ~done & (_log_tol_ratio(lo, *cols, n_axes=n_ax) < 0.0))
-            if sol.size:
-                res = find_root(lambda x, *c: _log_tol_ratio(x, *c, n_axes=n_ax),
-                                (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
-                                tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
-                # the bracket's lower end keeps f <= 0: within the tolerance (half
-                # ROOT_XATOL further inside, as above)
-                ro[tl[sol]] = np.exp(res.bracket[0] - ROOT_XATOL / 2.0)
-        ro = np.where(np.isfinite(ro), ro, 0.0)
-        clamped[o] = ro >= r_cap
-        fil = line_circle_fillet(np.where(ro > 0, ro, 1.0), *geo)
-        r[o] = ro
-        length = ro * fil.sweep
+    # per corner: its family's geometry, as 1-d columns (:class:`_Family`)
+    fams = []
+    la_o = np.flatnonzero(~arc_arc[o])
+    if la_o.size:
+        i = o[la_o]
+        fams.append((la_o, _LINE_CIRCLE, (*t2d[i].T, *centre[i].T, R[i], sense[i])))
+    aa_o = np.flatnonzero(arc_arc[o])
+    if aa_o.size:
+        i = o[aa_o]
+        fams.append((aa_o, _CIRCLE_CIRCLE,
+                     _circle_pair(path, a[i], b[i], E1[i], E2[i], R[i], radial[i])))
+    for sub_o, fam, cols in fams:
+        i = o[sub_o]
+        ro, r_cap, tol_ok = _radius_by_mode(
+            fam, cols, how[i], targets["dist"][i], targets["radius"][i],
+            targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
+            cap_first[i], cap_second[i], targets["dyn_radius"][i],
+            targets["dyn_length"][i])
+        clamped[i] = ro >= r_cap
+        f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
+        r[i] = ro
+        length = ro * f.sweep
         # the closed forms assume the branch that shrinks to the corner: the fillet
         # found must exist and keep both lengths
-        keeps = ((fil.line_trim <= cap_line[o]) & (fil.arc_trim <= cap_arc[o])
-                 & ((ho != HOW_ADIS) | (np.maximum(fil.line_trim, fil.arc_trim) <= dist)))
-        if tl.size:
-            keeps[tl] &= _log_tol_ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *cols,
-                                        n_axes=n_ax) <= 0.0
+        keeps = ((f.trim_first <= cap_first[i]) & (f.trim_second <= cap_second[i])
+                 & ((how[i] != HOW_ADIS)
+                    | (np.maximum(f.trim_first, f.trim_second) <= targets["dist"][i]))
+                 & tol_ok)
         sub = np.zeros(k, bool)
-        sub[o] = (~keeps | ~fil.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
+        sub[i] = (~keeps | ~f.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
                   | ~(ro > R_MIN_MM * 2))
         decide(sub, "rounding distance too small")
+        _put(fil, sub_o, f)
 
     o2 = np.flatnonzero(reason < 0)
     lim = machine.limits.for_axes(path.axes)
@@ -287,6 +271,11 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         moving = rho > 0
         wr = np.where(moving, rho, 1.0)
         v_g64[o2] = junction_speed_cap(t1[o2], t2[o2], lim.jump, FEASIBLE)[0]
+        aa = arc_arc[o2]
+        soft = accel[o2] == "SOFT"
+        # the elements' own radii in the construction's order (inf: the line)
+        R_first = np.where(aa, R[o2], np.inf)
+        R_second = np.where(aa, path.radius[b[o2]], R[o2])
         with np.errstate(divide="ignore", invalid="ignore"):
             v_axis = np.minimum(row_min(lim.v_max[None, :] / np.abs(t1[o2])),
                                 row_min(lim.v_max[None, :] / np.abs(t2[o2])))
@@ -295,30 +284,31 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                                                    * ro[:, None] / wr), np.inf))
             v_j = row_min(np.where(moving, np.cbrt(jerk_share * lim.j_max[None, :]
                                                    * (ro * ro)[:, None] / wr), np.inf))
-            Ra = R[o2]
-            v_arc = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
-                                                     * Ra[:, None] / wr), np.inf))
-            v_arc = np.where(accel[o2] == "SOFT", np.minimum(v_arc, row_min(np.where(
-                moving, np.cbrt(jerk_share * lim.j_max[None, :] * (Ra * Ra)[:, None] / wr),
-                np.inf))), v_arc)
+        v_arc = _arc_speed(lim, R_second, moving, wr, soft, centripetal_share, jerk_share)
+        v_arc_first = np.full(o2.size, np.inf)
+        if aa.any():
+            v_arc_first[aa] = _arc_speed(lim, R_first[aa], moving[aa], wr[aa], soft[aa],
+                                         centripetal_share, jerk_share)
         length = ro * f.sweep
-        soft = accel[o2] == "SOFT"
         # centripetal, one IPO cycle per inserted block (5.3), the feed; under SOFT the
         # path jerk on the fillet (third path derivative 1/r^2) and the curvature jumps
         # at its ends
         vr = np.minimum(np.minimum(v_prog, v_c), length / t_ipo)
         if soft.any():
             vr = np.where(soft, np.minimum(vr, v_j), vr)
-            # 6.3: the fillet's curvature vector jumps from the line's 0 at one end and
-            # to the arc's at the other (q'' = (centre - P) / radius^2)
+            # 6.3: the fillet's curvature vector jumps from the first element's (the
+            # line's 0) at one end and to the second's at the other (q'' = (centre -
+            # P) / radius^2)
             def world(v2):
                 return E1o * v2[:, :1] + E2o * v2[:, 1:]
             k_fs = world((f.centre - f.start) / (ro * ro)[:, None])
             k_fe = world((f.centre - f.end) / (ro * ro)[:, None])
-            k_ae = world((centre[o2] - f.end) / (Ra * Ra)[:, None])
-            zero = np.zeros_like(k_fs)
+            k_ae = world((f.centre_second - f.end) / (R_second * R_second)[:, None])
+            k_as = np.zeros_like(k_fs)
+            if aa.any():
+                k_as[aa] = world((f.centre_first - f.start) / (R_first * R_first)[:, None])[aa]
             v_k = np.minimum(
-                curvature_jump_speed_cap(zero, k_fs, lim.path_trans_jerk, t_ipo),
+                curvature_jump_speed_cap(k_as, k_fs, lim.path_trans_jerk, t_ipo),
                 curvature_jump_speed_cap(k_fe, k_ae, lim.path_trans_jerk, t_ipo))
             vr = np.where(soft, np.minimum(vr, v_k), vr)
         v_round[o2] = vr
@@ -329,17 +319,19 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         # the time estimate of the line-line corners, each side ramping to its own
         # speed (an arc side to its own limit), the fillet passed at v_round
-        la = line_arc[o2]
+        forward = line_arc[o2] | aa
         v_line = v_prog
-        v_in = np.where(la, v_line, np.minimum(v_line, v_arc))
-        v_out = np.where(la, np.minimum(v_line, v_arc), v_line)
+        v_first = np.minimum(v_line, v_arc_first)
+        v_second = np.minimum(v_line, v_arc)
+        v_in = np.where(forward, v_first, v_second)
+        v_out = np.where(forward, v_second, v_first)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / np.abs(t1[o2]))
             acc_out = row_min(lim.a_max[None, :] / np.abs(t2[o2]))
             j_in = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t1[o2])), np.inf)
             j_out = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t2[o2])), np.inf)
-        cut_in = np.where(la, f.line_trim, f.arc_trim)
-        cut_out = np.where(la, f.arc_trim, f.line_trim)
+        cut_in = np.where(forward, f.trim_first, f.trim_second)
+        cut_out = np.where(forward, f.trim_second, f.trim_first)
         radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
         sub[:] = False
         sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
@@ -358,29 +350,273 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     rows = {}
     if ins.size:
         f = _take(fil, np.searchsorted(o, ins))
-        la = line_arc[ins]
-        trim_in[ins] = np.where(la, f.line_trim, f.arc_trim)
-        trim_out[ins] = np.where(la, f.arc_trim, f.line_trim)
+        fw = line_arc[ins] | arc_arc[ins]
+        trim_in[ins] = np.where(fw, f.trim_first, f.trim_second)
+        trim_out[ins] = np.where(fw, f.trim_second, f.trim_first)
         radius_out[ins] = r[ins]
         length_out[ins] = r[ins] * f.sweep
         dev_out[ins] = row_norms(f.deviation)
-        rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], la, ka[ins])
+        rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], fw, ka[ins])
     return ArcCorners(reason, trim_in, trim_out, radius_out, length_out, dev_out,
                       clamped & (reason == 0), v_g64, v_round, rows)
 
 
-def _log_tol_ratio(x: np.ndarray, tx, ty, cx, cy, radius, sense, *rest,
-                   n_axes: int) -> np.ndarray:
+def _is_circle(path: Path, i: np.ndarray) -> np.ndarray:
+    """Segments ``i`` are circular arcs (no spiral, no clothoid, no helical lead)."""
+    return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
+            & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+
+
+def _circle_pair(path: Path, a: np.ndarray, b: np.ndarray, E1: np.ndarray, E2: np.ndarray,
+                 R1: np.ndarray, radial1: np.ndarray) -> tuple:
+    """The columns of :data:`_CIRCLE_CIRCLE` at corners between arcs ``a`` and ``b``:
+    both circles in the first arc's plane coordinates with the corner (the first arc's
+    end, ``radial1`` its unit radial there) at the origin, ``c_j = -R_j u_j``. The
+    second circle is taken through that point with its own radial at its start (the
+    two ends meet to the path's continuity tolerance; the fillet then meets the second
+    arc's shortened start as the arcs met). Its sense in the first's plane: its own
+    (``sign omega``) times the orientation of its plane vectors in the first's."""
+    phi2 = path.theta0[b]
+    rad2 = (path.e1.take(b, axis=0) * np.cos(phi2)[:, None]
+            + path.e2.take(b, axis=0) * np.sin(phi2)[:, None])
+    u2 = np.column_stack((row_dots(rad2, E1), row_dots(rad2, E2)))
+    u2 /= row_norms(u2)[:, None]
+    E1b, E2b = path.e1.take(b, axis=0), path.e2.take(b, axis=0)
+    orient = np.sign(row_dots(E1b, E1) * row_dots(E2b, E2)
+                     - row_dots(E1b, E2) * row_dots(E2b, E1))
+    R2 = path.radius[b]
+    c1 = -R1[:, None] * radial1
+    c2 = -R2[:, None] * u2
+    return (*c1.T, R1, np.sign(path.omega[a]), *c2.T, R2,
+            np.sign(path.omega[b]) * orient)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Fillet:
+    """A fillet per corner in the construction's order (line-arc: from the line; two
+    arcs: from the first), plane coordinates with the corner at the origin; shapes (k,)
+    or (k, 2). ``radial``/``heading``: unit vector from the centre to the start and the
+    direction of travel there; ``centre_first``/``centre_second``: the elements' own
+    centres (the line's: unused)."""
+
+    valid: np.ndarray
+    trim_first: np.ndarray
+    trim_second: np.ndarray
+    centre: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    radial: np.ndarray
+    heading: np.ndarray
+    sweep: np.ndarray
+    deviation: np.ndarray
+    centre_first: np.ndarray
+    centre_second: np.ndarray
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Family:
+    """A kind of arc corner (line-circle, circle-circle): its fillet of radius ``r``
+    and the closed-form radii that replace a given length of the first or the second
+    element, all from the same 1-d geometry columns (as
+    :func:`scipy.optimize.elementwise.find_root` passes them)."""
+
+    fillet: Callable
+    r_first: Callable
+    r_second: Callable
+    deviation: Callable
+
+
+def _lc(cols):
+    tx, ty, cx, cy, radius, sense = cols
+    return np.column_stack((tx, ty)), np.column_stack((cx, cy)), radius, sense
+
+
+def _lc_fillet(r, *cols) -> _Fillet:
+    t, centre, radius, sense = _lc(cols)
+    f = line_circle_fillet(r, t, centre, radius, sense)
+    start_dir = f.start / np.where(row_norms(f.start) > 0, row_norms(f.start), 1.0)[:, None]
+    # direction of travel at the construction's start: along the line towards the
+    # corner, i.e. -start / |start| (the start is at x t with x < 0)
+    return _Fillet(f.valid, f.line_trim, f.arc_trim, f.centre, f.start, f.end,
+                   (f.start - f.centre) / r[:, None], -start_dir, f.sweep, f.deviation,
+                   np.zeros_like(centre), centre)
+
+
+def _cc(cols):
+    c1x, c1y, r1, s1, c2x, c2y, r2, s2 = cols
+    return np.column_stack((c1x, c1y)), r1, s1, np.column_stack((c2x, c2y)), r2, s2
+
+
+def _cc_fillet(r, *cols) -> _Fillet:
+    c1, r1, s1, c2, r2, s2 = _cc(cols)
+    f = circle_circle_fillet(r, c1, r1, s1, c2, r2, s2)
+    return _Fillet(f.valid, f.trim_in, f.trim_out, f.centre, f.start, f.end, f.radial,
+                   f.heading, f.sweep, f.deviation, c1, c2)
+
+
+def _cc_r_second(trim, *cols):
+    c1, r1, s1, c2, r2, s2 = _cc(cols)
+    # the same fillet on the pair traversed backwards (core.rounding)
+    return circle_fillet_radius_within(trim, c2, r2, -s2, c1, r1, -s1)
+
+
+_LINE_CIRCLE = _Family(
+    fillet=_lc_fillet,
+    r_first=lambda trim, *cols: fillet_radius_for_line_trim(trim, *_lc(cols)),
+    r_second=lambda trim, *cols: fillet_radius_for_arc_trim(trim, *_lc(cols)),
+    deviation=lambda r, *cols: fillet_deviation(r, *_lc(cols)))
+_CIRCLE_CIRCLE = _Family(
+    fillet=_cc_fillet,
+    r_first=lambda trim, *cols: circle_fillet_radius_within(trim, *_cc(cols)),
+    r_second=_cc_r_second,
+    deviation=lambda r, *cols: circle_fillet_deviation(r, *_cc(cols)))
+
+
+def _empty_fillet(k: int) -> _Fillet:
+    z, z2 = np.zeros(k), np.zeros((k, 2))
+    return _Fillet(np.zeros(k, bool), z, z.copy(), z2, z2.copy(), z2.copy(), z2.copy(),
+                   z2.copy(), z.copy(), z2.copy(), z2.copy(), z2.copy())
+
+
+def _put(into: _Fillet, i: np.ndarray, part: _Fillet) -> None:
+    """Write ``part`` into rows ``i`` of ``into`` (its arrays, in place)."""
+    for name in _Fillet.__slots__:
+        getattr(into, name)[i] = getattr(part, name)
+
+
+def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray,
+                    rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
+                    E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
+                    cap_second: np.ndarray, dyn_radius: np.ndarray,
+                    dyn_length: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
+    the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
+    dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
+    and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
+    the tolerance holds at the radius found (True where no tolerance applies)."""
+    # the replaced lengths grow with r: the largest r within a length on each side
+    # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
+    # round-off of the closed form cannot put a trim above its limit
+    with np.errstate(invalid="ignore"):
+        r_cap = np.fmin(_positive(fam.r_first(cap_first, *cols)),
+                        _positive(fam.r_second(cap_second, *cols)))
+        r_adis = np.fmin(_positive(fam.r_first(dist, *cols)),
+                         _positive(fam.r_second(dist, *cols)))
+    r_cap *= 1.0 - CLOSED_FORM_MARGIN
+    r_adis *= 1.0 - CLOSED_FORM_MARGIN
+    ro = np.select([how == HOW_ADIS, how == HOW_RADIUS], [r_adis, rad], np.inf)
+    ro = np.fmin(ro, r_cap)
+    tol_ok = np.ones(how.size, bool)
+    # tolerances: the root of log(ratio) in log r below the clamp (the deviation
+    # grows with r), bracketed (Chandrupatla's method, scipy)
+    tl = np.flatnonzero(how == HOW_TOL)
+    if tl.size:
+        n_ax = E1.shape[1]
+        n_geo = len(cols)
+        tc = (*(col[tl] for col in cols), *E1[tl].T, *E2[tl].T,
+              *(tol[tl] * g0[tl, None]).T, cont[tl] * g0[tl])
+
+        def ratio(x, *c):
+            return _log_tol_ratio(x, *c, n_axes=n_ax, n_geo=n_geo, dev_fn=fam.deviation)
+
+        ro[tl] = _tolerance_radius(ratio, tc, r_cap[tl])
+        tol_ok[tl] = ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *tc) <= 0.0
+    # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
+    # about like r: the same search, the largest r not longer), at least dyn_radius,
+    # then clamped
+    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN))
+    if dy.size:
+        n_geo = len(cols)
+        dc = (*(col[dy] for col in cols), dyn_length[dy])
+
+        def too_long(x, *c):
+            return _log_length_ratio(x, *c, n_geo=n_geo, fillet=fam.fillet)
+
+        r_len = _tolerance_radius(too_long, dc, r_cap[dy])
+        ro[dy] = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
+    ro = np.where(np.isfinite(ro), ro, 0.0)
+    return ro, r_cap, tol_ok
+
+
+def _tolerance_radius(ratio: Callable, cols: tuple, r_cap: np.ndarray) -> np.ndarray:
+    """The largest radius at most ``r_cap`` whose ``ratio`` (``log`` of the largest
+    tolerance ratio, growing with ``log r``) is not above 0, mm, shape (k,) (0: none).
+
+    The deviation grows about like ``r``, so ``ratio`` is nearly linear in ``log r``:
+    secant steps from the clamp reach the root to round-off in a few steps; kept where
+    they end inside the tolerance and within ROOT_XATOL of the root, the others go to
+    the bracketed search (Chandrupatla's method, scipy).
+    """
+    ro = np.zeros(r_cap.size)
+    hi = np.log(np.where(np.isfinite(r_cap), r_cap, R_MAX_MM))
+    lo = np.full(r_cap.size, np.log(R_MIN_MM))
+    f_hi = ratio(hi, *cols)
+    top = f_hi <= 0.0
+    ro = np.where(top, r_cap, 0.0)
+    ok = np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top
+    x0, f0 = hi, np.where(ok, f_hi, 1.0)
+    x = np.where(ok, hi - f0, hi)
+    f_x = ratio(x, *cols)
+    for _ in range(SECANT_STEPS):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = (f_x - f0) / (x - x0)
+        move = ok & np.isfinite(slope) & (slope > 0) & (f_x != 0.0)
+        x0, f0 = x, f_x
+        x = np.where(move, np.minimum(x - f_x / np.where(move, slope, 1.0), hi), x)
+        f_x = np.where(move, ratio(x, *cols), f_x)
+    # half ROOT_XATOL inside the tolerance: r = exp(x) and log(r) differ by round-off,
+    # which must not carry the kept radius across the limit
+    x = x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0
+    f_x = ratio(x, *cols)
+    done = ok & (f_x <= 0.0) & (f_x >= -2.0 * ROOT_XATOL)
+    ro[done] = np.exp(x[done])
+    sol = np.flatnonzero(~top & ~done & (ratio(lo, *cols) < 0.0))
+    if sol.size:
+        res = find_root(ratio, (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
+                        tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
+        # the bracket's lower end keeps f <= 0: within the tolerance (half ROOT_XATOL
+        # further inside, as above)
+        ro[sol] = np.exp(res.bracket[0] - ROOT_XATOL / 2.0)
+    return ro
+
+
+def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,
+               soft: np.ndarray, centripetal_share: float, jerk_share: float) -> np.ndarray:
+    """What the heuristic grants an arc of ``radius`` in the fillet's plane: centripetal,
+    under SOFT also the path jerk ``rho_i v^3 / R^2``, mm/s, shape (k,)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_arc = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
+                                                 * radius[:, None] / wr), np.inf))
+        return np.where(soft, np.minimum(v_arc, row_min(np.where(
+            moving, np.cbrt(jerk_share * lim.j_max[None, :] * (radius * radius)[:, None]
+                            / wr), np.inf))), v_arc)
+
+
+def _log_length_ratio(x: np.ndarray, *cols, n_geo: int, fillet: Callable) -> np.ndarray:
+    """``log(r sweep / L)`` of the fillets of radius ``r = exp(x)`` (their length against
+    the target ``L``, the last column), elementwise over 1-d columns;
+    :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist."""
+    r = np.exp(x)
+    f = fillet(r, *cols[:n_geo])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(f.valid, np.log(np.maximum(r * f.sweep / cols[n_geo], 1e-300)),
+                        NO_FILLET_LOG_RATIO)
+
+
+def _log_tol_ratio(x: np.ndarray, *cols, n_axes: int, n_geo: int,
+                   dev_fn: Callable) -> np.ndarray:
     """``log`` of the largest tolerance ratio of the fillets of radius ``exp(x)`` (per
     axis ``|C_i - M_i| / tol_i``, contour ``|C - M| / tol``), elementwise over 1-d
-    columns (:func:`scipy.optimize.elementwise.find_root` passes the active ones);
-    :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist."""
+    columns (:func:`scipy.optimize.elementwise.find_root` passes the active ones): the
+    ``n_geo`` geometry columns of the family (``dev_fn``), then the plane vectors, the
+    per-axis and the contour tolerance; :data:`NO_FILLET_LOG_RATIO` where the fillet
+    does not exist."""
+    rest = cols[n_geo:]
     e1 = np.stack(rest[:n_axes], axis=1)
     e2 = np.stack(rest[n_axes:2 * n_axes], axis=1)
     tol = np.stack(rest[2 * n_axes:3 * n_axes], axis=1)
     cont = rest[3 * n_axes]
-    dev2, ok = fillet_deviation(np.exp(x), np.column_stack((tx, ty)),
-                                np.column_stack((cx, cy)), radius, sense)
+    dev2, ok = dev_fn(np.exp(x), *cols[:n_geo])
     dev = e1 * dev2[:, :1] + e2 * dev2[:, 1:]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.maximum(row_norms(dev) / cont, row_max_safe(np.abs(dev) / tol))
@@ -399,11 +635,11 @@ def row_max_safe(x: np.ndarray) -> np.ndarray:
         x.shape[0])
 
 
-def _take(f: ArcFillet, i: np.ndarray) -> ArcFillet:
-    return ArcFillet(*(getattr(f, name)[i] for name in ArcFillet.__slots__))
+def _take(f: _Fillet, i: np.ndarray) -> _Fillet:
+    return _Fillet(*(getattr(f, name)[i] for name in _Fillet.__slots__))
 
 
-def _fillet_rows(corner: np.ndarray, E1: np.ndarray, E2: np.ndarray, f: ArcFillet,
+def _fillet_rows(corner: np.ndarray, E1: np.ndarray, E2: np.ndarray, f: _Fillet,
                  r: np.ndarray, forward: np.ndarray, block: np.ndarray) -> dict:
     """Packed rows of the fillets (one circle each, ``d = 0``): ``e1`` the unit radial
     at the construction's start, ``e2`` its direction of travel there, ``omega = 1/r``;
@@ -413,13 +649,10 @@ def _fillet_rows(corner: np.ndarray, E1: np.ndarray, E2: np.ndarray, f: ArcFille
         return E1 * v2[:, :1] + E2 * v2[:, 1:]
 
     k = r.size
-    start_dir = f.start / np.where(row_norms(f.start) > 0, row_norms(f.start), 1.0)[:, None]
-    # direction of travel at the construction's start: along the line towards the
-    # corner, i.e. -start / |start| (the start is at x t with x < 0)
     return {
         "origin": corner + world(f.centre),
-        "e1": world((f.start - f.centre) / r[:, None]),
-        "e2": world(-start_dir),
+        "e1": world(f.radial),
+        "e2": world(f.heading),
         "d": np.zeros_like(corner),
         "radius": r.copy(),
         "omega": np.where(forward, 1.0, -1.0) / r,

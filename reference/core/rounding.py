@@ -1,5 +1,7 @@
-"""Corner rounding geometry: the tangent-arc fillet of a corner between two lines, and
-the table that records, per corner, what the rounding stage decided.
+"""Corner rounding geometry: the tangent-arc fillet of a corner between two lines (below),
+between a line and a circle (:func:`line_circle_fillet`) and between two circles
+(:func:`circle_circle_fillet`), and the table that records, per corner, what the
+rounding stage decided.
 
 Model (sinumerik-model 5.8 leaves the shape open: "the user must not assume a
 particular shape inside the rounding area", 5.1): under BRISK the rounding block is the
@@ -50,7 +52,7 @@ ROUNDING_REASONS: tuple[str, ...] = (
     "rounding not parameterised (ADISPOS = 0)",                       # 9  5.2 group 3
     "rounding not parameterised (tolerance 0)",                       # 10 5.2 group 3
     "tangential transition",                                          # 11
-    "corner between two arcs: rounding not modelled yet",             # 12 model limit
+    "corner next to an inserted block (TRC, TLIFT): rounding not modelled yet",  # 12
     "non-geometry axes move: rounding not modelled yet",              # 13 model limit
     "G644 SMOOTHING_MODE digit not documented",                       # 14 6xxx..9xxx
     # G645 at tangential transitions with a curvature jump (5.7, 6.3)
@@ -61,6 +63,8 @@ ROUNDING_REASONS: tuple[str, ...] = (
     # corners next to arcs (reference.rounding_arcs): model limits
     "corner next to a helix or spiral, or out of the arc's plane: rounding not modelled "
     "yet",                                                            # 19
+    # no longer given (G644 2xxx/3xxx at arc corners are modelled); kept so that the
+    # codes of the reasons after it stay
     "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet",  # 20
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
@@ -425,7 +429,269 @@ def fillet_deviation(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
     return dev, (disc >= 0) & (x < 0) & (rho > 0) & np.isfinite(x)
 
 
-__all__ = ["ArcFillet", "REASON_CODE", "ROUNDING_REASONS", "RoundingTable",
-           "axis_deviation_limit", "deflection_angle", "distance_for_deviation",
-           "fillet_deviation", "fillet_pieces", "fillet_radius_for_arc_trim",
-           "fillet_radius_for_line_trim", "line_circle_fillet"]
+@dataclass(frozen=True, slots=True, eq=False)
+class CircleFillet:
+    """Tangent arcs of radius ``r`` between two circles meeting at a corner, in their
+    common plane, per corner (shape (k,) or (k, 2)); see :func:`circle_circle_fillet`.
+
+    Attributes
+    ----------
+    valid : numpy.ndarray of bool
+        The fillet exists, leaves the first circle before the corner and meets the
+        second after it, turning the way the corner turns by the angle the contour turns
+        between its ends.
+    trim_in, trim_out : numpy.ndarray
+        Arc length of the first and of the second circle it replaces, mm.
+    centre, start, end : numpy.ndarray, shape (k, 2)
+        Its centre, its start on the first circle and its end on the second (plane
+        coordinates, the corner at the origin), mm.
+    radial, heading : numpy.ndarray, shape (k, 2)
+        Unit vector from its centre to its start, and its unit tangent there (the first
+        circle's tangent in the direction of travel).
+    sweep : numpy.ndarray
+        Angle it turns, rad (in ``(0, 2 pi)``).
+    deviation : numpy.ndarray, shape (k, 2)
+        ``C - M``: the corner minus the fillet's point nearest to it, mm.
+    """
+
+    valid: np.ndarray
+    trim_in: np.ndarray
+    trim_out: np.ndarray
+    centre: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    radial: np.ndarray
+    heading: np.ndarray
+    sweep: np.ndarray
+    deviation: np.ndarray
+
+
+def _circle_pair_frame(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray, c2: np.ndarray,
+                       r2: np.ndarray, s2: np.ndarray):
+    """Unit radials at the corner ``u_j = -c_j / R_j``, the side ``s`` the corner turns
+    to (+1 left) and ``iota_j`` (+1 where the fillet lies inside circle ``j``: it turns
+    the way that circle does) of :func:`circle_circle_fillet`."""
+    u1 = -c1 / r1[:, None]
+    u2 = -c2 / r2[:, None]
+    s = np.sign(_cross2(s1[:, None] * _perp(u1), s2[:, None] * _perp(u2)))
+    return u1, u2, s, np.where(s == s1, 1.0, -1.0), np.where(s == s2, 1.0, -1.0)
+
+
+def _circle_fillet_centre(r, u1, r1, u2, r2, iota1, iota2):
+    """Centre ``O`` of the fillet of radius ``r`` (:func:`circle_circle_fillet`) in each
+    circle's frame at the corner, and the discriminant of its equation.
+
+    ``|O - c_j|^2 = rho_j^2`` with ``c_j = -R_j u_j`` and ``rho_j = R_j - iota_j r``,
+    divided by ``2 R_j``: ``O.u_j = -iota_j r - g / R_j`` with one unknown ``g = (|O|^2 -
+    r^2) / 2``. For a given ``g`` this is linear in ``O``: ``O = A + g V``. In the frame
+    ``(u_1, perp(u_1))`` (``c = u_1.u_2``, ``X = u_1 x u_2``, so ``u_2 = c u_1 + X
+    perp(u_1)``): ``A = (-iota_1 r, -2 iota_2 r X / |u_2 + i u_1|^2)`` (``i = iota_1
+    iota_2``; ``|u_2 + i u_1|^2 = 2 (1 + i c) = 4 cos^2(theta/2)``, ``theta`` the corner's
+    deflection: the second component is the line-line ``-/+ r tan(theta/2)``), ``V =
+    (-1 / R_1, (c / R_1 - 1 / R_2) / X)``; then ``g`` solves ``|V|^2 g^2 - 2 (1 - A.V) g
+    + A_t^2 = 0`` (``|A|^2 - r^2 = A_t^2``), of which the root that tends to 0 with ``r``
+    is taken. In the frame ``(u_2, perp(u_2))`` by the same steps ``A = (-iota_2 r, 2
+    iota_1 r X / |u_2 + i u_1|^2)``, ``V = (-1 / R_2, (1 / R_1 - c / R_2) / X)``.
+
+    Every term is computed to round-off relative to itself, so the components of ``O``
+    along the circles' tangents -- the replaced angles -- are exact near a tangential
+    corner (``X -> 0``) as near a cusp; the form through the circles' radical line loses
+    digits like ``1 / theta^2`` there.
+
+    Returns
+    -------
+    on1, ot1, on2, ot2 : numpy.ndarray, shape (k,)
+        ``O.u_1``, ``O.perp(u_1)``, ``O.u_2``, ``O.perp(u_2)``, mm.
+    disc : numpy.ndarray, shape (k,)
+        Discriminant (the fillet exists where it is not negative).
+    """
+    i = iota1 * iota2
+    c = row_dots(u1, u2)
+    x = _cross2(u1, u2)
+    plus = u2 + i[:, None] * u1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p2 = row_dots(plus, plus)
+        at1 = -2.0 * iota2 * r * x / p2
+        at2 = 2.0 * iota1 * r * x / p2
+        vt1 = (c / r1 - 1.0 / r2) / x
+        vt2 = (1.0 / r1 - c / r2) / x
+        beta = 1.0 - (iota1 * r / r1 + at1 * vt1)
+        disc = beta * beta - (1.0 / (r1 * r1) + vt1 * vt1) * at1 * at1
+        g = at1 * at1 / (beta + np.where(beta >= 0, 1.0, -1.0)
+                         * np.sqrt(np.maximum(disc, 0.0)))
+    return -iota1 * r - g / r1, at1 + g * vt1, -iota2 * r - g / r2, at2 + g * vt2, disc
+
+
+def _rotated(u: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``u`` turned by ``a`` (counter-clockwise) and the change ``rot(a) u - u``, written
+    without cancellation, shape (k, 2) each."""
+    du = (-2.0 * np.sin(a / 2.0) ** 2)[:, None] * u + np.sin(a)[:, None] * _perp(u)
+    return u + du, du
+
+
+def circle_circle_fillet(r: np.ndarray, c1: np.ndarray, r1: np.ndarray, s1: np.ndarray,
+                         c2: np.ndarray, r2: np.ndarray, s2: np.ndarray) -> CircleFillet:
+    """The tangent arc of radius ``r`` rounding the corner between two circles.
+
+    Plane coordinates (the circles' common plane), the corner ``C`` at the origin: the
+    first circle (centre ``c_1``, radius ``R_1``, ``s_1`` +1 counter-clockwise, -1
+    clockwise) ends at ``C``, the second (``c_2``, ``R_2``, ``s_2``) starts there
+    (``|c_j| = R_j``). The rounding turns to the side ``s`` the corner turns to (the sign
+    of ``t_1 x t_2``, the circles' tangents at ``C``), so near ``C`` its centre ``O`` is
+    ``r`` from each circle on that side: ``|O - c_j| = R_j - r`` where the fillet turns
+    the way circle ``j`` does (inside it), ``R_j + r`` otherwise. Of the two points
+    where these two circles about ``c_1``, ``c_2`` cross, the one that tends to ``C``
+    with ``r`` is taken (:func:`_circle_fillet_centre`); the fillet touches circle ``j``
+    on the radius through ``O``. It is valid where it exists (both offset radii
+    positive, the circles cross), its start lies before ``C`` on the first circle and
+    its end after ``C`` on the second (each by less than half a turn), and the angle it
+    turns in the direction ``s``, ``sweep``, is the angle the programmed contour turns
+    between its ends, ``theta + s (s_1 a_1 + s_2 a_2)`` (``theta`` the corner's
+    deflection, ``a_j`` the angles replaced; the two agree up to whole turns, and this
+    picks the fillet that rounds this corner, not a loop).
+
+    The deviation is ``C - M``, ``M`` the fillet's point nearest ``C`` (on the radius
+    towards ``C``, or the nearer end where that radius misses the fillet).
+
+    Parameters
+    ----------
+    r : numpy.ndarray, shape (k,)
+        Fillet radii, mm (> 0).
+    c1, c2 : numpy.ndarray, shape (k, 2)
+    r1, s1, r2, s2 : numpy.ndarray, shape (k,)
+
+    Returns
+    -------
+    CircleFillet
+    """
+    u01, u02, s, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    on1, ot1, on2, ot2, disc = _circle_fillet_centre(r, u01, r1, u02, r2, iota1, iota2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        O = on1[:, None] * u01 + ot1[:, None] * _perp(u01)
+        # the angles replaced, from the radials at C to those through O (O - c_j has
+        # the components R_j + O.u_0j and O.perp(u_0j)): exact relative to the angle
+        ang1 = -s1 * np.arctan2(ot1, r1 + on1)
+        ang2 = s2 * np.arctan2(ot2, r2 + on2)
+        u1, du1 = _rotated(u01, -s1 * ang1)
+        u2, du2 = _rotated(u02, s2 * ang2)
+        start = r1[:, None] * du1
+        end = r2[:, None] * du2
+        radial = iota1[:, None] * u1
+        e_end = iota2[:, None] * u2
+        sweep = np.mod(s * np.arctan2(_cross2(radial, e_end), row_dots(radial, e_end)),
+                       2.0 * np.pi)
+        t1 = s1[:, None] * _perp(u01)
+        t2 = s2[:, None] * _perp(u02)
+        theta = 2.0 * np.arctan2(row_norms(t2 - t1), row_norms(t2 + t1))
+        expected = theta + s * (s1 * ang1 + s2 * ang2)
+        # nearest point to C: on the radius towards C where it meets the fillet's span
+        to_c = -O / row_norms(O)[:, None]
+        at = np.mod(s * np.arctan2(_cross2(radial, to_c), row_dots(radial, to_c)),
+                    2.0 * np.pi)
+        near = np.where((at <= sweep)[:, None], O + r[:, None] * to_c,
+                        np.where((row_norms(start) <= row_norms(end))[:, None], start, end))
+    valid = ((disc >= 0) & (r1 - iota1 * r > 0) & (r2 - iota2 * r > 0) & (ang1 > 0)
+             & (ang2 > 0) & (sweep > 0) & (np.abs(sweep - expected) < np.pi)
+             & np.isfinite(sweep) & (s != 0))
+    return CircleFillet(valid, r1 * ang1, r2 * ang2, O, start, end, radial,
+                        s1[:, None] * _perp(u1), sweep, -near)
+
+
+def circle_fillet_deviation(r: np.ndarray, c1: np.ndarray, r1: np.ndarray,
+                            s1: np.ndarray, c2: np.ndarray, r2: np.ndarray,
+                            s2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``C - M`` of the fillets of radius ``r`` of :func:`circle_circle_fillet`, shape
+    (k, 2), and whether they are valid, shape (k,) (the signature of
+    :func:`fillet_deviation`, for the same search over ``r``)."""
+    f = circle_circle_fillet(r, c1, r1, s1, c2, r2, s2)
+    return f.deviation, f.valid
+
+
+def circle_fillet_radius_for_trim(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray,
+                                  s1: np.ndarray, c2: np.ndarray, r2: np.ndarray,
+                                  s2: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`circle_circle_fillet` that replaces the arc length
+    ``trim`` of the first circle, closed form, mm, shape (k,). For the second circle's,
+    pass the pair traversed backwards: ``(c2, r2, -s2, c1, r1, -s1)`` (the same fillet;
+    the corner then turns the other way and each ``iota`` stays with its circle).
+
+    It touches the first circle at ``T = c_1 + R_1 u`` (``u`` the radial ``trim / R_1``
+    back along it from ``C``), with its centre ``O = T - iota_1 r u``; ``|O - c_2| = R_2 -
+    iota_2 r`` squared loses its ``r^2`` terms: ``r = (|T - c_2|^2 - R_2^2) / (2 (iota_1
+    u.(T - c_2) - iota_2 R_2))``. Without cancellation (``T = R_1 du``, ``du = u - u_01``,
+    ``|c_2| = R_2``, ``c_2 = -R_2 u_02``): the numerator is ``R_1 du.(R_1 du + 2 R_2
+    u_02)`` and twice the denominator ``iota_1 R_1 |du|^2 - iota_2 R_2 |u_02 - iota_1
+    iota_2 u|^2``.
+    """
+    u01, u02, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    a = -s1 * trim / r1
+    du = (-2.0 * np.sin(a / 2.0) ** 2)[:, None] * u01 + np.sin(a)[:, None] * _perp(u01)
+    T = r1[:, None] * du
+    u = u01 + du
+    num = row_dots(T, T + 2.0 * r2[:, None] * u02)
+    w = u02 - (iota1 * iota2)[:, None] * u
+    den = iota1 * r1 * row_dots(du, du) - iota2 * r2 * row_dots(w, w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return num / den
+
+
+def circle_fillet_largest_radius(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray,
+                                 c2: np.ndarray, r2: np.ndarray,
+                                 s2: np.ndarray) -> np.ndarray:
+    """Largest radius of the fillets of :func:`circle_circle_fillet` (where the
+    discriminant of :func:`_circle_fillet_centre` reaches 0), mm, shape (k,); ``inf``
+    where they exist at every radius (both circles curving away from the fillet).
+
+    ``disc(r) = (1 - r k)^2 - |V|^2 a^2 r^2`` with ``A_t = a r``, ``k = iota_1 / R_1 + a
+    V_t``: its first positive root is ``1 / (k + |V| |a|)``, where that is positive.
+    With ``a = -2 iota_2 X / P``, ``V_t = (c / R_1 - 1 / R_2) / X`` (``P = |u_2 + i
+    u_1|^2``) the ``X`` cancel: ``k = iota_1 / R_1 - 2 iota_2 (c / R_1 - 1 / R_2) / P``,
+    ``|V| |a| = 2 sqrt(X^2 / R_1^2 + (c / R_1 - 1 / R_2)^2) / P``.
+    """
+    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    i = iota1 * iota2
+    c = row_dots(u1, u2)
+    x = _cross2(u1, u2)
+    plus = u2 + i[:, None] * u1
+    p2 = row_dots(plus, plus)
+    m = c / r1 - 1.0 / r2
+    den = iota1 / r1 - 2.0 * iota2 * m / p2 + 2.0 * np.sqrt(x * x / (r1 * r1) + m * m) / p2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(den > 0, 1.0 / den, np.inf)
+
+
+def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray,
+                                s1: np.ndarray, c2: np.ndarray, r2: np.ndarray,
+                                s2: np.ndarray) -> np.ndarray:
+    """Largest radius whose fillet (:func:`circle_circle_fillet`) replaces at most the
+    arc length ``trim`` of the first circle, mm, shape (k,) (``inf``: every fillet
+    does; not positive: none). For the second circle pass the pair backwards, as to
+    :func:`circle_fillet_radius_for_trim`.
+
+    On the fillets' branch the replaced length grows with ``r`` up to the largest
+    radius (:func:`circle_fillet_largest_radius`); the closed form
+    :func:`circle_fillet_radius_for_trim` inverts it there, and beyond it falls back to
+    0 where the circles cross a second time. So: the closed form where ``trim`` is
+    below the length the largest fillet replaces, that radius where it is not.
+    """
+    r = circle_fillet_radius_for_trim(trim, c1, r1, s1, c2, r2, s2)
+    top = circle_fillet_largest_radius(c1, r1, s1, c2, r2, s2)
+    fin = np.isfinite(top)
+    reach = np.full(trim.shape, np.inf)
+    if fin.any():
+        # just inside the largest radius, where the fillet still exists (its replaced
+        # length changes like the root of the distance to it: 1e-12 relative moves it
+        # by about 1e-6 relative, on the closed form's side of the comparison)
+        f = circle_circle_fillet(np.where(fin, top, 1.0) * (1.0 - 1e-12), c1, r1, s1,
+                                 c2, r2, s2)
+        reach = np.where(fin, f.trim_in, np.inf)
+    return np.where(trim < reach, r, top)
+
+
+__all__ = ["ArcFillet", "CircleFillet", "REASON_CODE", "ROUNDING_REASONS",
+           "RoundingTable", "axis_deviation_limit", "circle_circle_fillet",
+           "circle_fillet_deviation", "circle_fillet_largest_radius",
+           "circle_fillet_radius_for_trim", "circle_fillet_radius_within", "deflection_angle",
+           "distance_for_deviation", "fillet_deviation", "fillet_pieces",
+           "fillet_radius_for_arc_trim", "fillet_radius_for_line_trim",
+           "line_circle_fillet"]

@@ -4,8 +4,9 @@ A seeded CAM-like polyline of 10^4 lines (0.5..5 mm, turns of 5..120 degrees, F6
 is planned by the heuristic under G64 and under each rounding mode, on the default
 machine with BRISK and SOFT; a seeded chain of 10^4 lines and tangent arcs under G645
 (tangential transitions with curvature jumps), and the same chain with a corner where
-each line leaves its arc (corners next to arcs); then the short-segment program
-(../shared/corpus/lcnc_short_segments_0.001.ngc converted to G642 by
+each line leaves its arc (corners next to arcs), and a seeded chain of 10^4 arcs each
+leaving the one before at a corner (corners between two arcs); then the short-segment
+program (../shared/corpus/lcnc_short_segments_0.001.ngc converted to G642 by
 tests/reference/corpus_sinumerik.py, 3000 blocks of 0.0254 mm) against itself under G64
 on both bundled machines. Every row is a ratio against the same program under G64,
 measured in the same run, of the wall time per block (the smallest of 7 runs: on a
@@ -49,7 +50,7 @@ from reference.prepare import build_path  # noqa: E402
 TARGET = 1.30
 sys.path.insert(0, str(HERE.parent / "reference"))
 from corpus_sinumerik import short_segments_g642  # noqa: E402
-from seeded_programs import line_arc_chain, polyline  # noqa: E402
+from seeded_programs import arc_chain, line_arc_chain, polyline  # noqa: E402
 
 
 def timed(text: str, machine, repeat: int = 5):
@@ -128,6 +129,15 @@ def main(argv=None) -> None:
         head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
         r, r_pl = row(f"{accel} {mode} arc corners", n,
                       *paired(head.format("G64") + kinked, head.format(mode) + kinked,
+                              machine))
+        worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
+    # corners between two arcs (each arc leaves the one before at a 30..60 degree corner)
+    arcs = arc_chain(n, 5)
+    for accel, mode in (("BRISK", "G642 CTOL=0.02"), ("BRISK", "G641 ADIS=0.2"),
+                        ("SOFT", "G645 CTOL=0.02")):
+        head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
+        r, r_pl = row(f"{accel} {mode} arc-arc corners", n,
+                      *paired(head.format("G64") + arcs, head.format(mode) + arcs,
                               machine))
         worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
     text = short_segments_g642()

@@ -18,6 +18,9 @@ from reference.nc import parse_file
 from reference.prepare import build_path
 from test_corpus_machines import MACHINES, _machine_file
 
+#: Four corners between arcs (test_rounding_arc_arc.ARCS with RND=1 at the third).
+ARCS_ONLY = ("G1 X0 Y0\nG2 X10 Y0 I5 J0\nG2 X-2 Y12 I0 J12\nG3 X-10 Y4 I0 J-8 RND=1\n"
+             "G2 X-16 Y10 I0 J6\nG3 X-11 Y15 I0 J5\nM30\n")
 PROGRAMS = {
     "g642_ctol": "G90 G642 CTOL=0.05 BRISK F4000\nG1 X0 Y0\nX40\nY30\nX10 Y35\nX0 Y0\nM30\n",
     "g641_adis": "G90 G641 ADIS=0.5 ADISPOS=1 BRISK F3000\nG0 X0 Y0\nG0 X20\nG1 Y20\nX0\nY0\nM30\n",
@@ -37,6 +40,10 @@ PROGRAMS = {
                             "G2 X50 Y10 I5 J0\nG1 X60 Y5\nM30\n",
     "g645_soft_line_arc": "G90 G645 CTOL=0.05 SOFT F6000\nG1 X0 Y0\nX20\nG3 X30 Y10 I0 J10\n"
                           "G1 Y30\nX31 Y50\nM30\n",
+    # corners between two arcs: tangent fillets (G641 ADIS with one RND; G642 CTOL under
+    # SOFT), each turn and both senses
+    "g641_arc_arc_corner": "G90 G641 ADIS=0.5 BRISK F3000\n" + ARCS_ONLY,
+    "g642_soft_arc_arc_corner": "G90 G642 CTOL=0.05 SOFT F3000\n" + ARCS_ONLY,
 }
 #: Programs whose roundings are clothoid pairs on every bundled machine (checked below).
 G2 = ("g642_soft_shallow", "g645_soft_zigzag", "g641_soft_adis", "g645_soft_line_arc")
@@ -64,6 +71,12 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
     if name == "g641_line_arc_corner":      # fillets at corners next to arcs inserted
         t = build_path(parse_file(prog), load_machine(str(mfile))).rounding
         assert int(np.sum(t.inserted & ~t.tangential)) >= 2
+    if name.endswith("arc_arc_corner"):     # fillets between arcs inserted (the RND one
+        # on every machine; all four where the rounding pays)
+        t = build_path(parse_file(prog), load_machine(str(mfile))).rounding
+        assert t.n == 4 and bool(t.inserted[2])
+        if name.startswith("g641") or machine == "linuxcnc_xyz":
+            assert t.inserted.all()
     if name in G2:
         path = build_path(parse_file(prog), load_machine(str(mfile)))
         t = path.rounding

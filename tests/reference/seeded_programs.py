@@ -50,3 +50,24 @@ def line_arc_chain(n: int, seed: int, kink_deg: float = 0.0) -> str:
         word = "G3" if side > 0 else "G2"
         out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
     return "\n".join(out) + "\nM30\n"
+
+
+def arc_chain(n: int, seed: int, kink_deg: float = 60.0) -> str:
+    """``n`` seeded arcs (radius 1..20 mm, turning 10..120 degrees, either way), each
+    leaving the one before at a corner of ``kink_deg/2 .. kink_deg`` degrees, either way:
+    a contour of corners between two arcs (body only, ``G2``/``G3`` words with the centre
+    as ``I J``, 12 decimals, then ``M30``)."""
+    rng = np.random.default_rng(seed)
+    heading, x, y, out = 0.0, 0.0, 0.0, []
+    for _ in range(n):
+        heading += np.radians(rng.uniform(kink_deg / 2, kink_deg)) * rng.choice((-1.0, 1.0))
+        r = rng.uniform(1.0, 20.0)
+        turn = np.radians(rng.uniform(10.0, 120.0)) * rng.choice((-1.0, 1.0))
+        side = np.sign(turn)                        # +1: counter-clockwise (G3)
+        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
+        i_, j_ = cx - x, cy - y
+        heading += turn
+        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
+        word = "G3" if side > 0 else "G2"
+        out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
+    return "\n".join(out) + "\nM30\n"

@@ -178,8 +178,10 @@ NO_ROUNDING = [
     ("G90 G641 ADIS=0.0000005 F3000\nG1 X0 Y0\nG1 X50\nG1 Y50\n",
      "rounding distance too small"),
     ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG1 X50\nG1 X60\n", "tangential transition"),
-    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG2 X10 Y0 I5 J0\nG2 X5 Y5 I0 J5\n",
-     "corner between two arcs: rounding not modelled yet"),
+    # model limit: two arcs in different planes (XY into ZX)
+    ("G90 G641 ADIS=0.5 F3000\nG1 X0 Y0\nG17 G2 X10 Y0 I5 J0\nG18 G2 X15 Z5 I0 K5\n",
+     "corner next to a helix or spiral, or out of the arc's plane: rounding not modelled "
+     "yet"),
 ]
 
 

@@ -167,9 +167,7 @@ def test_the_block_length_clamp_limits_rnd():
 
 
 def test_model_limits_are_named():
-    two_arcs = "G17 G90 G641 ADIS=0.5 BRISK F600\nG1 X0 Y0\nG2 X10 Y0 I5 J0\nG2 X5 Y5 I0 J5\n"
-    assert reasons(build_path(parse_text(two_arcs), machine())) == [
-        "corner between two arcs: rounding not modelled yet"]
+    """(corners between two arcs: tests/reference/test_rounding_arc_arc.py)"""
     # a line leaving the arc's plane
     out = "G17 G90 G641 ADIS=0.5 BRISK F600\nG1 X0 Y0 Z0\nG1 X20 Z5\nG2 X30 Y0 I5 J0\n"
     assert reasons(build_path(parse_text(out), machine()))[-1] == (
