@@ -297,20 +297,26 @@ class Profile:
         return (t, *self.state(t))
 
     # ------------------------------------------------------------ accounting
-    def _cuts(self, s_cuts):
-        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
-        time and position of each cut), or ``None`` when no cut falls inside an
-        interval."""
+    def _cut_positions(self, s_cuts) -> np.ndarray:
+        """The positions of ``s_cuts`` where :meth:`split_at` adds knots, sorted, unique."""
         cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
         cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
         # drop the cuts on a knot: the knots are non-decreasing, so the knot at or after
         # each cut is found by bisection (the same set as ``np.isin(cuts, self.s)``,
         # without sorting the knots again)
         at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
-        cuts = cuts[self.s[at] != cuts]
+        return cuts[self.s[at] != cuts]
+
+    def _cuts(self, s_cuts, known: tuple[np.ndarray, np.ndarray] | None = None):
+        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
+        time and position of each cut), or ``None`` when no cut falls inside an
+        interval. ``known``: ``(positions, times)`` of knots already found for a
+        superset of these cuts (:meth:`block_and_segment_times`), sorted positions."""
+        cuts = self._cut_positions(s_cuts)
         if cuts.size == 0 or self.n_intervals == 0:
             return None
-        tc = self.time_at(cuts)
+        tc = self.time_at(cuts) if known is None else known[1][np.searchsorted(known[0],
+                                                                               cuts)]
         k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
         order = np.argsort(tc, kind="stable")
         return k[order], tc[order], cuts[order]
@@ -360,7 +366,7 @@ class Profile:
         """
         return _interval_blocks(self.s, self.block, path)
 
-    def block_times(self, path) -> np.ndarray:
+    def block_times(self, path, _known=None) -> np.ndarray:
         """Time spent in each NC block; sums to :attr:`duration`.
 
         The same sums as ``split_at`` at every block end followed by
@@ -373,6 +379,9 @@ class Profile:
         path : reference.core.geometry.Path
             The path the profile runs on (its ``blocks`` define the block boundaries).
 
+        _known : tuple of numpy.ndarray, optional
+            Knot times already found (:meth:`block_and_segment_times`).
+
         Returns
         -------
         numpy.ndarray, shape (n_blocks,)
@@ -380,44 +389,74 @@ class Profile:
         """
         spans = path.blocks
         n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
-        cuts = spans.s_end[spans.s_end > spans.s_start]
-        cut = self._cuts(cuts)
-        if cut is None:
-            t, s, blk = self.t, self.s, self.block
-        else:
-            k, tc, sc = cut
-            t = np.insert(self.t, k + 1, tc)
-            s = np.insert(self.s, k + 1, sc)
-            blk = np.insert(self.block, k + 1, self.block[k])
+        t, s, blk = self._split_knots(spans.s_end[spans.s_end > spans.s_start], block=True,
+                                      known=_known)
         iv = _interval_blocks(s, blk, path)
         del s, blk
         return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
 
-    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
+    def _split_knots(self, s_cuts, block: bool = False, known=None):
+        """Knot times and positions (and with ``block`` the interval labels) of
+        :meth:`split_at` ``(s_cuts)``, the same arrays, without building (and checking)
+        the split profile: ``(t, s, block or None)``. ``known``: as in :meth:`_cuts`."""
+        cut = self._cuts(s_cuts, known)
+        if cut is None:
+            return self.t, self.s, (self.block if block else None)
+        k, tc, sc = cut
+        return (np.insert(self.t, k + 1, tc), np.insert(self.s, k + 1, sc),
+                np.insert(self.block, k + 1, self.block[k]) if block else None)
+
+    def segment_times(self, path, segments: np.ndarray | None = None,
+                      _known=None) -> np.ndarray:
         """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
 
         ``segments`` (int array, optional): only these are wanted; the profile is then
         split at their own breaks only and the other entries are 0. A segment's
         intervals are those between its two breaks either way, with the same knots, so
-        its time is the same number.
+        its time is the same number. ``_known``: knot times already found
+        (:meth:`block_and_segment_times`).
         """
         if segments is None:
-            prof = self.split_at(path.s_breaks)
+            t, s, _ = self._split_knots(path.s_breaks, known=_known)
         else:
-            segments = np.asarray(segments, dtype=np.int64)
-            ends = np.zeros(path.n_segments + 1, dtype=bool)     # their breaks, sorted
-            ends[segments] = True
-            ends[segments + 1] = True
-            prof = self.split_at(path.s_breaks[ends])
-        moving = prof.s[1:] > prof.s[:-1]
-        mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+            t, s, _ = self._split_knots(path.s_breaks[self._segment_ends(path, segments)],
+                                        known=_known)
+        moving = s[1:] > s[:-1]
+        mid = 0.5 * (s[:-1] + s[1:])
         seg = path.segment_index(mid)
         if segments is not None:
+            segments = np.asarray(segments, dtype=np.int64)
             wanted = np.zeros(path.n_segments, dtype=bool)
             wanted[segments] = True
             moving &= wanted[seg]
-        return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
+        return np.bincount(seg[moving], weights=np.diff(t)[moving],
                            minlength=path.n_segments)
+
+    def block_and_segment_times(self, path, segments: np.ndarray
+                                ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`block_times` ``(path)`` and :meth:`segment_times` ``(path, segments)``,
+        the same numbers, with the time of every knot the two splits add found once
+        (:meth:`time_at` solves each position on its own, so a knot's time does not
+        depend on which other knots are solved with it).
+        """
+        spans = path.blocks
+        if not len(spans):
+            return np.zeros(0), self.segment_times(path, segments)
+        cuts = self._cut_positions(np.concatenate((
+            spans.s_end[spans.s_end > spans.s_start],
+            path.s_breaks[self._segment_ends(path, segments)])))
+        known = (cuts, self.time_at(cuts) if cuts.size and self.n_intervals else
+                 np.zeros(0))
+        return self.block_times(path, known), self.segment_times(path, segments, known)
+
+    @staticmethod
+    def _segment_ends(path, segments) -> np.ndarray:
+        """Breaks of ``segments`` (both ends), as a mask over the path's breaks."""
+        segments = np.asarray(segments, dtype=np.int64)
+        ends = np.zeros(path.n_segments + 1, dtype=bool)
+        ends[segments] = True
+        ends[segments + 1] = True
+        return ends
 
 
 #: Iterations of :func:`_cubic_time`: Newton converges in a few steps; the bisection
