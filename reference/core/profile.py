@@ -307,19 +307,27 @@ class Profile:
         at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
         return cuts[self.s[at] != cuts]
 
-    def _cuts(self, s_cuts, known: tuple[np.ndarray, np.ndarray] | None = None):
-        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
-        time and position of each cut), or ``None`` when no cut falls inside an
-        interval. ``known``: ``(positions, times)`` of knots already found for a
-        superset of these cuts (:meth:`block_and_segment_times`), sorted positions."""
-        cuts = self._cut_positions(s_cuts)
+    def _cut_times(self, cuts: np.ndarray) -> np.ndarray:
+        """Knot times of :meth:`_cut_positions` ``cuts``, s."""
+        if cuts.size == 0 or self.n_intervals == 0:
+            return np.zeros(0)
+        return self.time_at(cuts)
+
+    def _ordered_cuts(self, cuts: np.ndarray, tc: np.ndarray):
+        """``(k, tc, sc)`` of the cuts at positions ``cuts`` reached at times ``tc``, in
+        time order (interval, time and position of each), or ``None`` without cuts."""
         if cuts.size == 0 or self.n_intervals == 0:
             return None
-        tc = self.time_at(cuts) if known is None else known[1][np.searchsorted(known[0],
-                                                                               cuts)]
         k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
         order = np.argsort(tc, kind="stable")
         return k[order], tc[order], cuts[order]
+
+    def _cuts(self, s_cuts):
+        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
+        time and position of each cut), or ``None`` when no cut falls inside an
+        interval."""
+        cuts = self._cut_positions(s_cuts)
+        return self._ordered_cuts(cuts, self._cut_times(cuts))
 
     def split_at(self, s_cuts) -> "Profile":
         """Same motion with extra knots where it first crosses each ``s_cuts`` value.
@@ -366,7 +374,7 @@ class Profile:
         """
         return _interval_blocks(self.s, self.block, path)
 
-    def block_times(self, path, _known=None) -> np.ndarray:
+    def block_times(self, path) -> np.ndarray:
         """Time spent in each NC block; sums to :attr:`duration`.
 
         The same sums as ``split_at`` at every block end followed by
@@ -379,84 +387,92 @@ class Profile:
         path : reference.core.geometry.Path
             The path the profile runs on (its ``blocks`` define the block boundaries).
 
-        _known : tuple of numpy.ndarray, optional
-            Knot times already found (:meth:`block_and_segment_times`).
-
         Returns
         -------
         numpy.ndarray, shape (n_blocks,)
             Indexed by block index (``path.blocks[i].block``), s.
         """
-        spans = path.blocks
-        n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
-        t, s, blk = self._split_knots(spans.s_end[spans.s_end > spans.s_start], block=True,
-                                      known=_known)
-        iv = _interval_blocks(s, blk, path)
-        del s, blk
-        return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
+        cuts = self._block_cuts(path)
+        return self._block_sums(path, cuts, self._cut_times(cuts))
 
-    def _split_knots(self, s_cuts, block: bool = False, known=None):
-        """Knot times and positions (and with ``block`` the interval labels) of
-        :meth:`split_at` ``(s_cuts)``, the same arrays, without building (and checking)
-        the split profile: ``(t, s, block or None)``. ``known``: as in :meth:`_cuts`."""
-        cut = self._cuts(s_cuts, known)
-        if cut is None:
-            return self.t, self.s, (self.block if block else None)
-        k, tc, sc = cut
-        return (np.insert(self.t, k + 1, tc), np.insert(self.s, k + 1, sc),
-                np.insert(self.block, k + 1, self.block[k]) if block else None)
-
-    def segment_times(self, path, segments: np.ndarray | None = None,
-                      _known=None) -> np.ndarray:
+    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
         """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
 
         ``segments`` (int array, optional): only these are wanted; the profile is then
         split at their own breaks only and the other entries are 0. A segment's
         intervals are those between its two breaks either way, with the same knots, so
-        its time is the same number. ``_known``: knot times already found
-        (:meth:`block_and_segment_times`).
+        its time is the same number. Formed from the split knots' times and positions
+        alone, as :meth:`block_times`.
         """
-        if segments is None:
-            t, s, _ = self._split_knots(path.s_breaks, known=_known)
-        else:
-            t, s, _ = self._split_knots(path.s_breaks[self._segment_ends(path, segments)],
-                                        known=_known)
-        moving = s[1:] > s[:-1]
-        mid = 0.5 * (s[:-1] + s[1:])
-        seg = path.segment_index(mid)
-        if segments is not None:
-            segments = np.asarray(segments, dtype=np.int64)
-            wanted = np.zeros(path.n_segments, dtype=bool)
-            wanted[segments] = True
-            moving &= wanted[seg]
-        return np.bincount(seg[moving], weights=np.diff(t)[moving],
-                           minlength=path.n_segments)
+        cuts = self._segment_cuts(path, segments)
+        return self._segment_sums(path, segments, cuts, self._cut_times(cuts))
 
     def block_and_segment_times(self, path, segments: np.ndarray
                                 ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`block_times` ``(path)`` and :meth:`segment_times` ``(path, segments)``,
-        the same numbers, with the time of every knot the two splits add found once
+        the same numbers, with the time of a knot that both splits add found once
         (:meth:`time_at` solves each position on its own, so a knot's time does not
         depend on which other knots are solved with it).
         """
-        spans = path.blocks
-        if not len(spans):
-            return np.zeros(0), self.segment_times(path, segments)
-        cuts = self._cut_positions(np.concatenate((
-            spans.s_end[spans.s_end > spans.s_start],
-            path.s_breaks[self._segment_ends(path, segments)])))
-        known = (cuts, self.time_at(cuts) if cuts.size and self.n_intervals else
-                 np.zeros(0))
-        return self.block_times(path, known), self.segment_times(path, segments, known)
+        cb, cs = self._block_cuts(path), self._segment_cuts(path, segments)
+        if cb.size and cs.size and self.n_intervals:
+            both = np.union1d(cb, cs)
+            t_both = self.time_at(both)
+            tb, ts = t_both[np.searchsorted(both, cb)], t_both[np.searchsorted(both, cs)]
+        else:
+            tb, ts = self._cut_times(cb), self._cut_times(cs)
+        return (self._block_sums(path, cb, tb), self._segment_sums(path, segments, cs, ts))
 
-    @staticmethod
-    def _segment_ends(path, segments) -> np.ndarray:
-        """Breaks of ``segments`` (both ends), as a mask over the path's breaks."""
+    def _block_cuts(self, path) -> np.ndarray:
+        """:meth:`_cut_positions` of the block ends."""
+        spans = path.blocks
+        return self._cut_positions(spans.s_end[spans.s_end > spans.s_start])
+
+    def _segment_cuts(self, path, segments) -> np.ndarray:
+        """:meth:`_cut_positions` of the breaks of ``segments`` (all breaks: None)."""
+        if segments is None:
+            return self._cut_positions(path.s_breaks)
         segments = np.asarray(segments, dtype=np.int64)
-        ends = np.zeros(path.n_segments + 1, dtype=bool)
+        ends = np.zeros(path.n_segments + 1, dtype=bool)     # their breaks, sorted
         ends[segments] = True
         ends[segments + 1] = True
-        return ends
+        return self._cut_positions(path.s_breaks[ends])
+
+    def _block_sums(self, path, cuts: np.ndarray, tc: np.ndarray) -> np.ndarray:
+        """:meth:`block_times` from the block-end cuts and their times."""
+        spans = path.blocks
+        n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
+        cut = self._ordered_cuts(cuts, tc)
+        if cut is None:
+            t, s, blk = self.t, self.s, self.block
+        else:
+            k, tc, sc = cut
+            t = np.insert(self.t, k + 1, tc)
+            s = np.insert(self.s, k + 1, sc)
+            blk = np.insert(self.block, k + 1, self.block[k])
+        iv = _interval_blocks(s, blk, path)
+        del s, blk
+        return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
+
+    def _segment_sums(self, path, segments, cuts: np.ndarray, tc: np.ndarray
+                      ) -> np.ndarray:
+        """:meth:`segment_times` from the segment-break cuts and their times."""
+        cut = self._ordered_cuts(cuts, tc)
+        if cut is None:
+            t, s = self.t, self.s
+        else:
+            k, tc, sc = cut
+            t = np.insert(self.t, k + 1, tc)
+            s = np.insert(self.s, k + 1, sc)
+        moving = s[1:] > s[:-1]
+        mid = 0.5 * (s[:-1] + s[1:])
+        seg = path.segment_index(mid)
+        if segments is not None:
+            wanted = np.zeros(path.n_segments, dtype=bool)
+            wanted[np.asarray(segments, dtype=np.int64)] = True
+            moving &= wanted[seg]
+        return np.bincount(seg[moving], weights=np.diff(t)[moving],
+                           minlength=path.n_segments)
 
 
 #: Iterations of :func:`_cubic_time`: Newton converges in a few steps; the bisection
