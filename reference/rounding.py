@@ -278,7 +278,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     tang_arc = np.zeros(a.size, bool)
     near_arc = np.flatnonzero(~is_line & (reason < 0))
     if near_arc.size:
-        tang_arc[near_arc] = is_tangential(*_junction_tangents(path, a[near_arc]), FEASIBLE)
+        # the arcs' tangents at the corners: evaluated once, used for both tests below
+        t1_arc, t2_arc = _junction_tangents(path, a[near_arc])
+        tang_arc[near_arc] = is_tangential(t1_arc, t2_arc, FEASIBLE)
     other = np.zeros(a.size, bool)
     if not geo.all():
         other = (row_max(np.abs(da[:, ~geo])) > MOVING_AXIS_TOL) | (
@@ -291,8 +293,14 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     t1, t2 = da, db                       # unit tangents of lines (geometry axes only here)
     if near_arc.size:                     # at corners next to arcs: the arcs' tangents
         t1, t2 = t1.copy(), t2.copy()
-        t1[near_arc], t2[near_arc] = _junction_tangents(path, a[near_arc])
-    tangential = is_tangential(t1, t2, FEASIBLE)
+        t1[near_arc], t2[near_arc] = t1_arc, t2_arc
+    if near_arc.size:                     # the arcs' corners were tested above
+        tangential = tang_arc.copy()
+        rest = np.ones(a.size, bool)
+        rest[near_arc] = False
+        tangential[rest] = is_tangential(t1[rest], t2[rest], FEASIBLE)
+    else:
+        tangential = is_tangential(t1, t2, FEASIBLE)
     decide(tangential, "tangential transition")
     # the same test between two lines, per break (-1: not computed), for the chains
     known = np.full(m - 1, -1, dtype=np.int8)
@@ -332,7 +340,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     v_round = np.full(a.size, np.nan)
     if open_.any():
         o = np.flatnonzero(open_)
-        v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE)[0]
+        # open corners are not tangential (decided above): the test is not repeated
+        v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE, tangential[o])[0]
         soft = accel_id[ka[o]] == soft_id
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
         a1, a2 = np.abs(t1[o]), np.abs(t2[o])

@@ -297,23 +297,37 @@ class Profile:
         return (t, *self.state(t))
 
     # ------------------------------------------------------------ accounting
-    def _cuts(self, s_cuts):
-        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
-        time and position of each cut), or ``None`` when no cut falls inside an
-        interval."""
+    def _cut_positions(self, s_cuts) -> np.ndarray:
+        """The positions of ``s_cuts`` where :meth:`split_at` adds knots, sorted, unique."""
         cuts = np.unique(np.asarray(s_cuts, dtype=np.float64))
         cuts = cuts[(cuts > self.s[0]) & (cuts < self.s[-1])]
         # drop the cuts on a knot: the knots are non-decreasing, so the knot at or after
         # each cut is found by bisection (the same set as ``np.isin(cuts, self.s)``,
         # without sorting the knots again)
         at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
-        cuts = cuts[self.s[at] != cuts]
+        return cuts[self.s[at] != cuts]
+
+    def _cut_times(self, cuts: np.ndarray) -> np.ndarray:
+        """Knot times of :meth:`_cut_positions` ``cuts``, s."""
+        if cuts.size == 0 or self.n_intervals == 0:
+            return np.zeros(0)
+        return self.time_at(cuts)
+
+    def _ordered_cuts(self, cuts: np.ndarray, tc: np.ndarray):
+        """``(k, tc, sc)`` of the cuts at positions ``cuts`` reached at times ``tc``, in
+        time order (interval, time and position of each), or ``None`` without cuts."""
         if cuts.size == 0 or self.n_intervals == 0:
             return None
-        tc = self.time_at(cuts)
         k = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, self.n_intervals - 1)
         order = np.argsort(tc, kind="stable")
         return k[order], tc[order], cuts[order]
+
+    def _cuts(self, s_cuts):
+        """Where :meth:`split_at` adds knots: ``(k, tc, sc)`` in time order (interval,
+        time and position of each cut), or ``None`` when no cut falls inside an
+        interval."""
+        cuts = self._cut_positions(s_cuts)
+        return self._ordered_cuts(cuts, self._cut_times(cuts))
 
     def split_at(self, s_cuts) -> "Profile":
         """Same motion with extra knots where it first crosses each ``s_cuts`` value.
@@ -378,10 +392,57 @@ class Profile:
         numpy.ndarray, shape (n_blocks,)
             Indexed by block index (``path.blocks[i].block``), s.
         """
+        cuts = self._block_cuts(path)
+        return self._block_sums(path, cuts, self._cut_times(cuts))
+
+    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
+        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
+
+        ``segments`` (int array, optional): only these are wanted; the profile is then
+        split at their own breaks only and the other entries are 0. A segment's
+        intervals are those between its two breaks either way, with the same knots, so
+        its time is the same number. Formed from the split knots' times and positions
+        alone, as :meth:`block_times`.
+        """
+        cuts = self._segment_cuts(path, segments)
+        return self._segment_sums(path, segments, cuts, self._cut_times(cuts))
+
+    def block_and_segment_times(self, path, segments: np.ndarray
+                                ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`block_times` ``(path)`` and :meth:`segment_times` ``(path, segments)``,
+        the same numbers, with the time of a knot that both splits add found once
+        (:meth:`time_at` solves each position on its own, so a knot's time does not
+        depend on which other knots are solved with it).
+        """
+        cb, cs = self._block_cuts(path), self._segment_cuts(path, segments)
+        if cb.size and cs.size and self.n_intervals:
+            both = np.union1d(cb, cs)
+            t_both = self.time_at(both)
+            tb, ts = t_both[np.searchsorted(both, cb)], t_both[np.searchsorted(both, cs)]
+        else:
+            tb, ts = self._cut_times(cb), self._cut_times(cs)
+        return (self._block_sums(path, cb, tb), self._segment_sums(path, segments, cs, ts))
+
+    def _block_cuts(self, path) -> np.ndarray:
+        """:meth:`_cut_positions` of the block ends."""
+        spans = path.blocks
+        return self._cut_positions(spans.s_end[spans.s_end > spans.s_start])
+
+    def _segment_cuts(self, path, segments) -> np.ndarray:
+        """:meth:`_cut_positions` of the breaks of ``segments`` (all breaks: None)."""
+        if segments is None:
+            return self._cut_positions(path.s_breaks)
+        segments = np.asarray(segments, dtype=np.int64)
+        ends = np.zeros(path.n_segments + 1, dtype=bool)     # their breaks, sorted
+        ends[segments] = True
+        ends[segments + 1] = True
+        return self._cut_positions(path.s_breaks[ends])
+
+    def _block_sums(self, path, cuts: np.ndarray, tc: np.ndarray) -> np.ndarray:
+        """:meth:`block_times` from the block-end cuts and their times."""
         spans = path.blocks
         n_blocks = int(spans.block.max()) + 1 if len(spans) else 0
-        cuts = spans.s_end[spans.s_end > spans.s_start]
-        cut = self._cuts(cuts)
+        cut = self._ordered_cuts(cuts, tc)
         if cut is None:
             t, s, blk = self.t, self.s, self.block
         else:
@@ -393,30 +454,24 @@ class Profile:
         del s, blk
         return np.bincount(iv, weights=np.diff(t), minlength=n_blocks)
 
-    def segment_times(self, path, segments: np.ndarray | None = None) -> np.ndarray:
-        """Time spent moving through each segment (holds excluded), shape ``(m,)``, s.
-
-        ``segments`` (int array, optional): only these are wanted; the profile is then
-        split at their own breaks only and the other entries are 0. A segment's
-        intervals are those between its two breaks either way, with the same knots, so
-        its time is the same number.
-        """
-        if segments is None:
-            prof = self.split_at(path.s_breaks)
+    def _segment_sums(self, path, segments, cuts: np.ndarray, tc: np.ndarray
+                      ) -> np.ndarray:
+        """:meth:`segment_times` from the segment-break cuts and their times."""
+        cut = self._ordered_cuts(cuts, tc)
+        if cut is None:
+            t, s = self.t, self.s
         else:
-            segments = np.asarray(segments, dtype=np.int64)
-            ends = np.zeros(path.n_segments + 1, dtype=bool)     # their breaks, sorted
-            ends[segments] = True
-            ends[segments + 1] = True
-            prof = self.split_at(path.s_breaks[ends])
-        moving = prof.s[1:] > prof.s[:-1]
-        mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+            k, tc, sc = cut
+            t = np.insert(self.t, k + 1, tc)
+            s = np.insert(self.s, k + 1, sc)
+        moving = s[1:] > s[:-1]
+        mid = 0.5 * (s[:-1] + s[1:])
         seg = path.segment_index(mid)
         if segments is not None:
             wanted = np.zeros(path.n_segments, dtype=bool)
-            wanted[segments] = True
+            wanted[np.asarray(segments, dtype=np.int64)] = True
             moving &= wanted[seg]
-        return np.bincount(seg[moving], weights=np.diff(prof.t)[moving],
+        return np.bincount(seg[moving], weights=np.diff(t)[moving],
                            minlength=path.n_segments)
 
 

@@ -167,7 +167,8 @@ def jump_ratio(dv: np.ndarray, allowance: np.ndarray) -> np.ndarray:
 
 
 def junction_speed_cap(t_in: np.ndarray, t_out: np.ndarray, allowance: np.ndarray,
-                       flavour: str) -> tuple[np.ndarray, np.ndarray]:
+                       flavour: str, tangential: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """Path-speed cap at each break from the axis velocity-jump rule.
 
     The checker accepts crossing at ``v`` when, for every axis,
@@ -195,6 +196,9 @@ def junction_speed_cap(t_in: np.ndarray, t_out: np.ndarray, allowance: np.ndarra
     allowance : numpy.ndarray, shape (n,)
         ``A_i (ovl_i - 1) T_ipo``, mm/s (``AxisArrays.jump``).
     flavour : {"feasible", "relaxed"}
+    tangential : numpy.ndarray of bool, shape (k,), optional
+        ``is_tangential(t_in, t_out, flavour)`` where the caller has it already (the
+        same test, not repeated); computed when omitted.
 
     Returns
     -------
@@ -225,7 +229,7 @@ def junction_speed_cap(t_in: np.ndarray, t_out: np.ndarray, allowance: np.ndarra
         # a crossing at standstill speed is a stop: say so, rather than plan a corner
         # at 1e-7 mm/s that takes a second per nanometre
         v = np.where(v <= VEL_TOL_MM_S, 0.0, v)
-    free = is_tangential(t_in, t_out, flavour)
+    free = is_tangential(t_in, t_out, flavour) if tangential is None else tangential
     return np.where(free, np.inf, v), np.where(free, -1, ax).astype(np.int64)
 
 

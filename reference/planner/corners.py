@@ -96,7 +96,8 @@ class _Inputs:
     tangential: np.ndarray     # (m - 1,)
 
 
-def g64_corner_speed(t_in: np.ndarray, t_out: np.ndarray, jump: np.ndarray) -> np.ndarray:
+def g64_corner_speed(t_in: np.ndarray, t_out: np.ndarray, jump: np.ndarray,
+                     tangential: np.ndarray | None = None) -> np.ndarray:
     """G64 corner speed: the feasible junction cap of the shared rulebook.
 
     Parameters
@@ -105,13 +106,15 @@ def g64_corner_speed(t_in: np.ndarray, t_out: np.ndarray, jump: np.ndarray) -> n
         Unit tangents before and after the breaks.
     jump : numpy.ndarray, shape (n,)
         Allowed axis velocity steps ``A_i (ovl_i - 1) T_ipo``, mm/s.
+    tangential : numpy.ndarray of bool, shape (k,), optional
+        ``is_tangential(t_in, t_out, FEASIBLE)`` where known (not tested again).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
         mm/s (``inf`` at tangential breaks and where no axis changes direction).
     """
-    return junction_speed_cap(t_in, t_out, jump, FEASIBLE)[0]
+    return junction_speed_cap(t_in, t_out, jump, FEASIBLE, tangential)[0]
 
 
 def _rule_stop(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +130,7 @@ def _interior(x: _Inputs, values: np.ndarray) -> np.ndarray:
 
 
 def _rule_g64(x: _Inputs) -> tuple[np.ndarray, np.ndarray]:
-    v = g64_corner_speed(x.t_in, x.t_out, x.lim.jump)
+    v = g64_corner_speed(x.t_in, x.t_out, x.lim.jump, x.tangential)
     return _interior(x, v), np.full(x.path.n_segments + 1, C.CORNER_RULE)
 
 

@@ -496,18 +496,19 @@ def _block_rows(path: Path, modes: SegmentModes, junc, at: _SegmentRows, profile
     m = path.n_segments
     v_break, v_peak_seg, seg_cause, case_seg = (at.v_break, at.v_peak_seg, at.seg_cause,
                                                 at.case_seg)
-    times = profile.block_times(path) if path.blocks else np.zeros(0)
     spans = path.blocks
     nb = len(spans)
     first, nseg, ids = spans.first_segment, spans.n_segments, spans.block
+    multi = np.flatnonzero(nseg > 1)
     moving = nseg > 0
     # per block: the segment where it spends most time decides cause, mode and case
     main = first.copy()
-    multi = np.flatnonzero(nseg > 1)
-    if multi.size:
+    if multi.size:            # blocks with roundings: their segments' times too
         segs = _group_members(first[multi], nseg[multi])
-        main[multi] = _group_argmax(profile.segment_times(path, segs), first[multi],
-                                    nseg[multi])
+        times, seg_t = profile.block_and_segment_times(path, segs)
+        main[multi] = _group_argmax(seg_t, first[multi], nseg[multi])
+    else:
+        times = profile.block_times(path) if nb else np.zeros(0)
     mainc = np.clip(main, 0, max(m - 1, 0))
     t_blk = times[np.clip(ids, 0, max(times.size - 1, 0))] if times.size else np.zeros(nb)
     kb = np.clip(first, 0, m)

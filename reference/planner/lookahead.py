@@ -220,17 +220,23 @@ def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
     own = own_cap.tolist()
     lo = elo = ehi = 0.0
     prev = -2
+    merged = []
+    # ``b if b < a else a`` is ``min(a, b)`` and ``b if b > a else a`` is ``max(a, b)``
+    # (the same value, NaN included), without a builtin call per candidate
     for k in idx.tolist():
         if k != prev + 1:
             lo, elo, ehi = cap[k - 1], eff[k - 1], eff[k - 1]
-        new_lo = min(lo, cap[k])
-        new_elo, new_ehi = min(elo, eff[k]), max(ehi, eff[k])
+        c_k, e_k = cap[k], eff[k]
+        new_lo = c_k if c_k < lo else lo
+        new_elo = e_k if e_k < elo else elo
+        new_ehi = e_k if e_k > ehi else ehi
         if own[k] >= new_lo and new_elo >= ratio * new_ehi:
-            merge[k] = True
+            merged.append(k)
             lo, elo, ehi = new_lo, new_elo, new_ehi
         else:
-            lo, elo, ehi = cap[k], eff[k], eff[k]
+            lo, elo, ehi = c_k, e_k, e_k
         prev = k
+    merge[merged] = True
     return merge
 
 

@@ -187,6 +187,17 @@ def _ramp_distance_and_slope(v_lo, v_hi, acc, jerk, knee=None, ratio=None):
     return 0.5 * vs * T, 0.5 * T + 0.5 * vs * dT
 
 
+def _ramp_distance_and_slope_brisk(v_lo, v_hi, acc, jerk):
+    """:func:`_ramp_distance_and_slope` where every ``jerk`` is ``inf`` and every ``acc``
+    finite (BRISK): ``A^2/J = 0``, so every ramp takes the acceleration-limited branch,
+    whose operations these are (the same numbers, without the jerk-limited branch that
+    ``numpy.where`` would compute and discard)."""
+    dv = np.maximum(v_hi - v_lo, 0.0)
+    T = dv / acc + acc / jerk
+    vs = v_lo + v_hi
+    return 0.5 * vs * T, 0.5 * T + 0.5 * vs * (1.0 / acc)
+
+
 def _depressed_cubic_root(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """The real root of ``x^3 + p x + q = 0`` for ``p >= 0``, ``q <= 0`` (one root, >= 0).
 
@@ -241,11 +252,14 @@ def ramp_reach(v, dist, acc, jerk, knee=None, ratio=None) -> np.ndarray:
         return np.where(np.isfinite(knee) & np.isfinite(dist), drive, plain)
     v, dist, acc, jerk = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
                                                for x in (v, dist, acc, jerk)))
-    out = np.full(v.shape, np.inf)
     fin = np.isfinite(dist)
-    if not fin.any():
-        return out
-    v_, d_, a_, j_ = v[fin], np.maximum(dist[fin], 0.0), acc[fin], jerk[fin]
+    every = bool(fin.all())             # then the arrays themselves, not gathered copies
+    if not every and not fin.any():
+        return np.full(v.shape, np.inf)
+    if every:
+        v_, d_, a_, j_ = v, np.maximum(dist, 0.0), acc, jerk
+    else:
+        v_, d_, a_, j_ = v[fin], np.maximum(dist[fin], 0.0), acc[fin], jerk[fin]
     thr = a_ * a_ / j_
     # acceleration-limited: dv^2 + b dv + c = 0 (stable root; c <= 0 in this branch)
     b = 2.0 * v_ + thr
@@ -260,6 +274,9 @@ def ramp_reach(v, dist, acc, jerk, knee=None, ratio=None) -> np.ndarray:
         x = _depressed_cubic_root(2.0 * v_, -d_ * np.sqrt(_finite_j(j_)))
         dv_jerk = x * x
         dv = np.where(jfin & (dv_jerk <= thr), dv_jerk, dv_acc)
+    if every:
+        return np.asarray(v_ + np.maximum(dv, 0.0))
+    out = np.full(v.shape, np.inf)
     out[fin] = v_ + np.maximum(dv, 0.0)
     return out
 
@@ -304,14 +321,24 @@ def solve_peak(v0, v1, length, cap, acc_up, jerk_up, acc_dn, jerk_dn, knee=None,
         knee = np.broadcast_to(np.asarray(knee, dtype=np.float64), v0.shape)
         ratio = np.broadcast_to(np.asarray(ratio, dtype=np.float64), v0.shape)
     kk = (lambda idx: (knee[idx], ratio[idx])) if has_knee else (lambda idx: (None, None))
+    # all BRISK (no jerk limit, no knee): the ramps' acceleration-limited formulas alone
+    brisk = (not has_knee and not np.isfinite(jerk_up).any()
+             and not np.isfinite(jerk_dn).any() and bool(np.isfinite(acc_up).all())
+             and bool(np.isfinite(acc_dn).all()))
     lo = np.maximum(v0, v1)
     hi = np.minimum(cap, np.minimum(ramp_reach(v0, L, acc_up, jerk_up, *kk(slice(None))),
                                     ramp_reach(v1, L, acc_dn, jerk_dn, *kk(slice(None)))))
     hi = np.maximum(hi, lo)
 
     def g_slope(x, idx):
-        d0, s0 = _ramp_distance_and_slope(v0[idx], x, acc_up[idx], jerk_up[idx], *kk(idx))
-        d1, s1 = _ramp_distance_and_slope(v1[idx], x, acc_dn[idx], jerk_dn[idx], *kk(idx))
+        if brisk:
+            d0, s0 = _ramp_distance_and_slope_brisk(v0[idx], x, acc_up[idx], jerk_up[idx])
+            d1, s1 = _ramp_distance_and_slope_brisk(v1[idx], x, acc_dn[idx], jerk_dn[idx])
+        else:
+            d0, s0 = _ramp_distance_and_slope(v0[idx], x, acc_up[idx], jerk_up[idx],
+                                              *kk(idx))
+            d1, s1 = _ramp_distance_and_slope(v1[idx], x, acc_dn[idx], jerk_dn[idx],
+                                              *kk(idx))
         return d0 + d1 - L[idx], s0 + s1
 
     vp = hi.copy()
