@@ -397,6 +397,13 @@ class Verdict:
             lb, ub = c.oracle.lower_bound_s, c.oracle.upper_bound_s
             text += (f"; the oracle ended '{c.oracle.status}' with a bracket "
                      f"UB/LB - 1 = {100 * (ub / lb - 1):.2f} %, so the interval is that wide")
+        if c.gap_lower < 0 and c.reference_report.ok(BOUND_SETS[c.oracle.bounds]):
+            # t_ref < UB while the planner's motion meets every limit of the oracle's set:
+            # that motion is itself a verified upper bound, the oracle's is loose here
+            text += (f"; {who}'s own motion is faster than the oracle's verified one and "
+                     f"meets the same {c.oracle.bounds} limits, so the optimum lies between "
+                     f"the lower bound and {who}'s time: the gap is at least 0, not "
+                     f"{_pct(c.gap_lower)} %")
         return cls(True, "ok", text, max_gap)
 
 

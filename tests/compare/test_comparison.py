@@ -14,6 +14,7 @@ from fakes import FakeSolution, fake_plan, fake_solution, toy_profile
 from optimal import SolveStatus
 from compare.comparison import ComparedBlock, OracleResult, Side, compare, compare_profiles
 from reference.core.causes import normalise_cause
+from reference.core.constraints import BOUND_SETS, check_profile, scale_time
 from reference.core.errors import InternalError
 from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
 
@@ -178,3 +179,28 @@ def test_a_lower_bound_above_an_accepted_profile_is_a_bug_not_a_gap(small):
     # at the bound itself (round-off below it) the claim holds
     ok = FakeSolution(SolveStatus.OPTIMAL, plan.profile, t * (1 + 1e-12), t * 1.01)
     assert compare(plan, ok, program=program).gap_upper == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_planner_faster_than_the_oracles_verified_motion_is_said_so(small, machine):
+    program, path, plan, sol = small
+    # an oracle whose verified motion is slower than the plan (a loose upper bound):
+    # the plan meets the same acc limits, so it is itself a motion of the oracle's set
+    slow = toy_profile(path, machine.limits, 0.35)
+    fake = FakeSolution(SolveStatus.GAP_NOT_MET, slow, 0.9 * plan.profile.duration,
+                        slow.duration)
+    c = compare(plan, fake, program=program)
+    assert plan.report.ok(BOUND_SETS["acc"]) and c.gap_lower < 0 < c.gap_upper
+    v = c.verdict(None)
+    assert v.ok and "meets the same acc limits" in v.text and "at least 0" in v.text
+    # the gap interval of DESIGN 7 is reported as it is
+    assert c.gap_lower == pytest.approx(plan.profile.duration / slow.duration - 1)
+    # when the plan does not meet the oracle's limits (here: too fast for them, its own
+    # check waived), nothing is said
+    prof = scale_time(plan.profile, 0.5)              # twice as fast: over the feed
+    fast = replace(plan, profile=prof, report=check_profile(path, machine.limits, prof))
+    assert not fast.report.ok(BOUND_SETS["acc"])
+    broken = replace(compare(fast, replace(fake, upper_bound_s=10 * fast.profile.duration),
+                             program=program), reference_ratio_tol=1e9)
+    assert broken.gap_lower < 0 and "at least 0" not in broken.verdict(None).text
+    # an upper bound below the plan's time: nothing to say either
+    assert "at least 0" not in compare(plan, sol, program=program).verdict(None).text
