@@ -369,7 +369,9 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
     gap_d = ("t_ref/UB − 1 … t_ref/LB − 1" if c.hold_s <= 0 else
              f"motion times: (t_ref − H)/(UB − H) − 1 … (t_ref − H)/(LB − H) − 1, "
              f"H = {c.hold_s:.4f} s of dwell and exact-stop settle on both sides") + (
-        "" if c.gap_lower_valid else " (lower end: vs. the relaxation)")
+        "" if c.gap_lower_valid else " (lower end: vs. the relaxation)") + (
+        f"; the {w}'s own motion meets the same limits and is faster than the oracle's, "
+        "so the gap is at least 0" if c.certified and c.reference_bounds_optimum else "")
     cards = "".join([
         _card(f"{w} time", f"{c.t_reference_s:.4f} s",
               f"bound set {c.reference_bounds}; {len(c.reference_violations)} violation(s)"),

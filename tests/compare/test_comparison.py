@@ -192,8 +192,12 @@ def test_a_planner_faster_than_the_oracles_verified_motion_is_said_so(small, mac
     assert plan.report.ok(BOUND_SETS["acc"]) and c.gap_lower < 0 < c.gap_upper
     v = c.verdict(None)
     assert v.ok and "meets the same acc limits" in v.text and "at least 0" in v.text
-    # the gap interval of DESIGN 7 is reported as it is
+    assert v.text.startswith(f"the heuristic is 0.0 – {100 * c.gap_upper:.1f} % slower")
+    # the gap interval of DESIGN 7 is reported as it is, the report says why it is >= 0
     assert c.gap_lower == pytest.approx(plan.profile.duration / slow.duration - 1)
+    assert c.reference_bounds_optimum
+    from compare.report_html import render_report
+    assert "so the gap is at least 0" in render_report(c)
     # when the plan does not meet the oracle's limits (here: too fast for them, its own
     # check waived), nothing is said
     prof = scale_time(plan.profile, 0.5)              # twice as fast: over the feed
@@ -202,5 +206,6 @@ def test_a_planner_faster_than_the_oracles_verified_motion_is_said_so(small, mac
     broken = replace(compare(fast, replace(fake, upper_bound_s=10 * fast.profile.duration),
                              program=program), reference_ratio_tol=1e9)
     assert broken.gap_lower < 0 and "at least 0" not in broken.verdict(None).text
+    assert not broken.reference_bounds_optimum
     # an upper bound below the plan's time: nothing to say either
     assert "at least 0" not in compare(plan, sol, program=program).verdict(None).text
