@@ -122,19 +122,22 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     # for each, so that the filtered motion keeps them where it arrives)
     sub_lim = limits.for_axes(work.axes)
     T_max = float(np.max(segment_periods(work, sub_lim), initial=0.0))
-    for W in (candidate_windows(work, sub_lim, T_max, base == "jerk") if T_max > 0 else ()):
-        try:
-            u = eroded_plans(path, limits, T_max, W, base == "jerk")
-        except ProfileError:
-            # the eroded caps leave an interval at zero speed at both ends (cannot be
-            # crossed): no candidate from this construction
-            continue
-        prof = fir_filtered(path, limits, u.profile, base == "jerk", u.rest_breaks,
-                            window_s=W) if W > 0 else u.profile
-        label = f"fir {W * 1e3:.3g} ms (eroded caps)" if W > 0 else "adapted caps"
-        c = verified(label, path, limits, prof, name, u.rest_breaks)
-        if c is not None:
-            cands.append(c)
+    jerk = base == "jerk"
+    for W in (candidate_windows(work, sub_lim, T_max, jerk) if T_max > 0 else ()):
+        for reach in ((False, True) if jerk and W > 0 else (False,)):
+            try:
+                u = eroded_plans(path, limits, T_max, W, jerk, reach)
+            except ProfileError:
+                # the eroded caps leave an interval at zero speed at both ends (cannot
+                # be crossed): no candidate from this construction
+                continue
+            prof = fir_filtered(path, limits, u.profile, jerk, u.rest_breaks,
+                                window_s=W) if W > 0 else u.profile
+            label = (f"fir {W * 1e3:.3g} ms (eroded caps{', jerk reach' if reach else ''})"
+                     if W > 0 else "adapted caps")
+            c = verified(label, path, limits, prof, name, u.rest_breaks)
+            if c is not None:
+                cands.append(c)
     t_check = time.perf_counter() - tc
     inner = (base_sol,) if acc is base_sol else (base_sol, acc)
     common = dict(grid=base_sol.grid, grid_points=base_sol.grid_points, iterations=base_sol.iterations,

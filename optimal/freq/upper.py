@@ -32,8 +32,10 @@ whatever the candidate was). The faster accepted one is the upper bound.
    phases stretched as the control's adaptation does (to ``1/f - W``: the filter adds
    ``W``); then filtered. ``jerk+freq`` tries a few windows
    (:func:`candidate_windows`: the filter also spreads every acceleration step into a
-   jerk-limited ramp); ``acc+freq`` also the motion itself, unfiltered and not eroded,
-   its phases stretched to the full ``1/f``, which is the closest to the acc optimum.
+   jerk-limited ramp), with u's acceleration kept to the jerk room the curvature terms
+   leave (at each interval, or over the distance the filter lags behind);
+   ``acc+freq`` also the motion itself, unfiltered and not eroded, its phases stretched
+   to the full ``1/f``, which is the closest to the acc optimum.
    They win on paths with corners and arcs, where the filtered optimum overshoots.
 
 Every candidate is slowed down per rest-to-rest piece (:func:`verified`) until the
@@ -411,7 +413,7 @@ def window_caps(s: np.ndarray, cap: np.ndarray, window_s: float) -> np.ndarray:
 #: a reversal twice that); the longest ``1/f`` is tried too. No window is best on every
 #: program (a longer one costs more at each cap, a shorter one more time scaling for
 #: the jerk), so each is a candidate.
-JERK_WINDOW_MULTIPLES = (1.0, 1.5, 2.0)
+JERK_WINDOW_MULTIPLES = (1.0, 2.0)
 
 
 def candidate_windows(work: Path, lim, period_s: float, jerk_limited: bool) -> tuple[float, ...]:
@@ -464,7 +466,7 @@ def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
 
 
 def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: float,
-                 jerk_limited: bool) -> ErodedPlan:
+                 jerk_limited: bool, jerk_reach: bool = False) -> ErodedPlan:
     """A motion whose moving average keeps every speed cap *where it arrives*: the input
     of the FIR candidate on paths with corners and curves.
 
@@ -493,7 +495,14 @@ def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: f
         (``acc+freq``): ``u`` is the candidate itself, not eroded, its phases stretched to
         the full ``1/f``.
     jerk_limited : bool
-        Cap the speed at curvature jumps as the jerk set does (``jerk+freq``).
+        Cap the speed at curvature jumps as the jerk set does (``jerk+freq``), and keep
+        u's tangential acceleration to what leaves every axis its jerk limit after the
+        filter (``a / W`` plus the curvature terms of the axis jerk).
+    jerk_reach : bool
+        Take that jerk room as the least over the intervals the filtered motion may lag
+        behind (u's speed times ``W``): needed where u accelerates hard just after a
+        curve, costly on long curves; the oracle tries both.
+
     Returns
     -------
     ErodedPlan
@@ -548,13 +557,35 @@ def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: f
     floor = ERODED_MIN_ACCEL_SHARE * float(np.min(lim.a_max))
     ds_n = np.diff(grid.s)
 
+    if jerk_limited and W > 0:
+        # the third derivative of the path at the interval middles, for the jerk room;
+        # the filtered motion lags u by up to W times u's speed (at most the eroded cap
+        # there): with jerk_reach each interval takes the least room of those that close
+        mid = 0.5 * (grid.s[:-1] + grid.s[1:])
+        _, _, _, d3 = free.evaluate(mid, segment=grid.segment)
+        d1, d2 = 0.5 * (np.abs(dq0) + np.abs(dq1)), 0.5 * (np.abs(ddq0) + np.abs(ddq1))
+        reach = W * np.sqrt(np.maximum(np.maximum(b[:-1], b[1:]), 0.0)) if jerk_reach \
+            else np.zeros(mid.size)
+        near_lo = np.searchsorted(mid, mid - reach, side="left")
+        near_hi = np.searchsorted(mid, mid + reach, side="right")
+
     def steps(b_at: np.ndarray) -> np.ndarray:
         with np.errstate(divide="ignore", invalid="ignore"):
             rem0 = (lim.a_max[None, :] - np.abs(ddq0) * b_at[:-1, None]) / np.abs(dq0)
             rem1 = (lim.a_max[None, :] - np.abs(ddq1) * b_at[1:, None]) / np.abs(dq1)
         rem0 = np.where(np.abs(dq0) > 0, rem0, np.inf).min(axis=1)
         rem1 = np.where(np.abs(dq1) > 0, rem1, np.inf).min(axis=1)
-        return 2.0 * np.maximum(np.minimum(rem0, rem1), floor) * ds_n
+        a_t = np.minimum(rem0, rem1)
+        if jerk_limited and W > 0:
+            # the filter turns a step of u's acceleration a into the path jerk a / W; on
+            # a curve the axis jerk (q' s''' + 3 q'' s' s'' + q''' s'^3) also carries the
+            # other two terms: a is kept to what leaves each axis its jerk limit
+            v = np.sqrt(np.maximum(np.maximum(b_at[:-1], b_at[1:]), 0.0))[:, None]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                room = (lim.j_max[None, :] - np.abs(d3) * v ** 3) / (d1 / W + 3.0 * d2 * v)
+            room = np.where(d1 + d2 > 0, room, np.inf).min(axis=1)
+            a_t = np.minimum(a_t, _window_min(room, near_lo, near_hi))
+        return 2.0 * np.maximum(a_t, floor) * ds_n
 
     b_eroded = b
     step = steps(b_eroded)

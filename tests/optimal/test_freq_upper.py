@@ -93,3 +93,30 @@ def test_window_caps_keep_every_cap_after_the_moving_average(seed):
     assert np.all(u_cap <= cap)
     # sampling: two samples of 2e-5 s around each crossing, at most 2000 mm/s^2 apart
     np.testing.assert_array_less(v_at, c_at + 2000.0 * 2e-5 * 2 + 1e-9)
+
+
+@pytest.mark.parametrize("radius", [5.0, 10.0, 30.0])
+def test_filtered_motion_with_jerk_reach_keeps_the_axis_jerk_on_a_curve(radius):
+    # eroded_plans keeps u's acceleration to the jerk room the curvature terms leave,
+    # over the distance the filter lags behind: the filtered motion on a half circle
+    # (rest to rest, no curvature jump) keeps every axis' jerk, measured here by third
+    # differences of the axis positions sampled every 0.2 ms (not by the checker)
+    import sys
+    from pathlib import Path as FsPath
+    sys.path.insert(0, str(FsPath(__file__).parent))
+    from oracle_cases import semicircle
+    from optimal.freq.lower import segment_periods
+    from optimal.freq.upper import candidate_windows, eroded_plans, fir_filtered
+    from reference.machine import load_machine
+
+    m = load_machine(None)
+    path = semicircle(radius, feed=100.0)
+    lim = m.limits.for_axes(path.axes)
+    T = float(np.max(segment_periods(path, lim)))
+    for W in candidate_windows(path, lim, T, True):
+        u = eroded_plans(path, m.limits, T, W, True, jerk_reach=True)
+        p = fir_filtered(path, m.limits, u.profile, True, u.rest_breaks, window_s=W)
+        dt = 2e-4
+        s, _, _, _ = p.state(np.arange(0.0, p.duration, dt))
+        jerk = np.diff(path.evaluate(s)[0], 3, axis=0) / dt ** 3
+        assert np.all(np.max(np.abs(jerk), axis=0) <= lim.j_max * (1 + 1e-3))
