@@ -57,7 +57,7 @@ from reference.core.tolerances import RATIO_TOL, ROUNDOFF_MARGIN_REL
 from reference.prepare import prepare, restrict_to_machine
 
 from .causes import derive_causes, stretch_causes
-from .inserted import inserted_pieces, stretch_motion
+from .inserted import inserted_splits, stretch_motion
 from .result import (GAP_ABS_TOL_S, INSERTED_KINDS, ComparedBlock, Comparison, OracleResult,
                      Side, Verdict, block_span, describe_violation, format_interval)
 
@@ -108,16 +108,15 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
     the span (a rounding always is) ends the block's own piece: its exit speed is the
     inserted piece's entry speed and its peak is measured on the stretch before it.
     """
-    found = inserted_pieces(path)
-    if not found:
+    splits = inserted_splits(path)
+    if not splits:
         return {}
     spans = path.blocks
-    order = sorted(found)
-    runs = np.concatenate([found[i] for i in order])             # (R, 2) first, last
+    runs = np.concatenate([sp.runs for sp in splits])            # (R, 2) first, last
     sb = path.s_breaks
     # the block's own stretch before its first inserted block, then each inserted one
-    own0 = np.array([spans[i].s_start for i in order])
-    own1 = np.array([sb[found[i][0, 0]] for i in order])
+    own0 = np.array([spans[sp.span].s_start for sp in splits])
+    own1 = np.array([sb[sp.runs[0, 0]] for sp in splits])
     ins0, ins1 = sb[runs[:, 0]], sb[runs[:, 1] + 1]
 
     def measure(prof: Profile | None, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
@@ -128,43 +127,38 @@ def _split_inserted(path: Path, limits: MachineLimits, ref_prof: Profile,
 
     has_own = own1 > own0
     ins_r, ins_o = measure(ref_prof, ins0, ins1), measure(opt_prof, ins0, ins1)
-    own_r = np.full((len(order), 4), math.nan)
-    own_o = np.full((len(order), 4), math.nan)
+    own_r = np.full((len(splits), 4), math.nan)
+    own_o = np.full((len(splits), 4), math.nan)
     own_r[has_own] = measure(ref_prof, own0[has_own], own1[has_own])
     own_o[has_own] = measure(opt_prof, own0[has_own], own1[has_own])
     cause_r = stretch_causes(path, limits, ref_prof, ins0, ins1, jerk_ref)
     cause_o = (stretch_causes(path, limits, opt_prof, ins0, ins1, jerk_opt)
                if opt_prof is not None else ["-"] * runs.shape[0])
-    table = path.rounding
     lines = {sp.block: sp.line for sp in spans}
-    corner_of: dict[int, tuple[int, int]] = {}
-    if table is not None:
-        for k in np.flatnonzero(table.inserted):
-            corner_of[int(table.block[k])] = (lines.get(int(table.block[k]), 0),
-                                               lines.get(int(table.next_block[k]), 0))
     kinds = KIND_CODES
     out = {}
     pos = 0
-    for n, i in enumerate(order):
-        ks = found[i]
+    for n, split in enumerate(splits):
+        i, ks, tail = split.span, split.runs, split.tail
         nk = ks.shape[0]
         rows_r, rows_o = ins_r[pos:pos + nk], ins_o[pos:pos + nk]
         cr, co = cause_r[pos:pos + nk], cause_o[pos:pos + nk]
         pos += nk
         sp = spans[i]
-        tail = bool(ks[-1, 1] == sp.first_segment + sp.n_segments - 1 and nk == 1)
+        corner_here = (tuple(lines.get(b, 0) for b in split.corner_blocks)
+                       if split.corner_blocks is not None else (sp.line, sp.line))
+        ins_len = split.inserted_length
 
-        def make(base, ks=ks, rows_r=rows_r, rows_o=rows_o, n=n, sp=sp, tail=tail, cr=cr,
-                 co=co):
+        # every per-span value bound now: make runs after the loop has moved on
+        def make(base, ks=ks, nk=nk, rows_r=rows_r, rows_o=rows_o, n=n, tail=tail, cr=cr,
+                 co=co, corner_here=corner_here, ins_len=ins_len):
             kind, corner, line, source, s_start, length, stop, hold, mr, mo, lr, lo = base
-            ins_len = float(sum(sb[b + 1] - sb[a] for a, b in ks.tolist()))
             own = []
             for whole, part, own_part in ((mr, rows_r, own_r[n]), (mo, rows_o, own_o[n])):
                 t = whole[0] - float(np.nansum(part[:, 0]))
                 exit_ = part[0, 1] if tail else whole[2]
                 peak = own_part[3] if tail and has_own[n] else whole[3]
                 own.append((t, whole[1], float(exit_), float(peak)))
-            corner_here = corner_of.get(sp.block, (sp.line, sp.line))
             pieces = [(kind, corner, line, source, s_start, length - ins_len,
                        "" if tail else stop, hold, own[0], own[1], lr, lo)]
             for j, (k, k_end) in enumerate(ks.tolist()):

@@ -14,6 +14,6 @@ same way.
 
 from __future__ import annotations
 
-from reference.core.rows import inserted_pieces, stretch_motion
+from reference.core.rows import inserted_pieces, inserted_splits, stretch_motion
 
-__all__ = ["inserted_pieces", "stretch_motion"]
+__all__ = ["inserted_pieces", "inserted_splits", "stretch_motion"]

@@ -199,6 +199,57 @@ def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
     return runs
 
 
+@dataclass(frozen=True, slots=True)
+class InsertedSplit:
+    """How one program block's span splits into its own stretch and its inserted blocks
+    (:func:`inserted_splits`).
+
+    Attributes
+    ----------
+    span : int
+        Index into ``path.blocks``.
+    runs : numpy.ndarray of int64, shape (r, 2)
+        First and last segment of each inserted block (:func:`inserted_pieces`).
+    corner_blocks : tuple of int or None
+        Program blocks before and after the corner the insertion replaces (the rounding
+        table's ``block``, ``next_block``), ``None`` without a rounding table entry.
+    tail : bool
+        One inserted block that ends the span: it ends the block's own stretch too.
+    inserted_length : float
+        Length of the inserted blocks, mm.
+    """
+
+    span: int
+    runs: np.ndarray
+    corner_blocks: tuple[int, int] | None
+    tail: bool
+    inserted_length: float
+
+
+def inserted_splits(path: Path) -> list[InsertedSplit]:
+    """Every span holding inserted blocks and how it splits, in span order: the one
+    layout ``feedoracle plan``'s rows and the comparison's rows are both cut by.
+    """
+    found = inserted_pieces(path)
+    if not found:
+        return []
+    spans, sb = path.blocks, path.s_breaks
+    corner: dict[int, tuple[int, int]] = {}
+    table = path.rounding
+    if table is not None:
+        for k in np.flatnonzero(table.inserted).tolist():
+            corner[int(table.block[k])] = (int(table.block[k]), int(table.next_block[k]))
+    out = []
+    for i in sorted(found):
+        ks = found[i]
+        last = int(spans.first_segment[i] + spans.n_segments[i] - 1)
+        out.append(InsertedSplit(
+            span=i, runs=ks, corner_blocks=corner.get(int(spans.block[i])),
+            tail=bool(ks.shape[0] == 1 and ks[-1, 1] == last),
+            inserted_length=float(np.sum(sb[ks[:, 1] + 1] - sb[ks[:, 0]]))))
+    return out
+
+
 def stretch_motion(profile: Profile, s0: np.ndarray, s1: np.ndarray) -> BlockMotion:
     """Time, entry, exit and peak speed of a profile on disjoint path stretches.
 

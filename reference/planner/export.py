@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.constraints import BOUND_SETS
 from ..core.geometry import KIND_CODES
-from ..core.rows import inserted_pieces, stretch_motion
+from ..core.rows import inserted_splits, stretch_motion
 from . import causes as C
 from .result import ReferencePlan
 
@@ -113,43 +113,35 @@ def _inserted_rows(plan: ReferencePlan) -> dict[int, tuple[dict, list[dict]]]:
     length and time, so the rows still sum to the plan's duration.
     """
     path = plan.path
-    found = inserted_pieces(path)
-    if not found:
+    splits = inserted_splits(path)
+    if not splits:
         return {}
     spans = path.blocks
-    order = sorted(found)
-    runs = np.concatenate([found[i] for i in order])            # (R, 2) first, last
+    runs = np.concatenate([sp.runs for sp in splits])            # (R, 2) first, last
     sb = path.s_breaks
     s0, s1 = sb[runs[:, 0]], sb[runs[:, 1] + 1]
     mot = stretch_motion(plan.profile, s0, s1)
     cause = (plan.segment_cause[runs[:, 0]] if plan.segment_cause is not None
              else np.full(runs.shape[0], -1))
-    corner = {}
-    table = path.rounding
-    if table is not None:
-        line_of = dict(zip(spans.block.tolist(), spans.line.tolist()))
-        for k in np.flatnonzero(table.inserted).tolist():
-            corner[int(table.block[k])] = [max(1, line_of.get(int(table.block[k]), 1)),
-                                           max(1, line_of.get(int(table.next_block[k]), 1))]
+    line_of = dict(zip(spans.block.tolist(), spans.line.tolist()))
     t_blk = np.asarray(plan.blocks.column("time_s"), dtype=np.float64)
     out = {}
     pos = 0
-    for i in order:
-        ks = found[i]
+    for sp in splits:
+        i, ks, tail = sp.span, sp.runs, sp.tail
         nk = ks.shape[0]
         sl = slice(pos, pos + nk)
         pos += nk
         blk, line = int(spans.block[i]), max(1, int(spans.line[i]))
         lengths = sb[ks[:, 1] + 1] - sb[ks[:, 0]]
         times = mot.time_s[sl]
-        tail = bool(ks[-1, 1] == spans.first_segment[i] + spans.n_segments[i] - 1
-                    and nk == 1)
         own = {"length_mm": max(0.0, float(spans.s_end[i] - spans.s_start[i]
-                                           - lengths.sum())),
+                                           - sp.inserted_length)),
                "t_reference_s": max(0.0, float(t_blk[i] - times.sum()))}
         if tail:
             own["v_exit_reference"] = max(0.0, float(mot.v_entry[sl][0]))
-        lines = corner.get(blk, [line, line])
+        lines = ([max(1, line_of.get(b, 1)) for b in sp.corner_blocks]
+                 if sp.corner_blocks is not None else [line, line])
         rows = [{"block": blk, "line": lines[0], "label": "",
                  "kind": KIND_CODES[int(path.kind[a])], "length_mm": float(ln),
                  "t_reference_s": max(0.0, float(t)), "v_exit_reference": max(0.0, float(v)),
