@@ -449,8 +449,9 @@ def fillet_radius_for_deviation(e: np.ndarray, t: np.ndarray, centre: np.ndarray
     = iota |iota n + u0|^2 / 2``, without cancellation). Squared: ``P^2 r^2 + 2 (P Q -
     q^2 e) r + Q^2 - q^2 e^2 = 0`` with ``P = p + e / R``, ``Q = e^2 / (2 R)``, ``q =
     t.u0``; the root that tends to the line-line ``e cos(theta/2) / (1 - cos(theta/2))``
-    as ``R`` grows is taken. Exact for the contour deviation; a start (checked by the
-    full fillet) where the per-axis deviations decide.
+    as ``R`` grows is taken. Exact for the contour deviation (squaring may give the
+    mirrored branch's root, ``x > 0``: 1 of 192 seeded corners); a start (checked by
+    the full fillet) for the tolerance search.
     """
     n, iota = _corner_frame(t, centre, radius, sense)
     u0 = -centre / radius[:, None]
