@@ -63,10 +63,11 @@ from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
-from .core.rounding import (REASON_CODE, circle_circle_fillet, circle_fillet_deviation,
+from .core.rounding import (REASON_CODE, axis_deviation_limit, circle_circle_fillet,
+                            circle_fillet_deviation, circle_fillet_radius_for_deviation,
                             circle_fillet_radius_within, fillet_deviation,
-                            fillet_radius_for_arc_trim, fillet_radius_for_line_trim,
-                            line_circle_fillet)
+                            fillet_radius_for_arc_trim, fillet_radius_for_deviation,
+                            fillet_radius_for_line_trim, line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
@@ -94,6 +95,14 @@ R_MAX_MM = 1e7
 ROOT_XATOL = 1e-11
 #: Secant steps in ``log r`` before the bracketed search (tolerance modes).
 SECANT_STEPS = 5
+#: ``|log ratio|`` at which a secant search in ``log r`` stops: the slope there is about
+#: 1 (0.75..1.3 on the seeded corners), so the root is within about ROOT_XATOL / 8 and
+#: the final step half ROOT_XATOL inside keeps the radius within ROOT_XATOL of it (each
+#: result checked: ``-2 ROOT_XATOL <= ratio <= 0``, else a later stage).
+SETTLED = ROOT_XATOL / 8.0
+#: A closed-form start is used where it lies at least this far below the clamp in
+#: ``log r`` (relative 1e-6): there the clamp does not bind and its ratio is not needed.
+GUESS_BELOW_CAP = 1e-6
 #: ``log`` of the tolerance ratio where the fillet does not exist (larger radii): far
 #: above 0, so the root search stays below it.
 NO_FILLET_LOG_RATIO = 50.0
@@ -242,7 +251,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
-            targets["dyn_length"][i])
+            targets["dyn_length"][i], t1[i], t2[i])
         clamped[i] = ro >= r_cap
         f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
         r[i] = ro
@@ -417,13 +426,15 @@ class _Fillet:
 class _Family:
     """A kind of arc corner (line-circle, circle-circle): its fillet of radius ``r``
     and the closed-form radii that replace a given length of the first or the second
-    element, all from the same 1-d geometry columns (as
-    :func:`scipy.optimize.elementwise.find_root` passes them)."""
+    element, its deviation ``C - M`` and the closed-form radius of a given contour
+    deviation (the tolerance search's start), all from the same 1-d geometry columns
+    (as :func:`scipy.optimize.elementwise.find_root` passes them)."""
 
     fillet: Callable
     r_first: Callable
     r_second: Callable
     deviation: Callable
+    r_deviation: Callable
 
 
 def _lc(cols):
@@ -464,12 +475,14 @@ _LINE_CIRCLE = _Family(
     fillet=_lc_fillet,
     r_first=lambda trim, *cols: fillet_radius_for_line_trim(trim, *_lc(cols)),
     r_second=lambda trim, *cols: fillet_radius_for_arc_trim(trim, *_lc(cols)),
-    deviation=lambda r, *cols: fillet_deviation(r, *_lc(cols)))
+    deviation=lambda r, *cols: fillet_deviation(r, *_lc(cols)),
+    r_deviation=lambda e, *cols: fillet_radius_for_deviation(e, *_lc(cols)))
 _CIRCLE_CIRCLE = _Family(
     fillet=_cc_fillet,
     r_first=lambda trim, *cols: circle_fillet_radius_within(trim, *_cc(cols)),
     r_second=_cc_r_second,
-    deviation=lambda r, *cols: circle_fillet_deviation(r, *_cc(cols)))
+    deviation=lambda r, *cols: circle_fillet_deviation(r, *_cc(cols)),
+    r_deviation=lambda e, *cols: circle_fillet_radius_for_deviation(e, *_cc(cols)))
 
 
 def _empty_fillet(k: int) -> _Fillet:
@@ -488,25 +501,35 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                     rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
                     cap_second: np.ndarray, dyn_radius: np.ndarray,
-                    dyn_length: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    dyn_length: np.ndarray, t1: np.ndarray,
+                    t2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
     dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
     and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
-    the tolerance holds at the radius found (True where no tolerance applies)."""
+    the tolerance holds at the radius found (True where no tolerance applies).
+    ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
+    start)."""
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
+    # (ADIS only where it applies; both lengths of a side in one call: the same
+    # elementwise numbers, half the calls)
+    k = how.size
+    adis = np.flatnonzero(how == HOW_ADIS)
+    both = np.concatenate((np.arange(k), adis))
+    cb = tuple(col[both] for col in cols)
     with np.errstate(invalid="ignore"):
-        r_cap = np.fmin(_positive(fam.r_first(cap_first, *cols)),
-                        _positive(fam.r_second(cap_second, *cols)))
-        r_adis = np.fmin(_positive(fam.r_first(dist, *cols)),
-                         _positive(fam.r_second(dist, *cols)))
-    r_cap *= 1.0 - CLOSED_FORM_MARGIN
-    r_adis *= 1.0 - CLOSED_FORM_MARGIN
+        r_both = np.fmin(
+            _positive(fam.r_first(np.concatenate((cap_first, dist[adis])), *cb)),
+            _positive(fam.r_second(np.concatenate((cap_second, dist[adis])), *cb)))
+    r_both *= 1.0 - CLOSED_FORM_MARGIN
+    r_cap = r_both[:k]
+    r_adis = np.full(k, np.inf)
+    r_adis[adis] = r_both[k:]
     ro = np.select([how == HOW_ADIS, how == HOW_RADIUS], [r_adis, rad], np.inf)
     ro = np.fmin(ro, r_cap)
-    tol_ok = np.ones(how.size, bool)
+    tol_ok = np.ones(k, bool)
     # tolerances: the root of log(ratio) in log r below the clamp (the deviation
     # grows with r), bracketed (Chandrupatla's method, scipy)
     tl = np.flatnonzero(how == HOW_TOL)
@@ -519,8 +542,16 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
         def ratio(x, *c):
             return _log_tol_ratio(x, *c, n_axes=n_ax, n_geo=n_geo, dev_fn=fam.deviation)
 
-        ro[tl] = _tolerance_radius(ratio, tc, r_cap[tl])
-        tol_ok[tl] = ratio(np.log(np.where(ro[tl] > 0, ro[tl], 1.0)), *tc) <= 0.0
+        # the start: the radius of the contour deviation that the tolerances allow in
+        # the direction C - M of the line-line corner between the tangents (where the
+        # contour tolerance decides and M lies on the radius towards C, the root)
+        e = np.fmin(cont[tl] * g0[tl], axis_deviation_limit(t1[tl], t2[tl],
+                                                              tol[tl] * g0[tl, None]))
+        ro[tl], f_ro = _tolerance_radius(ratio, tc, r_cap[tl],
+                                         fam.r_deviation(e, *(col[tl] for col in cols)))
+        # where no radius was found (0, or no clamp and the whole family within) the
+        # corner is too small anyway
+        tol_ok[tl] = f_ro <= 0.0
     # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
     # about like r: the same search, the largest r not longer), at least dyn_radius,
     # then clamped
@@ -532,52 +563,115 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
         def too_long(x, *c):
             return _log_length_ratio(x, *c, n_geo=n_geo, fillet=fam.fillet)
 
-        r_len = _tolerance_radius(too_long, dc, r_cap[dy])
+        r_len = _tolerance_radius(too_long, dc, r_cap[dy])[0]
         ro[dy] = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
     ro = np.where(np.isfinite(ro), ro, 0.0)
     return ro, r_cap, tol_ok
 
 
-def _tolerance_radius(ratio: Callable, cols: tuple, r_cap: np.ndarray) -> np.ndarray:
+def _tolerance_radius(ratio: Callable, cols: tuple, r_cap: np.ndarray,
+                      r_guess: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The largest radius at most ``r_cap`` whose ``ratio`` (``log`` of the largest
-    tolerance ratio, growing with ``log r``) is not above 0, mm, shape (k,) (0: none).
+    tolerance ratio, growing with ``log r``) is not above 0, mm, shape (k,) (0: none),
+    and ``ratio`` at the log of that radius (``nan`` where the radius is 0 or not
+    finite).
 
     The deviation grows about like ``r``, so ``ratio`` is nearly linear in ``log r``:
-    secant steps from the clamp reach the root to round-off in a few steps; kept where
-    they end inside the tolerance and within ROOT_XATOL of the root, the others go to
-    the bracketed search (Chandrupatla's method, scipy).
+    secant steps (:func:`_secant_root`) reach the root in a few steps; a radius is kept
+    where they end inside the tolerance and within ROOT_XATOL of the root. They start
+    from ``r_guess`` where it is clearly below the clamp (the closed form for the
+    contour deviation: where it decides, the root itself); else from the clamp (whose
+    ratio decides whether the clamp binds). Far above the root (no clamp: the search
+    starts at R_MAX_MM) the deviation may level off (both arcs curving away from the
+    fillet), where the secant crawls: those start again from R_MIN_MM, where every
+    fillet is as small as a line-line one and ``ratio`` has slope 1, so the first step
+    lands near the root. Any left go to the bracketed search (Chandrupatla's method,
+    scipy). Only the corners still moving are evaluated.
     """
-    ro = np.zeros(r_cap.size)
+    k = r_cap.size
     hi = np.log(np.where(np.isfinite(r_cap), r_cap, R_MAX_MM))
-    lo = np.full(r_cap.size, np.log(R_MIN_MM))
-    f_hi = ratio(hi, *cols)
-    top = f_hi <= 0.0
-    ro = np.where(top, r_cap, 0.0)
-    ok = np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top
-    x0, f0 = hi, np.where(ok, f_hi, 1.0)
-    x = np.where(ok, hi - f0, hi)
-    f_x = ratio(x, *cols)
-    for _ in range(SECANT_STEPS):
+    ro = np.zeros(k)
+    f_ro = np.full(k, np.nan)
+    done = np.zeros(k, bool)
+    # 0. from the guess, where it lies clearly below the clamp (then, the ratio growing
+    # with r, the clamp does not bind)
+    if r_guess is not None:
         with np.errstate(divide="ignore", invalid="ignore"):
-            slope = (f_x - f0) / (x - x0)
-        move = ok & np.isfinite(slope) & (slope > 0) & (f_x != 0.0)
-        x0, f0 = x, f_x
-        x = np.where(move, np.minimum(x - f_x / np.where(move, slope, 1.0), hi), x)
-        f_x = np.where(move, ratio(x, *cols), f_x)
-    # half ROOT_XATOL inside the tolerance: r = exp(x) and log(r) differ by round-off,
-    # which must not carry the kept radius across the limit
-    x = x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0
-    f_x = ratio(x, *cols)
-    done = ok & (f_x <= 0.0) & (f_x >= -2.0 * ROOT_XATOL)
-    ro[done] = np.exp(x[done])
-    sol = np.flatnonzero(~top & ~done & (ratio(lo, *cols) < 0.0))
+            x_g = np.log(r_guess)
+        start = np.flatnonzero((r_guess > R_MIN_MM) & (x_g < hi - GUESS_BELOW_CAP))
+        if start.size:
+            sc = tuple(c[start] for c in cols)
+            r, f = _secant_root(ratio, sc, x_g[start], ratio(x_g[start], *sc), hi[start])
+            ok = (f <= 0.0) & (f >= -2.0 * ROOT_XATOL)
+            ro[start[ok]], f_ro[start[ok]], done[start[ok]] = r[ok], f[ok], True
+    # 1. from the clamp: where it is within the tolerance, it is the radius
+    rest = np.flatnonzero(~done)
+    f_hi = ratio(hi[rest], *(c[rest] for c in cols)) if rest.size else np.zeros(0)
+    top = f_hi <= 0.0
+    ro[rest[top]] = r_cap[rest[top]]
+    f_ro[rest[top]] = np.where(np.isfinite(r_cap[rest[top]]), f_hi[top], np.nan)
+    done[rest[top]] = True
+    start = rest[np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top]
+    x0, f0 = hi[start], f_hi[np.isfinite(f_hi) & (f_hi < NO_FILLET_LOG_RATIO) & ~top]
+    # 2. the others from R_MIN_MM, where the root is bracketed (ratio below 0 there)
+    for stage in (1, 2):
+        if stage == 2:
+            rest = np.flatnonzero(~done)
+            x_lo = np.full(rest.size, np.log(R_MIN_MM))
+            f_lo = ratio(x_lo, *(c[rest] for c in cols))
+            below = f_lo < 0.0
+            start, x0, f0 = rest[below], x_lo[below], f_lo[below]
+        if not start.size:
+            continue
+        r, f = _secant_root(ratio, tuple(c[start] for c in cols), x0, f0, hi[start])
+        ok = (f <= 0.0) & (f >= -2.0 * ROOT_XATOL)
+        ro[start[ok]], f_ro[start[ok]], done[start[ok]] = r[ok], f[ok], True
+    sol = np.flatnonzero(~done)
     if sol.size:
-        res = find_root(ratio, (lo[sol], hi[sol]), args=tuple(c[sol] for c in cols),
+        sc = tuple(c[sol] for c in cols)
+        sol = sol[ratio(np.full(sol.size, np.log(R_MIN_MM)), *sc) < 0.0]
+    if sol.size:
+        sc = tuple(c[sol] for c in cols)
+        res = find_root(ratio, (np.full(sol.size, np.log(R_MIN_MM)), hi[sol]), args=sc,
                         tolerances={"xatol": ROOT_XATOL, "xrtol": 0.0})
         # the bracket's lower end keeps f <= 0: within the tolerance (half ROOT_XATOL
         # further inside, as above)
         ro[sol] = np.exp(res.bracket[0] - ROOT_XATOL / 2.0)
-    return ro
+        f_ro[sol] = ratio(np.log(ro[sol]), *sc)
+    return ro, f_ro
+
+
+def _secant_root(ratio: Callable, cols: tuple, x0: np.ndarray, f0: np.ndarray,
+                 hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Secant steps on ``ratio`` in ``x = log r`` from ``(x0, f0)``, the first with
+    slope 1, never above ``hi``, at most SECANT_STEPS more; a corner stops once
+    ``|ratio| <= SETTLED`` or when its step is not downhill-finite (0/0: it stopped
+    moving); each step evaluates only the corners still moving. Then half ROOT_XATOL
+    inside the tolerance (``r = exp(x)`` and ``log r`` differ by round-off, which must
+    not carry the kept radius across the limit). Returns ``r`` and ``ratio(log r)``,
+    shape (k,) each."""
+    x, f_x = x0.copy(), f0.copy()
+    xp, fp = x.copy(), f_x.copy()
+    act = np.flatnonzero(~(np.abs(f_x) <= SETTLED))
+    if act.size:
+        x[act] = np.minimum(x[act] - f_x[act], hi[act])
+        f_x[act] = ratio(x[act], *(c[act] for c in cols))
+        act = act[~(np.abs(f_x[act]) <= SETTLED)]
+    for _ in range(SECANT_STEPS):
+        if not act.size:
+            break
+        xa, fa = x[act], f_x[act]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = (fa - fp[act]) / (xa - xp[act])
+        move = np.isfinite(slope) & (slope > 0)
+        xp[act], fp[act] = xa, fa
+        act = act[move]
+        x[act] = np.minimum(xa[move] - fa[move] / slope[move], hi[act])
+        f_x[act] = ratio(x[act], *(c[act] for c in cols))
+        act = act[~(np.abs(f_x[act]) <= SETTLED)]
+    r = np.exp(x - np.maximum(f_x, 0.0) - ROOT_XATOL / 2.0)
+    with np.errstate(divide="ignore"):               # r = 0: f = ratio(-inf), not kept
+        return r, ratio(np.log(r), *cols)
 
 
 def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,

@@ -429,6 +429,72 @@ def fillet_deviation(r: np.ndarray, t: np.ndarray, centre: np.ndarray,
     return dev, (disc >= 0) & (x < 0) & (rho > 0) & np.isfinite(x)
 
 
+def _small_root(a2: np.ndarray, a1: np.ndarray, a0: np.ndarray) -> np.ndarray:
+    """The root of ``a2 r^2 + a1 r + a0 = 0`` (``a0 < 0 < -a1``) that tends to
+    ``-a0 / -a1`` as ``a2 -> 0``, written without cancellation: ``2 a0 / (-a1 -
+    sqrt(a1^2 - 4 a2 a0))``; ``nan`` where the discriminant is negative."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return 2.0 * a0 / (-a1 - np.sqrt(a1 * a1 - 4.0 * a2 * a0))
+
+
+def fillet_radius_for_deviation(e: np.ndarray, t: np.ndarray, centre: np.ndarray,
+                                radius: np.ndarray, sense: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`line_circle_fillet` whose contour deviation
+    ``|C - M|`` is ``e``, closed form, mm, shape (k,) (``nan`` or not positive: none).
+
+    ``M`` lies on the fillet's radius towards ``C``, so ``|O| = r + e``; with ``|O - c| =
+    R - iota r`` (``c = -R u0``) the difference of the squares is linear:
+    ``O.u0 = -iota r - g / R``, ``g = r e + e^2 / 2``, and with ``O = x t + r n``, ``|O|^2
+    = x^2 + r^2`` gives ``x^2 = 2 g`` and ``x (t.u0) = -(p r + g / R)`` (``p = iota + n.u0
+    = iota |iota n + u0|^2 / 2``, without cancellation). Squared: ``P^2 r^2 + 2 (P Q -
+    q^2 e) r + Q^2 - q^2 e^2 = 0`` with ``P = p + e / R``, ``Q = e^2 / (2 R)``, ``q =
+    t.u0``; the root that tends to the line-line ``e cos(theta/2) / (1 - cos(theta/2))``
+    as ``R`` grows is taken. Exact for the contour deviation (squaring may give the
+    mirrored branch's root, ``x > 0``: 1 of 192 seeded corners); a start (checked by
+    the full fillet) for the tolerance search.
+    """
+    n, iota = _corner_frame(t, centre, radius, sense)
+    u0 = -centre / radius[:, None]
+    half = iota[:, None] * n + u0
+    p = iota * row_dots(half, half) / 2.0
+    q2 = row_dots(t, u0) ** 2
+    big_p = p + e / radius
+    big_q = e * e / (2.0 * radius)
+    return _small_root(big_p * big_p, 2.0 * (big_p * big_q - q2 * e),
+                       big_q * big_q - q2 * e * e)
+
+
+def circle_fillet_radius_for_deviation(e: np.ndarray, c1: np.ndarray, r1: np.ndarray,
+                                       s1: np.ndarray, c2: np.ndarray, r2: np.ndarray,
+                                       s2: np.ndarray) -> np.ndarray:
+    """Radius of the fillet of :func:`circle_circle_fillet` whose contour deviation
+    ``|C - M|`` is ``e`` (``M`` on its radius towards ``C``), closed form, mm, shape (k,)
+    (``nan`` or not positive: none).
+
+    ``|O| = r + e`` fixes ``g = (|O|^2 - r^2) / 2 = r e + e^2 / 2`` in the quadratic of
+    :func:`_circle_fillet_centre`, ``|V|^2 g^2 - 2 (1 - r K) g + a^2 r^2 = 0`` (``A_t =
+    a r``, ``A.V = r K``, ``K = iota_1 / R_1 - 2 iota_2 (c / R_1 - 1 / R_2) / P`` as in
+    :func:`circle_fillet_largest_radius`), which becomes a quadratic in ``r``; divided by
+    ``e``: ``(|V|^2 e + 2 K + a^2 / e) r^2 + (|V|^2 e^2 + K e - 2) r + |V|^2 e^3 / 4 - e =
+    0``, of which the root that tends to the line-line one as the radii grow is taken.
+    Exact for the contour deviation; a start (checked by the full fillet) where the
+    per-axis deviations decide.
+    """
+    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    i = iota1 * iota2
+    c = row_dots(u1, u2)
+    x = _cross2(u1, u2)
+    plus = u2 + i[:, None] * u1
+    p2 = row_dots(plus, plus)
+    m = c / r1 - 1.0 / r2
+    kk = iota1 / r1 - 2.0 * iota2 * m / p2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v2 = 1.0 / (r1 * r1) + (m / x) ** 2
+        a = 2.0 * x / p2
+        return _small_root(v2 * e + 2.0 * kk + a * a / e, v2 * e * e + kk * e - 2.0,
+                           v2 * e ** 3 / 4.0 - e)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class CircleFillet:
     """Tangent arcs of radius ``r`` between two circles meeting at a corner, in their
@@ -691,6 +757,7 @@ def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray
 __all__ = ["ArcFillet", "CircleFillet", "REASON_CODE", "ROUNDING_REASONS",
            "RoundingTable", "axis_deviation_limit", "circle_circle_fillet",
            "circle_fillet_deviation", "circle_fillet_largest_radius",
+           "circle_fillet_radius_for_deviation", "fillet_radius_for_deviation",
            "circle_fillet_radius_for_trim", "circle_fillet_radius_within", "deflection_angle",
            "distance_for_deviation", "fillet_deviation", "fillet_pieces",
            "fillet_radius_for_arc_trim", "fillet_radius_for_line_trim",

@@ -4,9 +4,9 @@
 it, then ``python tests/bench/same_results.py compare BEFORE.pkl AFTER.pkl``. The
 programs: every corpus program (``../shared/corpus``; the LinuxCNC ones converted, each
 under G64 and the rounding modes, BRISK and SOFT, :func:`corpus_in_mode`), the
-short-segment program under G642, and seeded polylines and line-arc chains (with and
-without corners next to the arcs) under G64 and the rounding modes; on both bundled
-machines. Per case: every segment array of the built path, its rounding table and block
+short-segment program under G642, and seeded polylines, line-arc chains (with and
+without corners next to the arcs) and arc chains (corners between two arcs) under G64
+and the rounding modes; on both bundled machines. Per case: every segment array of the built path, its rounding table and block
 spans, and of the plan (with its own check) the profile, total time, block rows, corner
 rows and trace (less its wall time). ``compare`` prints the largest relative difference
 ``|a - b| / max(1, |a|)`` of the float columns and every mismatch; a speed-up that only
@@ -32,7 +32,7 @@ from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
-from seeded_programs import line_arc_chain, polyline  # noqa: E402
+from seeded_programs import arc_chain, line_arc_chain, polyline  # noqa: E402
 
 MODES = ("G64", "G641 ADIS=0.2", "G642", "G642 CTOL=0.02", "G645", "G645 CTOL=0.05",
          "G643", "G644")
@@ -61,9 +61,13 @@ def programs(n: int = 1500) -> dict[str, str]:
             progs[f"polyline|{mode} {acc}"] = f"G90 {mode} {acc} F6000\nG1 X0 Y0\nG1 " + body
         for kink in (0.0, 60.0):
             chain = line_arc_chain(n, 5, kink_deg=kink)
-            for mode in ("G64", "G645", "G642 CTOL=0.02", "G641 ADIS=0.2"):
+            for mode in ("G64", "G645", "G642 CTOL=0.02", "G641 ADIS=0.2", "G643", "G644"):
                 progs[f"chain{kink:g}|{mode} {acc}"] = \
                     f"G17 G90 {mode} {acc} F6000\nG1 X0 Y0\n" + chain
+        arcs = arc_chain(n, 5)
+        for mode in ("G64", "G642 CTOL=0.02", "G641 ADIS=0.2", "G645 CTOL=0.02", "G643",
+                     "G644", "G642"):
+            progs[f"arcs|{mode} {acc}"] = f"G17 G90 {mode} {acc} F6000\nG1 X0 Y0\n" + arcs
     return progs
 
 

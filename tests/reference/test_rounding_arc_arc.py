@@ -38,6 +38,7 @@ from scipy.optimize import brentq, root
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
 from reference.core.rounding import (circle_circle_fillet, circle_fillet_largest_radius,
+                                     circle_fillet_radius_for_deviation,
                                      circle_fillet_radius_for_trim,
                                      circle_fillet_radius_within)
 from reference.machine import load_machine, machine_from_dict
@@ -426,3 +427,58 @@ def test_g644_2xxx_at_an_arc_corner_lasts_one_period_of_the_lowest_frequency():
     assert t.length_mm[-1] == pytest.approx(20.0 / 10.0, rel=1e-9)
     r = brentq(lambda x: x * hand("outside", x)["sweep"] - 2.0, 0.1, 5.0, xtol=1e-14)
     assert t.radius_mm[-1] == pytest.approx(r, rel=1e-9)
+
+
+@pytest.mark.parametrize("case", ["inside", "outside"])
+def test_closed_form_radius_of_a_contour_deviation_by_hand(case):
+    """The tolerance search starts from the radius whose fillet deviates from the corner
+    by a given contour deviation ``e`` (closed form, core.rounding): at the hand corners
+    the radius where ``sqrt(2) mu - r = e`` (module docstring) by scipy's brentq."""
+    (x1, y1), (x2, y2) = CENTRES[case]
+    c1 = np.array([[x1 - C[0], y1 - C[1]]])
+    c2 = np.array([[x2 - C[0], y2 - C[1]]])
+    s = -1.0 if case == "inside" else 1.0
+    one = np.ones(1)
+    for e in (1e-4, 0.02, 0.1):
+        r = circle_fillet_radius_for_deviation(np.array([e]), c1, 5.0 * one, s * one, c2,
+                                               5.0 * one, s * one)
+        expect = brentq(lambda x: hand(case, x)["deviation"] - e, 1e-9, 1.0, xtol=1e-15)
+        assert r[0] == pytest.approx(expect, rel=1e-10)
+
+
+def test_closed_form_radius_of_a_contour_deviation_between_a_line_and_a_circle():
+    """The same closed form between a line and a circle on seeded corners (radii 1..20
+    mm, turns of 5..120 degrees, deviations 0.001..0.1 mm), against the forward
+    construction: in nine corners of ten it is the smallest radius of that deviation
+    (brentq on the forward construction); elsewhere the squared equation's root belongs
+    to the mirrored branch, a start that the tolerance search corrects."""
+    from reference.core.rounding import fillet_deviation, fillet_radius_for_deviation
+    rng = np.random.default_rng(3)
+    checked = same = 0
+    for _ in range(200):
+        R, sense = rng.uniform(1.0, 20.0), rng.choice((-1.0, 1.0))
+        ang = rng.uniform(0.0, 2.0 * math.pi)
+        u0 = np.array([math.cos(ang), math.sin(ang)])
+        centre = -R * u0
+        tc = sense * np.array([-u0[1], u0[0]])
+        th = np.radians(rng.uniform(5.0, 120.0)) * rng.choice((-1.0, 1.0))
+        t = np.array([math.cos(th) * tc[0] - math.sin(th) * tc[1],
+                      math.sin(th) * tc[0] + math.cos(th) * tc[1]])
+        e = rng.uniform(0.001, 0.1)
+        cols = (t[None], centre[None], np.array([R]), np.array([sense]))
+
+        def dev(r):
+            d, ok = fillet_deviation(np.array([r]), *cols)
+            return float(np.linalg.norm(d[0])) - e if ok[0] else math.inf
+
+        # the smallest radius of that deviation (the branch that shrinks to the corner)
+        grid = np.geomspace(1e-9, 0.999 * R, 400)
+        above = [g for g in grid if dev(g) > 0]
+        if not above:                            # no fillet of that deviation below R
+            continue
+        hi = above[0]
+        expect = brentq(dev, grid[max(np.searchsorted(grid, hi) - 1, 0)], hi, xtol=1e-15)
+        got = fillet_radius_for_deviation(np.array([e]), *cols)[0]
+        checked += 1
+        same += got == pytest.approx(expect, rel=1e-9)
+    assert checked > 100 and same >= 0.9 * checked
