@@ -169,8 +169,7 @@ def fir_filtered(path: Path, limits: MachineLimits, acc_profile: Profile,
     by a cruise of at least ``W`` becomes one of ``r + W >= T_k``), ``a_k`` its largest
     ``|s''|`` and ``J_k`` the smallest jerk limit of its moving axes (a step ``a_k``
     spread over ``W`` has the jerk ``a_k / W``). On a rest-to-rest line whose acc profile
-    is a trapezoid with ramps ``r`` this is the closed form ``L/v + T`` plus ``r``, and
-    the dispatcher tries acc profiles with raised accelerations (shorter ``r``).
+    is a trapezoid with ramps ``r`` this is the closed form ``L/v + T`` plus ``r``.
 
     Parameters
     ----------
