@@ -36,7 +36,8 @@ from reference.core.rows import block_motion, block_rows
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from .lower import freq_lower_bound, segment_periods
-from .upper import candidate_windows, eroded_plans, fir_filtered, scaled, verified
+from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered, scaled,
+                    verified)
 
 ProgressFn = Callable[..., object]
 
@@ -124,17 +125,23 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     T_max = float(np.max(segment_periods(work, sub_lim), initial=0.0))
     jerk = base == "jerk"
     for W in (candidate_windows(work, sub_lim, T_max, jerk) if T_max > 0 else ()):
-        for reach in ((False, True) if jerk and W > 0 else (False,)):
+        # (jerk reach, rest share): the variants of optimal.freq.upper.eroded_plans,
+        # none always faster
+        variants = ((False, 0.0),) if W == 0 else (
+            ((False, 0.0), (True, 0.0), (True, ERODED_REST_SHARE)) if jerk
+            else ((False, 0.0), (False, ERODED_REST_SHARE)))
+        for reach, rest_share in variants:
             try:
-                u = eroded_plans(path, limits, T_max, W, jerk, reach)
+                u = eroded_plans(path, limits, T_max, W, jerk, reach, rest_share)
             except ProfileError:
                 # the eroded caps leave an interval at zero speed at both ends (cannot
                 # be crossed): no candidate from this construction
                 continue
             prof = fir_filtered(path, limits, u.profile, jerk, u.rest_breaks,
                                 window_s=W) if W > 0 else u.profile
-            label = (f"fir {W * 1e3:.3g} ms (eroded caps{', jerk reach' if reach else ''})"
-                     if W > 0 else "adapted caps")
+            label = (f"fir {W * 1e3:.3g} ms (eroded caps{', jerk reach' if reach else ''}"
+                     f"{', slow corners at rest' if rest_share else ''})" if W > 0
+                     else "adapted caps")
             c = verified(label, path, limits, prof, name, u.rest_breaks)
             if c is not None:
                 cands.append(c)

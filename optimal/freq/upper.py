@@ -270,6 +270,11 @@ ERODED_MIN_ACCEL_SHARE = 0.05
 #: 1 um/s is a stop for the time (its band of ``cap W`` is some 50 nm long, below what
 #: the grid resolves next to it).
 ERODED_REST_CAP_MM_S = 1e-3
+#: ``rest_share`` of the second eroded candidate of each window (:func:`eroded_plans`):
+#: corners slower than the speed a quarter window gains at the smallest axis
+#: acceleration are taken at rest. Of 0.25, 0.5 and 1 tried on the corpus, 0.25 and 0.5
+#: gave the same brackets and 1 made some worse (a stop costs more than the plateau).
+ERODED_REST_SHARE = 0.25
 #: Rounds in which :func:`eroded_plans` re-evaluates the tangential acceleration at the
 #: speeds its passes reached (the checker judges the result; more rounds change little).
 TANGENTIAL_ROUNDS = 2
@@ -465,7 +470,8 @@ def _eroded_grid(path: Path, n: int, v_junction: np.ndarray, window_s: float):
 
 
 def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: float,
-                 jerk_limited: bool, jerk_reach: bool = False) -> ErodedPlan:
+                 jerk_limited: bool, jerk_reach: bool = False,
+                 rest_share: float = 0.0) -> ErodedPlan:
     """A motion whose moving average keeps every speed cap *where it arrives*: the input
     of the FIR candidate on paths with corners and curves.
 
@@ -501,6 +507,11 @@ def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: f
         Take that jerk room as the least over the intervals the filtered motion may lag
         behind (u's speed times ``W``): needed where u accelerates hard just after a
         curve, costly on long curves; the oracle tries both.
+    rest_share : float
+        Corners whose cap is at most ``rest_share * A_min * W`` are rests (piece ends of
+        the filter) instead of plateaus: the filter needs ``W`` to pass a corner at its cap
+        on a plateau, while stopping at a slow corner costs about ``v_c / A``
+        (:data:`ERODED_REST_SHARE`; the oracle tries both, neither is always faster).
 
     Returns
     -------
@@ -537,7 +548,8 @@ def eroded_plans(path: Path, limits: MachineLimits, period_s: float, window_s: f
     v_break[:-1] = np.minimum(v_break[:-1], seg_cap)
     # corners the motion passes at rest: a zero cap, or one so low that crossing it is a
     # stop in all but name (and u^2 = 0 at both ends of an interval cannot be crossed)
-    rest = np.flatnonzero(v_point <= ERODED_REST_CAP_MM_S)
+    rest_cap = max(ERODED_REST_CAP_MM_S, rest_share * float(np.min(lim.a_max)) * W)
+    rest = np.flatnonzero(v_point <= rest_cap)
     rest = rest[(rest > 0) & (rest < m)]
     grid = _eroded_grid(free, n, v_break, W)
     dq0, ddq0, dq1, ddq1 = interval_geometry(free, grid)
