@@ -78,7 +78,8 @@ G643/G644 insert the same segments (the control rounds axis-wise inside the bloc
 G645's rounding of tangential transitions is modelled between a line and a circle and
 between two circles in one plane curving opposite ways (S-bends), the rounding of
 corners next to arcs between a line and a circle and between two circles in one plane
-(tangential arcs curving the same way, helices and spirals are named and passed as G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
+(tangential arcs curving the same way, helices and spirals are named and passed as
+G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,

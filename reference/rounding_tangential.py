@@ -258,7 +258,8 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
         # per open transition: the rounding's trims, length, smallest radius, curvature
         # rate, shortest piece, deviation (line-arc and S-bend sized apart, decided
         # alike below)
-        cut_in, cut_out, rlen, rmin, rate, piece, devo = (np.zeros(o.size) for _ in range(7))
+        cut_in, cut_out, rlen, rmin, rate, piece, devo = (np.zeros(o.size)
+                                                          for _ in range(7))
         small, cut = np.zeros(o.size, bool), np.zeros(o.size, bool)
         la = ~sbend[o]
         la_at, sb_at = o[la], o[~la]

@@ -45,8 +45,7 @@ much shorter ramp than at a line-arc transition.
 
 *Sizing.* The largest distance from the programmed contour (the two arcs) has no closed
 form: it is sampled along the rounding (:data:`DEV_SAMPLES` per piece) and the largest
-sample refined by golden-section search between its neighbours (a smooth maximum, or
-where the nearest arc changes: both are unimodal there). The rate ``c`` is the root of
+sample refined on ever finer grids around it (:data:`REFINE_ROUNDS`). The rate ``c`` is the root of
 "deviation = tolerance" (the deviation grows like ``1/c^2``; Newton-secant steps in
 ``log c``).
 
@@ -81,7 +80,7 @@ REFINE_ROUNDS = 12
 REFINE_POINTS = 5
 REFINE_SHRINK = 4.0
 #: Iteration cap of the ``theta`` root (bracketed secant with the Illinois correction;
-#: 6-12 steps in practice) and of the ``log c`` root (3-6 in practice).
+#: 8-25 steps over a batch in practice) and of the ``log c`` root (4-7 in practice).
 ROOT_MAX_ITER = 100
 #: The ``theta`` root stops when the S's advance misses the ramp B's start by at most
 #: this (the landing error, mm: a thousandth of the 1e-9 mm to which consecutive
@@ -98,7 +97,7 @@ THETA_MAX = 0.5 * np.pi
 #: small-angle root is about 5.4 times it for ``R1 = R2``); THETA_MAX where it does not
 #: bracket.
 THETA_GUESS = 16.0
-#: The rate's bracket is widened by this factor per step until it holds the root.
+#: A rate for which no heading lands (pieces far too long) is raised by this factor.
 RATE_BRACKET_STEP = 4.0
 
 
@@ -241,7 +240,7 @@ def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray) -> np.ndarray:
 
 def sbend_deviation(sh: SBendShape) -> np.ndarray:
     """Largest distance of the rounding from the programmed arcs, mm, shape (k,)
-    (module docstring: sampled, then refined by golden-section search)."""
+    (module docstring: sampled, then refined on finer grids)."""
     pieces = _canonical_pieces(sh)
     lengths = pieces[4]
     k = sh.rate.size
@@ -323,8 +322,9 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
     The deviation grows about like ``1/c^2`` (all lengths scale like ``1/c``, the
     deviation like their square over the radius): Newton steps in ``log c`` with the
     slope measured by the last two (secant; -2 at first), from the small-angle estimate
-    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``); a rate for which no
-    heading lands (pieces far too long) is raised by :data:`RATE_BRACKET_STEP`.
+    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``); a rate
+    for which no heading lands (pieces far too long) is raised by
+    :data:`RATE_BRACKET_STEP`.
 
     Parameters
     ----------

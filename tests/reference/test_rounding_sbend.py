@@ -52,10 +52,10 @@ def s_bend(r1: float, r2: float, word1: str = "G3") -> str:
 def integrate(sh, i: int):
     """The rounding by an ODE solver from its curvature profile alone (hand model:
     ``1/R1 -> 0`` over ``L1``, ``0 -> +c L_s -> 0 -> -c L_s -> 0`` over ``4 L_s``,
-    ``0 -> -1/R2`` over ``L2``, all linear in the arc length), started on the first arc ``trim_in``
-    before the junction with its tangent (frame: junction at the origin, tangent +x,
-    first centre (0, R1), second centre (0, -R2)). Returns the dense solution and the
-    length."""
+    ``0 -> -1/R2`` over ``L2``, all linear in the arc length), started on the first arc
+    ``trim_in`` before the junction with its tangent (frame: junction at the origin,
+    tangent +x, first centre (0, R1), second centre (0, -R2)). Returns the dense
+    solution and the length."""
     r1, r2 = float(sh.r_in[i]), float(sh.r_out[i])
     c, ls = float(sh.rate[i]), float(sh.piece[i])
     l1, l2 = float(sh.ramp_in[i]), float(sh.ramp_out[i])
