@@ -363,9 +363,9 @@ def _size_sbend(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np
     ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``) until both
     fit; whether it was cut, and whether it is too small (bool, shape (j,) each)."""
     r1, r2 = R[o], R_b[o]
-    rate = sbend_for_deviation(r1, r2, dev)
+    sh = sbend_for_deviation(r1, r2, dev)
+    rate = sh.rate
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
-    sh = sbend_shape(r1, r2, rate)
     cut = np.zeros(o.size, bool)
     for _ in range(CLAMP_ROUNDS):
         over = np.maximum(sh.trim_in / cap_in, sh.trim_out / cap_out)

@@ -62,22 +62,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import _eval_clothoid
+from .geometry import _fresnel
 from .transition import ramp_offset, s_shift
 
 #: Pieces per S-bend transition: ramp A, the S's four pieces, ramp B.
 SBEND_PIECES = 6
 #: Samples per piece of the deviation search. The largest sample is then refined, so
 #: this only has to separate the local maxima (each piece turns by less than a quarter
-#: turn and the deviation has at most one bump per piece; 24 samples put several on
+#: turn and the deviation has at most one bump per piece; 12 samples put several on
 #: each).
-DEV_SAMPLES = 24
-#: Refinement rounds: each evaluates :data:`REFINE_POINTS` points at spacing ``h``
-#: around the best so far and divides ``h`` by :data:`REFINE_SHRINK`; from the sample
-#: spacing, 4^-12 ~ 6e-8 of it, so the maximum's value (flat to second order there) is
-#: found to far below round-off of the tolerance.
-REFINE_ROUNDS = 12
-REFINE_POINTS = 5
+DEV_SAMPLES = 12
+#: Refinement rounds: each evaluates :data:`REFINE_POINTS` points evenly over the
+#: span ``+-h`` around the best so far (``h`` at first the sample spacing) and divides
+#: ``h`` by :data:`REFINE_SHRINK` (the points' own spacing, so the maximum stays
+#: inside); after 6 rounds ``h`` is 4^-6 ~ 2.4e-4 of the sample spacing, and the vertex
+#: of the parabola through the last three points then puts the maximum's value (a
+#: smooth maximum: flat to second order) far below round-off of the tolerance.
+REFINE_ROUNDS = 6
+REFINE_POINTS = 9
 REFINE_SHRINK = 4.0
 #: Iteration cap of the ``theta`` root (bracketed secant with the Illinois correction;
 #: 8-25 steps over a batch in practice) and of the ``log c`` root (4-7 in practice).
@@ -88,8 +90,10 @@ ROOT_MAX_ITER = 100
 #: of the heading).
 LANDING_TOL_MM = 1e-12
 THETA_TOL = 1e-15
-#: The ``log c`` root stops when the deviation is at the tolerance to this, relative.
-DEVIATION_REL_TOL = 1e-12
+#: The rate aims at a deviation this much (relative) below the tolerance, and stops
+#: within half of it (the deviation itself is found to about 1e-13 relative), so the
+#: tolerance is used to 1.5e-9 and never exceeded.
+DEVIATION_REL_TOL = 1e-9
 #: Largest ``theta`` searched, rad: a larger one would mean a rounding that replaces
 #: more than a quarter turn of each arc (the block-length clamp acts long before).
 THETA_MAX = 0.5 * np.pi
@@ -211,19 +215,45 @@ def _canonical_pieces(sh: SBendShape):
             lengths)
 
 
+def _clothoid_xy(origin, e1, e2, rate, length, s_local):
+    """Positions on clothoid pieces at distances ``s_local`` from each piece's start
+    (the model of :mod:`reference.core.geometry`, positions only); ``origin``, ``e1``,
+    ``e2`` shape (..., 2), the rest shape (...)."""
+    c = np.abs(rate)
+    sigma = np.clip(np.where(rate < 0, length - s_local, s_local), 0.0, length)
+    scale = np.sqrt(np.pi / c)
+    fs, fc = _fresnel(sigma / scale)
+    return (origin + (scale * fc)[..., None] * e1 + (scale * fs)[..., None] * e2)
+
+
+def _samples(pieces, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n + 1`` evenly spaced points on each piece (both ends): distances from the
+    rounding's start, shape (k, 6 (n + 1)), and canonical points, shape (k, 6 (n + 1),
+    2)."""
+    origin, e1, e2, rates, lengths = pieces
+    k = rates.shape[0]
+    s_local = lengths[:, :, None] * np.linspace(0.0, 1.0, n + 1)[None, None, :]
+    xy = _clothoid_xy(origin[:, :, None, :], e1[:, :, None, :], e2[:, :, None, :],
+                      rates[:, :, None], lengths[:, :, None], s_local)
+    starts = np.cumsum(lengths, axis=1) - lengths
+    return (starts[:, :, None] + s_local).reshape(k, -1), xy.reshape(k, -1, 2)
+
+
 def _points(pieces, s: np.ndarray) -> np.ndarray:
     """Canonical points at distances ``s`` (shape (k, N)) from the rounding's start,
     shape (k, N, 2)."""
     origin, e1, e2, rates, lengths = pieces
-    k, N = s.shape
     ends = np.cumsum(lengths, axis=1)
     idx = np.minimum((s[:, :, None] >= ends[:, None, :]).sum(axis=2), SBEND_PIECES - 1)
-    rows = np.repeat(np.arange(k), N)
-    j = idx.ravel()
-    start = (ends - lengths)[rows, j]
-    q = _eval_clothoid(origin[rows, j], e1[rows, j], e2[rows, j], rates[rows, j],
-                       lengths[rows, j], s.ravel() - start)[0]
-    return q.reshape(k, N, 2)
+
+    def take(a):
+        if a.ndim == 3:
+            return np.take_along_axis(a, idx[:, :, None], axis=1)
+        return np.take_along_axis(a, idx, axis=1)
+
+    start = take(ends - lengths)
+    return _clothoid_xy(take(origin), take(e1), take(e2), take(rates), take(lengths),
+                        s - start)
 
 
 def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray) -> np.ndarray:
@@ -244,17 +274,16 @@ def sbend_deviation(sh: SBendShape) -> np.ndarray:
     pieces = _canonical_pieces(sh)
     lengths = pieces[4]
     k = sh.rate.size
-    # samples: DEV_SAMPLES per piece, both ends included
-    frac = np.linspace(0.0, 1.0, DEV_SAMPLES + 1)
-    starts = np.cumsum(lengths, axis=1) - lengths
-    s = (starts[:, :, None] + lengths[:, :, None] * frac[None, None, :]).reshape(k, -1)
-    dev = _distance(_points(pieces, s), sh.r_in, sh.r_out)
+    s, xy = _samples(pieces, DEV_SAMPLES)
+    dev = _distance(xy, sh.r_in, sh.r_out)
     i = dev.argmax(axis=1)
     rows = np.arange(k)
     best, at = dev[rows, i], s[rows, i]
     total = lengths.sum(axis=1)
+    # the maximum lies within one sample spacing of the best sample: each round covers
+    # that span with REFINE_POINTS points and shrinks it by REFINE_SHRINK
     h = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), SBEND_PIECES - 1)] / DEV_SAMPLES
-    off = np.arange(REFINE_POINTS) - REFINE_POINTS // 2
+    off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
     for _ in range(REFINE_ROUNDS):
         x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
         d = _distance(_points(pieces, x), sh.r_in, sh.r_out)
@@ -263,7 +292,17 @@ def sbend_deviation(sh: SBendShape) -> np.ndarray:
         best = np.where(better, d[rows, j], best)
         at = np.where(better, x[rows, j], at)
         h = h / REFINE_SHRINK
-    return best
+    # the maximum is smooth (a distance from one arc): the vertex of the parabola
+    # through the best point and its neighbours at the last spacing
+    x = np.clip(at[:, None] + h[:, None] * np.array([-1.0, 1.0])[None, :], 0.0,
+                total[:, None])
+    nb = _distance(_points(pieces, x), sh.r_in, sh.r_out)
+    curv = nb[:, 0] + nb[:, 1] - 2.0 * best
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = at + 0.5 * h * (nb[:, 0] - nb[:, 1]) / curv
+    v = np.where((curv < 0) & (np.abs(v - at) <= h), v, at)
+    top = _distance(_points(pieces, np.clip(v, 0.0, total)[:, None]), sh.r_in, sh.r_out)
+    return np.maximum(np.maximum(best, top[:, 0]), nb.max(axis=1))
 
 
 def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
@@ -316,15 +355,17 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
-                        ) -> np.ndarray:
-    """Rate ``c`` whose S-bend transition deviates from the arcs by ``deviation``.
+                        ) -> SBendShape:
+    """The S-bend transitions that deviate from the arcs by ``deviation``.
 
     The deviation grows about like ``1/c^2`` (all lengths scale like ``1/c``, the
     deviation like their square over the radius): Newton steps in ``log c`` with the
     slope measured by the last two (secant; -2 at first), from the small-angle estimate
-    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``); a rate
-    for which no heading lands (pieces far too long) is raised by
-    :data:`RATE_BRACKET_STEP`.
+    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``), each
+    step only for the transitions not yet done; a rate for which no heading lands
+    (pieces far too long) is raised by :data:`RATE_BRACKET_STEP`. The aim is
+    ``deviation (1 - DEVIATION_REL_TOL)``, met to half of that margin: the result never
+    exceeds ``deviation`` and is at most ``1.5 DEVIATION_REL_TOL`` below it.
 
     Parameters
     ----------
@@ -333,35 +374,33 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
 
     Returns
     -------
-    numpy.ndarray, shape (k,)
-        1/mm^2.
+    SBendShape
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
-    log_e = np.log(deviation)
-
-    def g(log_c):
-        sh = sbend_shape(r_in, r_out, np.exp(log_c))
-        return np.log(sh.deviation) - log_e          # nan: no landing heading
-
+    aim = np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
     x = 0.5 * np.log(1.8 / (np.minimum(r_in, r_out) ** 3 * deviation))
-    gx = g(x)
+    sh = sbend_shape(r_in, r_out, np.exp(x))
+    gx = np.log(sh.deviation) - aim                   # nan: no landing heading
     x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
     for _ in range(ROOT_MAX_ITER):
-        lost = np.isnan(gx)
-        if not lost.any() and np.all(np.abs(gx) <= DEVIATION_REL_TOL):
+        todo = np.flatnonzero(~(np.abs(gx) <= 0.5 * DEVIATION_REL_TOL))
+        if not todo.size:
             break
+        xs, gs = x[todo], gx[todo]
+        lost = np.isnan(gs)
         with np.errstate(divide="ignore", invalid="ignore"):
-            slope = (gx - g_old) / (x - x_old)
+            slope = (gs - g_old[todo]) / (xs - x_old[todo])
         # the secant slope where it is sane (the deviation falls with the rate), else -2
         slope = np.where((slope < -0.5) & (slope > -8.0), slope, -2.0)
-        step = np.where(lost, np.log(RATE_BRACKET_STEP), -gx / slope)
-        done = ~lost & (np.abs(gx) <= DEVIATION_REL_TOL)
-        step = np.where(done, 0.0, step)
-        x_old, g_old = np.where(lost | done, x_old, x), np.where(lost | done, g_old, gx)
-        x = x + step
-        gx = np.where(done, gx, g(x))
-    return np.exp(x)
+        step = np.where(lost, np.log(RATE_BRACKET_STEP), -gs / slope)
+        x_old[todo] = np.where(lost, x_old[todo], xs)
+        g_old[todo] = np.where(lost, g_old[todo], gs)
+        x[todo] = xs + step
+        part = sbend_shape(r_in[todo], r_out[todo], np.exp(x[todo]))
+        sh = _scatter(sh, todo, part)
+        gx[todo] = np.log(part.deviation) - aim[todo]
+    return sh
 
 
 def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
@@ -409,6 +448,16 @@ def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
 
 def _take(sh: SBendShape, i: np.ndarray) -> SBendShape:
     return SBendShape(*(getattr(sh, f)[i] for f in SBendShape.__slots__))
+
+
+def _scatter(sh: SBendShape, i: np.ndarray, part: SBendShape) -> SBendShape:
+    """``sh`` with the transitions ``i`` replaced by ``part``."""
+    out = []
+    for f in SBendShape.__slots__:
+        a = getattr(sh, f).copy()
+        a[i] = getattr(part, f)
+        out.append(a)
+    return SBendShape(*out)
 
 
 def _replace(sh: SBendShape, **kw) -> SBendShape:
