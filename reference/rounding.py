@@ -23,12 +23,13 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    block only (named first: it is a path stop too), a stop at the break (exact stop,
    auxiliary output before motion, M0, a positioning axis, ...), a block without path
    motion between, a change of acceleration mode (BRISK/SOFT);
-3. transitions next to an arc: a tangential one (line into arc, arc into line) is
-   rounded by G645 only ("G645 also inserts rounding" at "tangential transitions with a
-   curvature jump", 5.7), decided and sized apart
+3. transitions next to an arc: a tangential one (line into arc, arc into line, an
+   S-bend of two arcs) is rounded by G645 only ("G645 also inserts rounding" at
+   "tangential transitions with a curvature jump", 5.7), decided and sized apart
    (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
    pairs that takes up the classical shift and a curvature ramp onto the arc,
-   :mod:`reference.core.transition`); other modes name it "tangential transition".
+   :mod:`reference.core.transition`; between arcs :mod:`reference.core.
+   transition_sbend`); other modes name it "tangential transition".
    A corner between a line and a circular arc, or between two circular arcs in one
    plane, is rounded by a tangent fillet (:func:`reference.rounding_arcs.arc_corners`,
    sized by the same mode parameters). Model limits of this version: corners next to
@@ -74,10 +75,11 @@ Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
-G645's rounding of tangential transitions is modelled between a line and a circle only,
-the rounding of corners next to arcs between a line and a circle and between two
-circles in one plane (tangential arc into arc, helices and spirals are named and passed
-as G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
+G645's rounding of tangential transitions is modelled between a line and a circle and
+between two circles in one plane curving opposite ways (S-bends), the rounding of
+corners next to arcs between a line and a circle and between two circles in one plane
+(tangential arcs curving the same way, helices and spirals are named and passed as
+G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,
@@ -101,7 +103,7 @@ from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
 from .nc.program import Program
 from .rounding_arcs import arc_corners
-from .rounding_tangential import PIECES, tangential_transitions
+from .rounding_tangential import tangential_transitions
 
 #: Group-10 modes that round corners.
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
@@ -379,11 +381,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                                     attrs["accel"][ka[trans]], CENTRIPETAL_SHARE,
                                     JERK_VELOCITY_SHARE, corner_time_loss)
         reason[trans] = tr.reason
-        done = (tr.reason == 0).astype(np.float64)
         dist[trans] = np.maximum(tr.trim_in, tr.trim_out)
-        length[trans] = tr.shape.length * done
-        dev[trans] = tr.shape.deviation * done
-        rad[trans] = tr.shape.radius * done
+        length[trans], dev[trans], rad[trans] = tr.length, tr.deviation, tr.radius
         clamped[trans] = tr.clamped
         g2_out[trans] = tr.reason == 0
         v64[trans], v_round[trans] = tr.v_g64, tr.v_round
@@ -417,7 +416,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     for part, at in ((tr, trans), (ac, arcc)):
         if part is not None and (part.reason == 0).any():
             done = part.reason == 0
-            n_rows = PIECES if part is tr else 1
+            n_rows = part.n_rows if part is tr else 1
             extras.append((a[at[done]], part.trim_in[done],
                            part.trim_out[done], part.rows, n_rows))
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],

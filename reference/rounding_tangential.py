@@ -9,15 +9,21 @@ only if the curvature jump would otherwise force the axis acceleration beyond it
 named as the corner rounding names its own (:data:`reference.core.rounding.
 ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
 
-1. only a line into a circular arc or an arc into a line (both in the geometry axes,
-   the arc a circle: no helix, no spiral); arc into arc is a model limit, named;
+1. a line into a circular arc or an arc into a line (both in the geometry axes, the arc
+   a circle: no helix, no spiral), or an S-bend: a circle into a tangent circle in the
+   same plane curving the other way (:mod:`reference.core.transition_sbend`, six
+   clothoid pieces through zero curvature); two arcs curving the same way (``1/R1 ->
+   1/R2``, one sign) need a clothoid piece between two non-zero curvatures, which the
+   path does not have (:mod:`reference.core.geometry`), and arcs in different planes
+   are not modelled: both are named, a model limit;
 2. under BRISK no rounding: "Under BRISK only the acceleration limits apply (an
    acceleration step is allowed)" (6.3), so the curvature jump costs no speed;
 3. ``v_g64`` = the curvature-jump rule at the transition (6.3, the shared
    :func:`reference.core.rules.curvature_jump_speed_cap`); if it is not below the
    programmed speed and the arc's own limits (centripetal, path jerk on the arc: what
    the heuristic grants a curved segment, :data:`reference.rounding.CENTRIPETAL_SHARE`
-   and ``JERK_VELOCITY_SHARE``), G64 passes it without reduction: none;
+   and ``JERK_VELOCITY_SHARE``; at an S-bend both arcs'), G64 passes it without
+   reduction: none;
 4. the ramp length ``L`` from the tolerance: the deviation (in the arc's plane) may be
    at most ``min_i PATH_TRANS_POS_TOL_i / rho_i`` (``rho_i`` the axis' weight in the
    plane: an in-plane deviation ``p`` moves axis ``i`` by at most ``rho_i p``), G0 blocks
@@ -25,11 +31,14 @@ ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
    the tolerance of tangential transitions);
 5. the block-length clamp (5.3, the G644 excerpt; ``c = rounding_length_clamp``): the
    rounding replaces at most ``c`` times each block (the line by ``line_trim ~ 1.6 L``,
-   the arc by ``L/2``), so ``L`` is reduced until both fit; pieces at or below
-   MIN_SEGMENT_LENGTH_MM: "rounding distance too small";
-6. ``v_round`` = the speed the rounding allows (centripetal at ``1/R``, the path jerk
-   ``rho_i |q'''| v^3`` with ``|q'''| <= hypot(c, 1/R^2)`` on the ramp, one IPO cycle per
-   piece); inserted only if ``v_round > v_g64``, else "rounding would be slower than G64".
+   the arc by ``L/2``; at an S-bend each arc by its trim), so ``L`` is reduced (the
+   S-bend's rate raised) until both fit; pieces at or below MIN_SEGMENT_LENGTH_MM:
+   "rounding distance too small";
+6. ``v_round`` = the speed the rounding allows (centripetal at its smallest radius:
+   ``R`` at a line-arc transition, the S's peak ``1/(c L_s)`` at an S-bend; the path
+   jerk ``rho_i |q'''| v^3`` with ``|q'''| <= hypot(c, 1/r_min^2)``, one IPO cycle per
+   piece); inserted only if ``v_round > v_g64`` and the corner rounding's time estimate
+   favours it, else "rounding would be slower than G64".
 """
 
 from __future__ import annotations
@@ -42,10 +51,12 @@ from .core.arrays import row_min
 from .core.geometry import KIND_CODES, Path
 from .core.limits import AxisArrays
 from .core.rounding import REASON_CODE
-from .core.rules import curvature_jump_speed_cap
+from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
                               transition_rows, transition_shape)
+from .core.transition_sbend import (SBEND_PIECES, SBendShape, sbend_for_deviation,
+                                    sbend_rows, sbend_shape)
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
@@ -59,12 +70,20 @@ _ROUNDING = KIND_CODES.index("rounding")
 CLAMP_ROUNDS = 6
 #: Relative margin below the clamp each scaling aims at.
 CLAMP_MARGIN = 1e-9
+#: Largest factor one clamp round raises an S-bend's rate by (a transition that found
+#: no landing heading has no trims to scale by: it is raised by this much).
+RATE_RAISE_MAX = 1e3
+#: Named where a tangential transition between arcs is passed as under G64: arcs
+#: curving the same way (``1/R1 -> 1/R2``, one sign) need a clothoid piece from one
+#: non-zero curvature to another, which the path does not have; arcs in different
+#: planes are not modelled either.
+_BETWEEN_ARCS = "tangential transition between arcs: rounding not modelled yet"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Transitions:
     """Decisions at the G645 tangential transitions given to :func:`tangential_transitions`,
-    shape (k,) each (rows: :data:`reference.core.transition.PIECES` per inserted one).
+    shape (k,) each unless said.
 
     Attributes
     ----------
@@ -72,13 +91,17 @@ class Transitions:
         Code of :data:`reference.core.rounding.ROUNDING_REASONS` (0 = rounded).
     trim_in, trim_out : numpy.ndarray
         Length the rounding replaces of the segment before and after, mm (0 where none).
-    shape : TransitionShape
-        Sizes (meaningful where rounded).
+    length, deviation, radius : numpy.ndarray
+        Length of the rounding, its largest distance from the programmed contour and its
+        smallest radius of curvature, mm (0 where none).
     clamped : numpy.ndarray of bool
-        ``L`` was cut by the block-length clamp.
+        The rounding was cut by the block-length clamp.
     v_g64, v_round : numpy.ndarray
         Speed at the transition under G64 (curvature-jump rule) and through the
         rounding, mm/s (``nan`` where not evaluated).
+    n_rows : numpy.ndarray of int, shape (r,)
+        Rows per inserted transition (:data:`PIECES` line-arc, :data:`SBEND_PIECES`
+        S-bend), in the order of ``reason == 0``.
     rows : dict
         Packed rows of the inserted transitions, in the order of ``reason == 0``.
     """
@@ -86,10 +109,13 @@ class Transitions:
     reason: np.ndarray
     trim_in: np.ndarray
     trim_out: np.ndarray
-    shape: TransitionShape
+    length: np.ndarray
+    deviation: np.ndarray
+    radius: np.ndarray
     clamped: np.ndarray
     v_g64: np.ndarray
     v_round: np.ndarray
+    n_rows: np.ndarray
     rows: dict
 
 
@@ -147,22 +173,26 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     """
     k = a.size
     b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
+    arc_arc = (path.kind[a] == _ARC) & (path.kind[b] == _ARC)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
         reason[(reason < 0) & mask] = REASON_CODE[why]
 
-    decide(~(line_arc | arc_line),
-           "tangential transition between arcs: rounding not modelled yet")
-    circle = ((path.dradius[arc] == 0) & (path.sharpness[arc] == 0)
-              & ~(np.abs(path.d.take(arc, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+    def is_circle(i: np.ndarray) -> np.ndarray:
+        return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
+                & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+
+    decide(~(line_arc | arc_line | arc_arc), _BETWEEN_ARCS)
+    circle = is_circle(arc) & np.where(arc_arc, is_circle(b), True)
     decide(~circle, "tangential transition into a helix or spiral: rounding not "
            "modelled yet")
     decide(accel != "SOFT", "curvature jump allowed under BRISK (acceleration step)")
 
     lim = machine.limits.for_axes(path.axes)
     t_ipo = machine.limits.t_ipo_s
-    # the canonical frame at the arc's end at the line (reference.core.transition)
+    # the canonical frame at the arc's end at the line (reference.core.transition);
+    # between two arcs at the first arc's end (reference.core.transition_sbend)
     R = path.radius[arc]
     w = path.omega[arc]
     at = np.where(line_arc, 0.0, path.length[arc])
@@ -171,95 +201,186 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     radial = E1 * np.cos(phi)[:, None] + E2 * np.sin(phi)[:, None]
     junction = path.origin.take(arc, axis=0) + R[:, None] * radial
     tangent = np.sign(w)[:, None] * (E2 * np.cos(phi)[:, None] - E1 * np.sin(phi)[:, None])
-    along = np.where(line_arc[:, None], tangent, -tangent)
+    along = np.where(line_arc[:, None] | arc_arc[:, None], tangent, -tangent)
     inward = -radial
+    # the second arc's normal at its start: an S-bend curves the other way in the plane
+    # (normals opposite, the shared test of two directions); arcs curving the same way
+    # would need a clothoid piece between two non-zero curvatures (_BETWEEN_ARCS)
+    inward_b = inward.copy()
+    sbend = np.zeros(k, bool)
+    aa = np.flatnonzero(arc_arc & (reason < 0))
+    if aa.size:
+        th_b = path.theta0[b[aa]]
+        inward_b[aa] = -(path.e1.take(b[aa], axis=0) * np.cos(th_b)[:, None]
+                         + path.e2.take(b[aa], axis=0) * np.sin(th_b)[:, None])
+        sbend[aa] = is_tangential(inward[aa], -inward_b[aa], FEASIBLE)
+    decide(arc_arc & ~sbend, _BETWEEN_ARCS)
+    R_b = np.where(sbend, path.radius[b], R)        # the second arc (= R at a line)
     rho = np.sqrt(along ** 2 + inward ** 2)          # each axis' weight in the arc's plane
     moving = rho > 0
     wr = np.where(moving, rho, 1.0)
 
     v_g64 = np.full(k, np.nan)
     v_round = np.full(k, np.nan)
-    shape = _zero_shape(k)
+    trim_in, trim_out = np.zeros(k), np.zeros(k)
+    length, deviation, radius = np.zeros(k), np.zeros(k), np.zeros(k)
     clamped = np.zeros(k, bool)
     o = np.flatnonzero(reason < 0)
-    v_prog = v_c = np.zeros(0)
+    la_shape, sb_shape = _zero_shape(0), None
+    la_at = sb_at = np.zeros(0, np.int64)
     if o.size:
         Ro = R[o]
         kappa = inward[o] / Ro[:, None]
-        v_g64[o] = curvature_jump_speed_cap(np.zeros_like(kappa), kappa,
-                                            lim.path_trans_jerk, t_ipo)
+        k_in = np.where(sbend[o, None], kappa, 0.0)
+        k_out = np.where(sbend[o, None], inward_b[o] / R_b[o, None], kappa)
+        v_g64[o] = curvature_jump_speed_cap(k_in, k_out, lim.path_trans_jerk, t_ipo)
         v_prog = _programmed_speed(path, lim, a[o], b[o], along[o])
-        v_c = _centripetal_speed(lim, Ro, moving[o], wr[o], centripetal_share)
-        # the arc's own path-jerk limit rho_i v^3 / R^2 <= share J_i
-        v_j = _jerk_speed(lim, 1.0 / (Ro * Ro), moving[o], wr[o], jerk_share)
+        # each arc's own limits: centripetal, and path jerk rho_i v^3 / R^2 <= share J_i
+        v_arc_a = np.minimum(v_prog, np.minimum(
+            _centripetal_speed(lim, Ro, moving[o], wr[o], centripetal_share),
+            _jerk_speed(lim, 1.0 / (Ro * Ro), moving[o], wr[o], jerk_share)))
+        Rbo = R_b[o]
+        v_arc_b = np.minimum(v_prog, np.minimum(
+            _centripetal_speed(lim, Rbo, moving[o], wr[o], centripetal_share),
+            _jerk_speed(lim, 1.0 / (Rbo * Rbo), moving[o], wr[o], jerk_share)))
         sub = np.zeros(k, bool)
-        v_arc = np.minimum(v_prog, np.minimum(v_c, v_j))
-        sub[o] = ~(v_g64[o] < v_arc)
+        sub[o] = ~(v_g64[o] < np.minimum(v_arc_a, v_arc_b))
         decide(sub, "G64 passes the curvature jump without reduction")
         keep = reason[o] < 0
-        o, v_prog, v_c, v_arc = o[keep], v_prog[keep], v_c[keep], v_arc[keep]
+        o, v_prog, v_arc_a, v_arc_b = o[keep], v_prog[keep], v_arc_a[keep], v_arc_b[keep]
     if o.size:
-        Ro = R[o]
         tol = np.array([machine.settings_of(ax).path_trans_pos_tol_mm for ax in path.axes])
         with np.errstate(divide="ignore"):
             dev = row_min(np.where(moving[o], tol[None, :] / wr[o], np.inf))
         g0 = path.rapid[a[o]] & path.rapid[b[o]]
         dev = dev * np.where(g0, machine.channel.g0_tolerance_factor, 1.0)
-        ramp = ramp_for_deviation(Ro, dev)
         c = machine.channel.rounding_length_clamp
-        cap_arc = 2.0 * c * path.length[arc[o]]
-        cap_line = c * path.length[line[o]]
-        cut = ramp > cap_arc
-        ramp = np.minimum(ramp, cap_arc)
-        sh = transition_shape(Ro, ramp)
-        for _ in range(CLAMP_ROUNDS):
-            over = sh.line_trim > cap_line
-            if not over.any():
-                break
-            cut |= over
-            ramp = np.where(over, ramp * (1.0 - CLAMP_MARGIN) * cap_line / sh.line_trim,
-                            ramp)
-            sh = transition_shape(Ro, ramp)
+        # per open transition: the rounding's trims, length, smallest radius, curvature
+        # rate, shortest piece, deviation (line-arc and S-bend sized apart, decided
+        # alike below)
+        cut_in, cut_out, rlen, rmin, rate, piece, devo = (np.zeros(o.size)
+                                                          for _ in range(7))
+        small, cut = np.zeros(o.size, bool), np.zeros(o.size, bool)
+        la = ~sbend[o]
+        la_at, sb_at = o[la], o[~la]
+        if la_at.size:
+            sh, cut_la, small_la = _size_line_arc(path, R, arc, line, la_at, dev[la], c)
+            la_shape = sh
+            lin = line_arc[la_at]
+            cut_in[la] = np.where(lin, sh.line_trim, sh.arc_trim)
+            cut_out[la] = np.where(lin, sh.arc_trim, sh.line_trim)
+            rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
+            piece[la] = np.minimum(sh.piece, sh.ramp)
+            small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
+        if sb_at.size:
+            sh, cut_sb, small_sb = _size_sbend(path, R, R_b, a, b, sb_at, dev[~la], c)
+            sb_shape = sh
+            cut_in[~la], cut_out[~la] = sh.trim_in, sh.trim_out
+            rlen[~la], rmin[~la], rate[~la] = sh.length, sh.min_radius, sh.rate
+            piece[~la] = np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
+            small[~la], cut[~la], devo[~la] = small_sb, cut_sb, sh.deviation
         clamped[o] = cut
         sub = np.zeros(k, bool)
-        sub[o] = ((sh.line_trim > cap_line) | ~(sh.piece > MIN_SEGMENT_LENGTH_MM)
-                  | ~(sh.ramp > MIN_SEGMENT_LENGTH_MM))
+        sub[o] = small
         decide(sub, "rounding distance too small")
-        # the rounding's speed: centripetal at 1/R (the S curves less), path jerk with
-        # |q'''| <= hypot(c, 1/R^2) (the S pieces have the same rate c and less
-        # curvature), one IPO cycle per piece (5.3), the programmed speed
-        v_j = _jerk_speed(lim, np.hypot(sh.rate, 1.0 / (Ro * Ro)), moving[o], wr[o],
+        # the rounding's speed: centripetal at its smallest radius (line-arc: the arc's,
+        # the S curves less; S-bend: the S's peak), path jerk with |q^(3)| <=
+        # hypot(c, 1/r_min^2) (every piece has the rate c), one IPO cycle per piece
+        # (5.3), the programmed speed
+        v_c = _centripetal_speed(lim, rmin, moving[o], wr[o], centripetal_share)
+        v_j = _jerk_speed(lim, np.hypot(rate, 1.0 / (rmin * rmin)), moving[o], wr[o],
                           jerk_share)
-        v_round[o] = np.minimum(np.minimum(v_prog, np.minimum(v_c, v_j)),
-                                np.minimum(sh.piece, sh.ramp) / t_ipo)
+        v_round[o] = np.minimum(np.minimum(v_prog, np.minimum(v_c, v_j)), piece / t_ipo)
         # 5.2 group 2 "rounding would slow the program down", 5.8 "insert only if this
         # beats the non-rounded limit": the corner rounding's time estimate, each side
-        # ramping to its own speed (the line to the programmed one, the arc to its own
+        # ramping to its own speed (a line to the programmed one, an arc to its own
         # limit) from the transition speed; the rounding is passed at v_round over its
-        # length and replaces line_trim of the line and L/2 of the arc
-        la = line_arc[o]
-        v_line, acc, jerk = v_prog, *_path_dynamics(lim, along[o])
-        v_in, v_out = np.where(la, v_line, v_arc), np.where(la, v_arc, v_line)
-        cut_in = np.where(la, sh.line_trim, sh.arc_trim)
-        cut_out = np.where(la, sh.arc_trim, sh.line_trim)
-        loss_round = time_loss(v_in, v_out, v_round[o], acc, acc, jerk, jerk, sh.length,
+        # length and replaces cut_in before and cut_out after the transition
+        lin = line_arc[o]
+        acc, jerk = _path_dynamics(lim, along[o])
+        v_in = np.where(lin, v_prog, v_arc_a)
+        v_out = np.where(lin, v_arc_a, np.where(sbend[o], v_arc_b, v_prog))
+        loss_round = time_loss(v_in, v_out, v_round[o], acc, acc, jerk, jerk, rlen,
                                cut_in, cut_out)
         loss_g64 = time_loss(v_in, v_out, v_g64[o], acc, acc, jerk, jerk, 0.0, 0.0)
         sub[:] = False
         sub[o] = ~((v_round[o] > v_g64[o]) & (loss_round < loss_g64))
         decide(sub, "rounding would be slower than G64")
-        shape = _scatter_shape(sh, o, k)
+        trim_in[o], trim_out[o] = cut_in, cut_out
+        length[o], deviation[o], radius[o] = rlen, devo, rmin
     reason[reason < 0] = REASON_CODE["rounded"]
     ins = reason == 0
-    trim_line = np.where(ins, shape.line_trim, 0.0)
-    trim_arc = np.where(ins, shape.arc_trim, 0.0)
-    trim_in = np.where(line_arc, trim_line, trim_arc)
-    trim_out = np.where(line_arc, trim_arc, trim_line)
-    i = np.flatnonzero(ins)
-    rows = transition_rows(junction[i], along[i], inward[i], _take_shape(shape, i),
-                           arc_line[i], ka[i], _ROUNDING)
-    return Transitions(reason, trim_in, trim_out, shape, clamped & ins, v_g64, v_round,
-                       rows)
+    done = np.where(ins, 1.0, 0.0)
+    trim_in, trim_out = trim_in * done, trim_out * done
+    # rows of the inserted ones, in their order: PIECES per line-arc transition,
+    # SBEND_PIECES per S-bend
+    i_la = np.flatnonzero(ins[la_at])
+    i_sb = np.flatnonzero(ins[sb_at])
+    g_la, g_sb = la_at[i_la], sb_at[i_sb]
+    rows = transition_rows(junction[g_la], along[g_la], inward[g_la],
+                           _take_shape(la_shape, i_la), arc_line[g_la], ka[g_la], _ROUNDING)
+    n_rows = np.zeros(k, np.int64)
+    n_rows[g_la] = PIECES
+    if g_sb.size:
+        more = sbend_rows(junction[g_sb], along[g_sb], inward[g_sb],
+                          _take_sbend(sb_shape, i_sb), ka[g_sb], _ROUNDING)
+        n_rows[g_sb] = SBEND_PIECES
+        order = np.argsort(np.concatenate((np.repeat(g_la, PIECES),
+                                           np.repeat(g_sb, SBEND_PIECES))), kind="stable")
+        rows = {key: np.concatenate((rows[key], more[key]))[order] for key in rows}
+    return Transitions(reason, trim_in, trim_out, length * done, deviation * done,
+                       radius * done, clamped & ins, v_g64, v_round, n_rows[ins], rows)
+
+
+def _size_line_arc(path: Path, R: np.ndarray, arc: np.ndarray, line: np.ndarray,
+                   o: np.ndarray, dev: np.ndarray, c: float):
+    """Line-arc transitions ``o``: the shape whose deviation is ``dev`` (mm, shape (j,)),
+    the ramp cut by the block-length clamp ``c`` (5.3) until both trims fit; whether it
+    was cut, and whether it is too small (bool, shape (j,) each)."""
+    Ro = R[o]
+    ramp = ramp_for_deviation(Ro, dev)
+    cap_arc = 2.0 * c * path.length[arc[o]]
+    cap_line = c * path.length[line[o]]
+    cut = ramp > cap_arc
+    ramp = np.minimum(ramp, cap_arc)
+    sh = transition_shape(Ro, ramp)
+    for _ in range(CLAMP_ROUNDS):
+        over = sh.line_trim > cap_line
+        if not over.any():
+            break
+        cut |= over
+        ramp = np.where(over, ramp * (1.0 - CLAMP_MARGIN) * cap_line / sh.line_trim, ramp)
+        sh = transition_shape(Ro, ramp)
+    small = ((sh.line_trim > cap_line) | ~(sh.piece > MIN_SEGMENT_LENGTH_MM)
+             | ~(sh.ramp > MIN_SEGMENT_LENGTH_MM))
+    return sh, cut, small
+
+
+def _size_sbend(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.ndarray,
+                o: np.ndarray, dev: np.ndarray, c: float):
+    """S-bend transitions ``o`` (:mod:`reference.core.transition_sbend`): the shape whose
+    deviation is ``dev`` (mm, shape (j,)); where a trim exceeds the block-length clamp
+    ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``) until both
+    fit; whether it was cut, and whether it is too small (bool, shape (j,) each)."""
+    r1, r2 = R[o], R_b[o]
+    sh = sbend_for_deviation(r1, r2, dev)
+    rate = sh.rate
+    cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
+    cut = np.zeros(o.size, bool)
+    for _ in range(CLAMP_ROUNDS):
+        over = np.maximum(sh.trim_in / cap_in, sh.trim_out / cap_out)
+        over = np.where(np.isnan(over), RATE_RAISE_MAX, over)
+        hit = over > 1.0
+        if not hit.any():
+            break
+        cut |= hit
+        rate = np.where(hit, rate * np.minimum(over, RATE_RAISE_MAX) / (1.0 - CLAMP_MARGIN),
+                        rate)
+        sh = sbend_shape(r1, r2, rate)
+    small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
+             | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
+                 > MIN_SEGMENT_LENGTH_MM))
+    return sh, cut, small
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
@@ -307,13 +428,8 @@ def _take_shape(shape: TransitionShape, i: np.ndarray) -> TransitionShape:
     return TransitionShape(*(getattr(shape, f)[i] for f in TransitionShape.__slots__))
 
 
-def _scatter_shape(part: TransitionShape, o: np.ndarray, k: int) -> TransitionShape:
-    out = []
-    for f in TransitionShape.__slots__:
-        arr = np.zeros(k)
-        arr[o] = getattr(part, f)
-        out.append(arr)
-    return TransitionShape(*out)
+def _take_sbend(shape: SBendShape, i: np.ndarray) -> SBendShape:
+    return SBendShape(*(getattr(shape, f)[i] for f in SBendShape.__slots__))
 
 
-__all__ = ["PIECES", "Transitions", "tangential_transitions"]
+__all__ = ["PIECES", "SBEND_PIECES", "Transitions", "tangential_transitions"]

@@ -3,7 +3,8 @@
 A seeded CAM-like polyline of 10^4 lines (0.5..5 mm, turns of 5..120 degrees, F6000)
 is planned by the heuristic under G64 and under each rounding mode, on the default
 machine with BRISK and SOFT; a seeded chain of 10^4 lines and tangent arcs under G645
-(tangential transitions with curvature jumps), and the same chain with a corner where
+(tangential transitions with curvature jumps), a seeded chain of tangent arcs curving
+alternately under G645 (S-bends, MD33120 = 0.05 mm), and the same line-arc chain with a corner where
 each line leaves its arc (corners next to arcs), and a seeded chain of 10^4 arcs each
 leaving the one before at a corner (corners between two arcs); then the short-segment
 program (../shared/corpus/lcnc_short_segments_0.001.ngc converted to G642 by
@@ -35,6 +36,8 @@ from __future__ import annotations
 
 import sys
 import time
+import tomllib
+from importlib import resources
 from pathlib import Path as FsPath
 
 
@@ -42,7 +45,7 @@ HERE = FsPath(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 
 from reference.core.constraints import check_profile  # noqa: E402
-from reference.machine import load_machine  # noqa: E402
+from reference.machine import load_machine, machine_from_dict  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
@@ -50,7 +53,7 @@ from reference.prepare import build_path  # noqa: E402
 TARGET = 1.30
 sys.path.insert(0, str(HERE.parent / "reference"))
 from corpus_sinumerik import short_segments_g642  # noqa: E402
-from seeded_programs import arc_chain, line_arc_chain, polyline  # noqa: E402
+from seeded_programs import arc_chain, line_arc_chain, polyline, s_bend_chain  # noqa: E402
 
 
 def timed(text: str, machine, repeat: int = 5):
@@ -101,6 +104,15 @@ def row(label: str, n: int, base, rounded) -> tuple[float, float]:
     return ratio, ratio_pl
 
 
+def _with_trans_tol(name: str, tol_mm: float):
+    """The bundled machine ``name`` with PATH_TRANS_POS_TOL = ``tol_mm`` on every axis."""
+    d = tomllib.loads(resources.files("reference.machines").joinpath(f"{name}.toml")
+                      .read_text())
+    for ax in d["axis"].values():
+        ax["PATH_TRANS_POS_TOL"] = tol_mm
+    return machine_from_dict(d)
+
+
 def main(argv=None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     n = 2000 if "--quick" in argv else 10000
@@ -122,6 +134,14 @@ def main(argv=None) -> None:
                       *paired(head.format("G64") + chain, head.format("G645") + chain,
                               machine))
         worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
+    # G645 at tangential S-bends (a seeded chain of tangent arcs curving alternately;
+    # MD33120 0.05 mm on the default machine's X, Y so that most of them are rounded)
+    sbends = s_bend_chain(n, 5)
+    head = "G17 G90 {} SOFT F8000\n"
+    r, r_pl = row(f"SOFT G645 S-bends, {n} blocks", n,
+                  *paired(head.format("G64") + sbends, head.format("G645") + sbends,
+                          _with_trans_tol("default", 0.05)))
+    worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
     # corners next to arcs (each line leaves its arc at a 30..60 degree corner)
     kinked = line_arc_chain(n, 5, kink_deg=60.0)
     for accel, mode in (("BRISK", "G642 CTOL=0.02"), ("BRISK", "G641 ADIS=0.2"),

@@ -71,3 +71,23 @@ def arc_chain(n: int, seed: int, kink_deg: float = 60.0) -> str:
         word = "G3" if side > 0 else "G2"
         out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
     return "\n".join(out) + "\nM30\n"
+
+
+def s_bend_chain(n: int, seed: int, r_min: float = 20.0, r_max: float = 200.0) -> str:
+    """``n`` seeded tangent arcs (radius ``r_min..r_max`` mm, turning 20..60 degrees), each
+    curving the other way from the one before: a chain of S-bends, tangential transitions
+    between arcs whose curvatures have opposite signs (body only, ``G1 X0 Y0`` then
+    ``G2``/``G3`` words with the centre as ``I J``, 12 decimals, then ``M30``)."""
+    rng = np.random.default_rng(seed)
+    heading, x, y, out, side = 0.0, 0.0, 0.0, ["G1 X0 Y0"], 1.0
+    for _ in range(n):
+        r = rng.uniform(r_min, r_max)
+        turn = np.radians(rng.uniform(20.0, 60.0)) * side
+        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
+        i_, j_ = cx - x, cy - y
+        heading += turn
+        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
+        out.append(f"{'G3' if side > 0 else 'G2'} X{x:.12f} Y{y:.12f} I{i_:.12f} "
+                   f"J{j_:.12f}")
+        side = -side
+    return "\n".join(out) + "\nM30\n"

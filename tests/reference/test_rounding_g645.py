@@ -243,9 +243,11 @@ def test_no_transition_and_why(text, mach, why):
 
 
 def test_model_limits_are_named():
-    """Arc into arc (an S of two arcs) and a helix are passed as under G64, named."""
-    s_arcs = "G17 G90 G645 SOFT F6000\nG1 X0 Y0\nG3 X20 Y20 I0 J20\nG2 X40 Y40 I20 J0\n"
-    assert reasons(build_path(parse_text(s_arcs), machine())) == [
+    """Arc into an arc curving the same way (a clothoid from 1/R1 to 1/R2 would not
+    start at zero curvature; S-bends are rounded, test_rounding_sbend.py) and a helix
+    are passed as under G64, named."""
+    same_way = "G17 G90 G645 SOFT F6000\nG1 X0 Y0\nG3 X20 Y20 I0 J20\nG3 X10 Y30 I-10 J0\n"
+    assert reasons(build_path(parse_text(same_way), machine())) == [
         "tangential transition between arcs: rounding not modelled yet"]
     # the line along the helix's start tangent (5 pi mm in the plane per 2 mm in Z)
     x0 = 20.0 - 5.0 * math.pi

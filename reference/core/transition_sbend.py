@@ -1,0 +1,468 @@
+"""Geometry of G645's rounding of a tangential S-bend: two arcs curving opposite ways.
+
+sinumerik-model 5.7: "At tangential transitions with a curvature jump (e.g. line to arc),
+G645 also inserts rounding, using MD33120 PATH_TRANS_POS_TOL"; 5.8 models the inserted
+block as a curvature ramp (:mod:`reference.core.transition` for a line and an arc).
+Between an arc of curvature ``+1/R1`` and a tangent arc of curvature ``-1/R2`` (G2 then
+G3, or G3 then G2, in one plane) the curvature jumps by ``1/R1 + 1/R2``.
+
+*No monotone ramp lands on the arc.* Let ``e(s) = kappa(s) - kappa_prog(s)`` be the
+curvature of a rounding minus the programmed one (``+1/R1`` before the junction ``J``
+at ``s = 0``, ``-1/R2`` after). For the rounding to leave the first arc and land on the
+second with its position and tangent, in the small-angle picture ``int e ds = 0``
+(heading) and ``int s e ds = 0`` (sideways position). If ``kappa`` fell monotonically
+from ``1/R1`` to ``-1/R2``, then ``e <= 0`` before ``J`` and ``e >= 0`` after it, so
+``s e >= 0`` everywhere and ``int s e ds > 0``: it cannot land (the classical result that
+a reverse clothoid joins two circles only if they are apart, centre distance
+``> R1 + R2``, while tangent circles are at ``R1 + R2``). The curvature must overshoot.
+
+*The model*, built of clothoid pieces that each have a zero-curvature end
+(:mod:`reference.core.geometry`)::
+
+    1/R1 -> 0 (ramp A, length L) -> +k_s -> 0 -> -k_s -> 0 (the S, 4 pieces of L_s)
+         -> -1/R2 (ramp B, length L)
+
+Both ramps have one length ``L`` (rates ``1/(R1 L)`` and ``1/(R2 L)``), the S pieces the
+larger rate ``c = 1/(min(R1, R2) L)``: the fastest-changing piece sets the path jerk
+``v^3 c``, none is steeper than it must be, and the ramp onto the flatter arc is not
+shorter than the other (every piece costs an IPO cycle, spec 5.3).
+
+Ramp A leaves the first arc, ramp B lands on the second: each is the ramp of the
+line-arc transition (:func:`reference.core.transition.ramp_offset`) onto its own arc,
+with its zero-curvature end on a line of heading ``-theta`` (``theta`` measured from
+the common tangent at ``J``, towards the second arc's side). Both lines are parallel;
+the one of ramp B lies ``lat = 2 (R1 + R2) sin^2(theta/2) + p1 + p2`` further towards
+the first arc's centre (``p = -y_Q`` each ramp's classical shift) and starts ``adv =
+(R1 + R2) sin theta + x_Q1 + x_Q2`` further along. The S of two symmetric clothoid pairs
+(turn ``h``, :func:`reference.core.transition.s_shift` with the rate ``c``) takes up
+``lat`` sideways and ``2 d_p (1 + cos h)`` along; ``theta`` is the root of "the S's
+advance equals ``adv``" (one unknown per transition, solved by a safeguarded secant).
+The rounding then is G2 continuous with both arcs and lands exactly; the first arc is
+shortened by ``theta R1 + L1/2``, the second by ``theta R2 + L2/2`` (both stay the exact
+programmed arcs). The curvature overshoot is the S's peak ``k_s = c L_s`` (about
+``2.4/R`` for ``R1 = R2 = R``): the price of landing, and why a given deviation needs a
+much shorter ramp than at a line-arc transition.
+
+*Sizing.* The largest distance from the programmed contour (the two arcs) has no closed
+form: it is sampled along the rounding (:data:`DEV_SAMPLES` per piece) and the largest
+sample refined on ever finer grids around it (:data:`REFINE_ROUNDS`). The rate ``c`` is the root of
+"deviation = tolerance" (the deviation grows like ``1/c^2``; Newton-secant steps in
+``log c``).
+
+Canonical frame (per transition): origin ``J``, ``x`` along the direction of travel,
+``y`` towards the first arc's centre (so the centres are at ``(0, R1)`` and
+``(0, -R2)``).
+
+Units: mm, rad. Shapes: ``k`` transitions, ``n`` axes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import _fresnel
+from .transition import ramp_offset, s_shift
+
+#: Pieces per S-bend transition: ramp A, the S's four pieces, ramp B.
+SBEND_PIECES = 6
+#: Samples per piece of the deviation search. The largest sample is then refined, so
+#: this only has to separate the local maxima (each piece turns by less than a quarter
+#: turn and the deviation has at most one bump per piece; 12 samples put several on
+#: each).
+DEV_SAMPLES = 12
+#: Refinement rounds: each evaluates :data:`REFINE_POINTS` points evenly over the
+#: span ``+-h`` around the best so far (``h`` at first the sample spacing) and divides
+#: ``h`` by :data:`REFINE_SHRINK` (the points' own spacing, so the maximum stays
+#: inside); after 6 rounds ``h`` is 4^-6 ~ 2.4e-4 of the sample spacing, and the vertex
+#: of the parabola through the last three points then puts the maximum's value (a
+#: smooth maximum: flat to second order) far below round-off of the tolerance.
+REFINE_ROUNDS = 6
+REFINE_POINTS = 9
+REFINE_SHRINK = 4.0
+#: Iteration cap of the ``theta`` root (bracketed secant with the Illinois correction;
+#: 8-25 steps over a batch in practice) and of the ``log c`` root (4-7 in practice).
+ROOT_MAX_ITER = 100
+#: The ``theta`` root stops when the S's advance misses the ramp B's start by at most
+#: this (the landing error, mm: a thousandth of the 1e-9 mm to which consecutive
+#: segments must meet), or when its bracket is narrower than THETA_TOL (rad: round-off
+#: of the heading).
+LANDING_TOL_MM = 1e-12
+THETA_TOL = 1e-15
+#: The rate aims at a deviation this much (relative) below the tolerance, and stops
+#: within half of it (the deviation itself is found to about 1e-13 relative), so the
+#: tolerance is used to 1.5e-9 and never exceeded.
+DEVIATION_REL_TOL = 1e-9
+#: Largest ``theta`` searched, rad: a larger one would mean a rounding that replaces
+#: more than a quarter turn of each arc (the block-length clamp acts long before).
+THETA_MAX = 0.5 * np.pi
+#: First upper end of the ``theta`` bracket, times ``(L1 + L2) / (R1 + R2)`` (the
+#: small-angle root is about 5.4 times it for ``R1 = R2``); THETA_MAX where it does not
+#: bracket.
+THETA_GUESS = 16.0
+#: A rate for which no heading lands (pieces far too long) is raised by this factor.
+RATE_BRACKET_STEP = 4.0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SBendShape:
+    """Size of S-bend transitions (module docstring), shape (k,) each.
+
+    Attributes
+    ----------
+    r_in, r_out : numpy.ndarray
+        Radii of the first and second arc, mm.
+    rate : numpy.ndarray
+        Curvature rate ``c`` of the S pieces and the steeper ramp, 1/mm^2.
+    ramp_in, ramp_out : numpy.ndarray
+        Ramp lengths, both ``L = 1/(min(R1, R2) c)``, mm.
+    piece : numpy.ndarray
+        Length ``L_s`` of each S piece, mm.
+    turn, pair_distance : numpy.ndarray
+        Turn ``h`` (rad) and tangent distance ``d_p`` (mm) of each S pair.
+    theta : numpy.ndarray
+        Heading of the S, from the common tangent towards the second arc's side, rad.
+    trim_in, trim_out : numpy.ndarray
+        How much of the first and of the second arc the rounding replaces, mm.
+    deviation : numpy.ndarray
+        Largest distance from the programmed contour, mm.
+    length : numpy.ndarray
+        Length of the rounding ``2 L + 4 L_s``, mm.
+    min_radius : numpy.ndarray
+        Smallest radius of curvature along the rounding and the arcs' ends,
+        ``min(R1, R2, 1/(c L_s))``, mm.
+    """
+
+    r_in: np.ndarray
+    r_out: np.ndarray
+    rate: np.ndarray
+    ramp_in: np.ndarray
+    ramp_out: np.ndarray
+    piece: np.ndarray
+    turn: np.ndarray
+    pair_distance: np.ndarray
+    theta: np.ndarray
+    trim_in: np.ndarray
+    trim_out: np.ndarray
+    deviation: np.ndarray
+    length: np.ndarray
+    min_radius: np.ndarray
+
+
+def _s_of(theta, r_in, r_out, rate, xq, yq):
+    """The S for heading ``theta``: residual ``adv - advance`` (mm), ``L_s``, ``h``,
+    ``d_p``."""
+    rr = r_in + r_out
+    lat = 2.0 * rr * np.sin(0.5 * theta) ** 2 - yq
+    l_s, h, d_p = s_shift(lat, rate)
+    return rr * np.sin(theta) + xq - 2.0 * d_p * (1.0 + np.cos(h)), l_s, h, d_p
+
+
+def _illinois(f, lo, hi, f_lo, f_hi, tol, ftol):
+    """Vectorised Illinois root of ``f`` in brackets ``[lo, hi]`` (``f_lo < 0 < f_hi``),
+    until every bracket is narrower than ``tol`` or its last value below ``ftol``; the
+    last iterates."""
+    side = np.zeros(lo.shape, np.int8)
+    x = 0.5 * (lo + hi)
+    fx = np.full(lo.shape, np.inf)
+    for _ in range(ROOT_MAX_ITER):
+        w = hi - lo
+        if np.all((w <= tol) | (np.abs(fx) <= ftol)):
+            break
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = lo - f_lo * w / (f_hi - f_lo)
+        bad = ~((x > lo) & (x < hi))
+        x = np.where(bad, 0.5 * (lo + hi), x)
+        fx = f(x)
+        neg = fx < 0
+        # Illinois: halve the value kept twice on the same side
+        f_hi = np.where(neg & (side == -1), 0.5 * f_hi, f_hi)
+        f_lo = np.where(~neg & (side == 1), 0.5 * f_lo, f_lo)
+        lo, f_lo = np.where(neg, x, lo), np.where(neg, fx, f_lo)
+        hi, f_hi = np.where(neg, hi, x), np.where(neg, f_hi, fx)
+        side = np.where(neg, -1, 1).astype(np.int8)
+    return x
+
+
+def _canonical_pieces(sh: SBendShape):
+    """Zero-curvature ends, ``e1``, ``e2`` (shape (k, 6, 2) each), signed rates and
+    lengths (shape (k, 6)) of the six pieces in the canonical frame."""
+    th, h, d_p = sh.theta, sh.turn, sh.pair_distance
+    u = np.stack((np.cos(th), -np.sin(th)), axis=1)
+    nrm = np.stack((np.sin(th), np.cos(th)), axis=1)
+    xq1, yq1, _, _ = ramp_offset(sh.r_in, sh.ramp_in)
+    xq2, yq2, _, _ = ramp_offset(sh.r_out, sh.ramp_out)
+    # the points where each ramp's line touches its arc (heading -theta)
+    j1 = np.stack((-sh.r_in * np.sin(th), 2.0 * sh.r_in * np.sin(0.5 * th) ** 2), axis=1)
+    q1 = j1 - xq1[:, None] * u + yq1[:, None] * nrm
+    ch, s_h = np.cos(h)[:, None], np.sin(h)[:, None]
+    p1 = q1 + (d_p[:, None] * (1.0 + ch)) * u + (d_p[:, None] * s_h) * nrm
+    q2 = q1 + (2.0 * d_p[:, None] * (1.0 + ch)) * u + (2.0 * d_p[:, None] * s_h) * nrm
+    heading = ch * u + s_h * nrm                      # between the pairs
+    # e2: the side each piece bends towards (its centre of curvature): ramp A towards
+    # the first arc's centre, the first pair to the left, the second to the right,
+    # ramp B towards the second arc's centre
+    pts = [q1, q1, p1, p1, q2, q2]
+    e1s = [-u, u, -heading, heading, -u, u]
+    e2s = [nrm, nrm, ch * nrm - s_h * u, s_h * u - ch * nrm, -nrm, -nrm]
+    c = sh.rate
+    rates = np.stack((-1.0 / (sh.r_in * sh.ramp_in), c, -c, c, -c,
+                      1.0 / (sh.r_out * sh.ramp_out)), axis=1)
+    lengths = np.stack((sh.ramp_in, sh.piece, sh.piece, sh.piece, sh.piece, sh.ramp_out),
+                       axis=1)
+    return (np.stack(pts, axis=1), np.stack(e1s, axis=1), np.stack(e2s, axis=1), rates,
+            lengths)
+
+
+def _clothoid_xy(origin, e1, e2, rate, length, s_local):
+    """Positions on clothoid pieces at distances ``s_local`` from each piece's start
+    (the model of :mod:`reference.core.geometry`, positions only); ``origin``, ``e1``,
+    ``e2`` shape (..., 2), the rest shape (...)."""
+    c = np.abs(rate)
+    sigma = np.clip(np.where(rate < 0, length - s_local, s_local), 0.0, length)
+    scale = np.sqrt(np.pi / c)
+    fs, fc = _fresnel(sigma / scale)
+    return (origin + (scale * fc)[..., None] * e1 + (scale * fs)[..., None] * e2)
+
+
+def _samples(pieces, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n + 1`` evenly spaced points on each piece (both ends): distances from the
+    rounding's start, shape (k, 6 (n + 1)), and canonical points, shape (k, 6 (n + 1),
+    2)."""
+    origin, e1, e2, rates, lengths = pieces
+    k = rates.shape[0]
+    s_local = lengths[:, :, None] * np.linspace(0.0, 1.0, n + 1)[None, None, :]
+    xy = _clothoid_xy(origin[:, :, None, :], e1[:, :, None, :], e2[:, :, None, :],
+                      rates[:, :, None], lengths[:, :, None], s_local)
+    starts = np.cumsum(lengths, axis=1) - lengths
+    return (starts[:, :, None] + s_local).reshape(k, -1), xy.reshape(k, -1, 2)
+
+
+def _points(pieces, s: np.ndarray) -> np.ndarray:
+    """Canonical points at distances ``s`` (shape (k, N)) from the rounding's start,
+    shape (k, N, 2)."""
+    origin, e1, e2, rates, lengths = pieces
+    ends = np.cumsum(lengths, axis=1)
+    idx = np.minimum((s[:, :, None] >= ends[:, None, :]).sum(axis=2), SBEND_PIECES - 1)
+
+    def take(a):
+        if a.ndim == 3:
+            return np.take_along_axis(a, idx[:, :, None], axis=1)
+        return np.take_along_axis(a, idx, axis=1)
+
+    start = take(ends - lengths)
+    return _clothoid_xy(take(origin), take(e1), take(e2), take(rates), take(lengths),
+                        s - start)
+
+
+def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray) -> np.ndarray:
+    """Distance of canonical points ``p`` (k, N, 2) from the programmed contour: the
+    first arc (``x <= 0`` near ``J``) and the second (``x >= 0``); where a point's
+    radial projection falls beyond an arc's end at ``J``, that arc's nearest point is
+    ``J``."""
+    x, y = p[..., 0], p[..., 1]
+    at_j = np.hypot(x, y)
+    d1 = np.where(x <= 0, np.abs(np.hypot(x, y - r_in[:, None]) - r_in[:, None]), at_j)
+    d2 = np.where(x >= 0, np.abs(np.hypot(x, y + r_out[:, None]) - r_out[:, None]), at_j)
+    return np.minimum(d1, d2)
+
+
+def sbend_deviation(sh: SBendShape) -> np.ndarray:
+    """Largest distance of the rounding from the programmed arcs, mm, shape (k,)
+    (module docstring: sampled, then refined on finer grids)."""
+    pieces = _canonical_pieces(sh)
+    lengths = pieces[4]
+    k = sh.rate.size
+    s, xy = _samples(pieces, DEV_SAMPLES)
+    dev = _distance(xy, sh.r_in, sh.r_out)
+    i = dev.argmax(axis=1)
+    rows = np.arange(k)
+    best, at = dev[rows, i], s[rows, i]
+    total = lengths.sum(axis=1)
+    # the maximum lies within one sample spacing of the best sample: each round covers
+    # that span with REFINE_POINTS points and shrinks it by REFINE_SHRINK
+    h = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), SBEND_PIECES - 1)] / DEV_SAMPLES
+    off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
+    for _ in range(REFINE_ROUNDS):
+        x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
+        d = _distance(_points(pieces, x), sh.r_in, sh.r_out)
+        j = d.argmax(axis=1)
+        better = d[rows, j] > best
+        best = np.where(better, d[rows, j], best)
+        at = np.where(better, x[rows, j], at)
+        h = h / REFINE_SHRINK
+    # the maximum is smooth (a distance from one arc): the vertex of the parabola
+    # through the best point and its neighbours at the last spacing
+    x = np.clip(at[:, None] + h[:, None] * np.array([-1.0, 1.0])[None, :], 0.0,
+                total[:, None])
+    nb = _distance(_points(pieces, x), sh.r_in, sh.r_out)
+    curv = nb[:, 0] + nb[:, 1] - 2.0 * best
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = at + 0.5 * h * (nb[:, 0] - nb[:, 1]) / curv
+    v = np.where((curv < 0) & (np.abs(v - at) <= h), v, at)
+    top = _distance(_points(pieces, np.clip(v, 0.0, total)[:, None]), sh.r_in, sh.r_out)
+    return np.maximum(np.maximum(best, top[:, 0]), nb.max(axis=1))
+
+
+def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
+                deviation: bool = True) -> SBendShape:
+    """The S-bend transition of rate ``rate`` between arcs of radii ``r_in``, ``r_out``.
+
+    Parameters
+    ----------
+    r_in, r_out, rate : numpy.ndarray, shape (k,)
+        mm, mm, 1/mm^2.
+    deviation : bool
+        Also measure the deviation (else ``nan``).
+
+    Returns
+    -------
+    SBendShape
+        ``theta`` is ``nan`` where no heading up to :data:`THETA_MAX` lands (pieces too
+        long for the radii).
+    """
+    r_in, r_out, rate = (np.asarray(v, dtype=np.float64) for v in (r_in, r_out, rate))
+    l1 = l2 = 1.0 / (np.minimum(r_in, r_out) * rate)
+    xq1, yq1, _, _ = ramp_offset(r_in, l1)
+    xq2, yq2, _, _ = ramp_offset(r_out, l2)
+    xq, yq = xq1 + xq2, yq1 + yq2
+    lo = np.zeros_like(rate)
+    hi = np.minimum(THETA_GUESS * (l1 + l2) / (r_in + r_out), THETA_MAX)
+    f_lo = _s_of(lo, r_in, r_out, rate, xq, yq)[0]
+    f_hi = _s_of(hi, r_in, r_out, rate, xq, yq)[0]
+    wide = ~(f_hi > 0)
+    if wide.any():
+        hi = np.where(wide, THETA_MAX, hi)
+        f_hi = np.where(wide, _s_of(hi, r_in, r_out, rate, xq, yq)[0], f_hi)
+    ok = (f_lo < 0) & (f_hi > 0)
+    theta = np.full_like(rate, np.nan)
+    if ok.any():
+        sel = (r_in[ok], r_out[ok], rate[ok], xq[ok], yq[ok])
+        theta[ok] = _illinois(lambda t: _s_of(t, *sel)[0], lo[ok], hi[ok], f_lo[ok],
+                              f_hi[ok], THETA_TOL, LANDING_TOL_MM)
+    t = np.where(ok, theta, 0.0)
+    _, l_s, h, d_p = _s_of(t, r_in, r_out, rate, xq, yq)
+    sh = SBendShape(r_in, r_out, rate, l1, l2, l_s, h, d_p, theta, theta * r_in + 0.5 * l1,
+                    theta * r_out + 0.5 * l2, np.full_like(rate, np.nan),
+                    l1 + l2 + 4.0 * l_s,
+                    np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_s)))
+    if deviation and ok.any():
+        dev = np.full_like(rate, np.nan)
+        dev[ok] = sbend_deviation(_take(sh, np.flatnonzero(ok)))
+        sh = _replace(sh, deviation=dev)
+    return sh
+
+
+def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
+                        ) -> SBendShape:
+    """The S-bend transitions that deviate from the arcs by ``deviation``.
+
+    The deviation grows about like ``1/c^2`` (all lengths scale like ``1/c``, the
+    deviation like their square over the radius): Newton steps in ``log c`` with the
+    slope measured by the last two (secant; -2 at first), from the small-angle estimate
+    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``), each
+    step only for the transitions not yet done; a rate for which no heading lands
+    (pieces far too long) is raised by :data:`RATE_BRACKET_STEP`. The aim is
+    ``deviation (1 - DEVIATION_REL_TOL)``, met to half of that margin: the result never
+    exceeds ``deviation`` and is at most ``1.5 DEVIATION_REL_TOL`` below it.
+
+    Parameters
+    ----------
+    r_in, r_out, deviation : numpy.ndarray, shape (k,)
+        mm (``deviation > 0``).
+
+    Returns
+    -------
+    SBendShape
+    """
+    r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
+                              for v in (r_in, r_out, deviation))
+    aim = np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
+    x = 0.5 * np.log(1.8 / (np.minimum(r_in, r_out) ** 3 * deviation))
+    sh = sbend_shape(r_in, r_out, np.exp(x))
+    gx = np.log(sh.deviation) - aim                   # nan: no landing heading
+    x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
+    for _ in range(ROOT_MAX_ITER):
+        todo = np.flatnonzero(~(np.abs(gx) <= 0.5 * DEVIATION_REL_TOL))
+        if not todo.size:
+            break
+        xs, gs = x[todo], gx[todo]
+        lost = np.isnan(gs)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = (gs - g_old[todo]) / (xs - x_old[todo])
+        # the secant slope where it is sane (the deviation falls with the rate), else -2
+        slope = np.where((slope < -0.5) & (slope > -8.0), slope, -2.0)
+        step = np.where(lost, np.log(RATE_BRACKET_STEP), -gs / slope)
+        x_old[todo] = np.where(lost, x_old[todo], xs)
+        g_old[todo] = np.where(lost, g_old[todo], gs)
+        x[todo] = xs + step
+        part = sbend_shape(r_in[todo], r_out[todo], np.exp(x[todo]))
+        sh = _scatter(sh, todo, part)
+        gx[todo] = np.log(part.deviation) - aim[todo]
+    return sh
+
+
+def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
+               sh: SBendShape, block: np.ndarray, kind_code: int) -> dict[str, np.ndarray]:
+    """Packed rows of the transitions, :data:`SBEND_PIECES` per transition in path order.
+
+    Parameters
+    ----------
+    junction : numpy.ndarray, shape (k, n)
+        Where the arcs meet.
+    along : numpy.ndarray, shape (k, n)
+        Unit tangent there, in the direction of travel.
+    inward : numpy.ndarray, shape (k, n)
+        Unit normal towards the first arc's centre.
+    sh : SBendShape
+    block : numpy.ndarray of int, shape (k,)
+    kind_code : int
+
+    Returns
+    -------
+    dict
+        Keys of :class:`reference.core.geometry.Path` rows, plus ``sharpness``.
+    """
+    k, n = junction.shape
+    pts, e1c, e2c, rates, lengths = _canonical_pieces(sh)
+
+    def world(xy, offset):
+        return (offset[:, None, :] + xy[..., 0:1] * along[:, None, :]
+                + xy[..., 1:2] * inward[:, None, :])
+
+    origin = world(pts, junction)
+    zero = np.zeros_like(junction)
+    e1, e2 = world(e1c, zero), world(e2c, zero)
+    kmax = np.abs(rates) * lengths
+    m = k * SBEND_PIECES
+    return {
+        "origin": origin.reshape(m, n), "e1": e1.reshape(m, n), "e2": e2.reshape(m, n),
+        "d": np.zeros((m, n)), "radius": (1.0 / kmax).ravel(), "omega": kmax.ravel(),
+        "theta0": np.zeros(m), "length": lengths.ravel(),
+        "block": np.repeat(np.asarray(block, np.int64), SBEND_PIECES),
+        "kind": np.full(m, kind_code, dtype=np.int8), "dradius": np.zeros(m),
+        "sharpness": rates.ravel(),
+    }
+
+
+def _take(sh: SBendShape, i: np.ndarray) -> SBendShape:
+    return SBendShape(*(getattr(sh, f)[i] for f in SBendShape.__slots__))
+
+
+def _scatter(sh: SBendShape, i: np.ndarray, part: SBendShape) -> SBendShape:
+    """``sh`` with the transitions ``i`` replaced by ``part``."""
+    out = []
+    for f in SBendShape.__slots__:
+        a = getattr(sh, f).copy()
+        a[i] = getattr(part, f)
+        out.append(a)
+    return SBendShape(*out)
+
+
+def _replace(sh: SBendShape, **kw) -> SBendShape:
+    return SBendShape(*(kw.get(f, getattr(sh, f)) for f in SBendShape.__slots__))
+
+
+__all__ = ["SBEND_PIECES", "SBendShape", "sbend_deviation", "sbend_for_deviation",
+           "sbend_rows", "sbend_shape"]
