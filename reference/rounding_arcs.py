@@ -69,12 +69,10 @@ from .core.rounding import (REASON_CODE, axis_deviation_limit, circle_circle_fil
                             fillet_radius_for_arc_trim, fillet_radius_for_deviation,
                             fillet_radius_for_line_trim, line_circle_fillet)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
-from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
+from .core.tolerances import MIN_SEGMENT_LENGTH_MM
 from .machine import Machine
 from .rounding_tangential import line_arc_pairs
 
-_LINE = KIND_CODES.index("line")
-_ARC = KIND_CODES.index("arc")
 _ROUNDING = KIND_CODES.index("rounding")
 
 #: A line counts as lying in its arc's plane, and a second arc in the first's, when its
@@ -182,8 +180,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     ArcCorners
     """
     k = a.size
-    b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
-    arc_arc = (path.kind[a] == _ARC) & (path.kind[b] == _ARC)
+    b, line_arc, arc_line, arc_arc, arc, line, circle = line_arc_pairs(path, a)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
@@ -203,7 +200,6 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         row_norms(E1b - row_dots(E1b, E1)[:, None] * E1 - row_dots(E1b, E2)[:, None] * E2),
         row_norms(E2b - row_dots(E2b, E1)[:, None] * E1 - row_dots(E2b, E2)[:, None] * E2))
     off = np.where(arc_arc, off_b, off)
-    circle = _is_circle(path, arc) & np.where(arc_arc, _is_circle(path, b), True)
     decide(~circle | ~(off <= OFF_PLANE_MAX),
            "corner next to a helix or spiral, or out of the arc's plane: rounding not "
            "modelled yet")
@@ -368,12 +364,6 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], fw, ka[ins])
     return ArcCorners(reason, trim_in, trim_out, radius_out, length_out, dev_out,
                       clamped & (reason == 0), v_g64, v_round, rows)
-
-
-def _is_circle(path: Path, i: np.ndarray) -> np.ndarray:
-    """Segments ``i`` are circular arcs (no spiral, no clothoid, no helical lead)."""
-    return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
-            & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
 
 
 def _circle_pair(path: Path, a: np.ndarray, b: np.ndarray, E1: np.ndarray, E2: np.ndarray,

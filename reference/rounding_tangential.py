@@ -121,7 +121,8 @@ class Transitions:
 
 
 def line_arc_pairs(path: Path, a: np.ndarray):
-    """The two segments at breaks ``a``/``a + 1`` as a line and an arc, when they are.
+    """The two segments at breaks ``a``/``a + 1`` as a line and an arc, or two arcs, when
+    they are; the one classification of the G645 transitions and of the arc corners.
 
     Parameters
     ----------
@@ -133,17 +134,28 @@ def line_arc_pairs(path: Path, a: np.ndarray):
     -------
     b : numpy.ndarray of int, shape (k,)
         ``a + 1``.
-    line_arc, arc_line : numpy.ndarray of bool, shape (k,)
-        A line into an arc, an arc into a line.
+    line_arc, arc_line, arc_arc : numpy.ndarray of bool, shape (k,)
+        A line into an arc, an arc into a line, an arc into an arc.
     arc, line : numpy.ndarray of int, shape (k,)
-        Which of the two is the arc and which the line (meaningful where either flag is
-        set).
+        Which of the two is the arc and which the line (meaningful where a flag is set;
+        two arcs: the first and the second).
+    circle : numpy.ndarray of bool, shape (k,)
+        Its arc (both, for two arcs) is a circular arc: no spiral, clothoid or helical
+        lead.
     """
     b = a + 1
     kind_a, kind_b = path.kind[a], path.kind[b]
     line_arc = (kind_a == _LINE) & (kind_b == _ARC)
     arc_line = (kind_a == _ARC) & (kind_b == _LINE)
-    return b, line_arc, arc_line, np.where(line_arc, b, a), np.where(line_arc, a, b)
+    arc_arc = (kind_a == _ARC) & (kind_b == _ARC)
+    arc, line = np.where(line_arc, b, a), np.where(line_arc, a, b)
+
+    def is_circle(i: np.ndarray) -> np.ndarray:
+        return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
+                & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+
+    circle = is_circle(arc) & np.where(arc_arc, is_circle(b), True)
+    return b, line_arc, arc_line, arc_arc, arc, line, circle
 
 def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                            accel: np.ndarray, centripetal_share: float,
@@ -172,19 +184,13 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     Transitions
     """
     k = a.size
-    b, line_arc, arc_line, arc, line = line_arc_pairs(path, a)
-    arc_arc = (path.kind[a] == _ARC) & (path.kind[b] == _ARC)
+    b, line_arc, arc_line, arc_arc, arc, line, circle = line_arc_pairs(path, a)
     reason = np.full(k, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
         reason[(reason < 0) & mask] = REASON_CODE[why]
 
-    def is_circle(i: np.ndarray) -> np.ndarray:
-        return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
-                & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
-
     decide(~(line_arc | arc_line | arc_arc), _BETWEEN_ARCS)
-    circle = is_circle(arc) & np.where(arc_arc, is_circle(b), True)
     decide(~circle, "tangential transition into a helix or spiral: rounding not "
            "modelled yet")
     decide(accel != "SOFT", "curvature jump allowed under BRISK (acceleration step)")

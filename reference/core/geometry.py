@@ -323,12 +323,39 @@ def clothoid_pieces(start: np.ndarray, t_in: np.ndarray, t_out: np.ndarray,
     origin[0::2], e1[0::2], e2[0::2] = start, t_in, nor
     origin[1::2], e1[1::2], e2[1::2] = end, -t_out, back_n
     rep = np.repeat
+    return clothoid_rows(origin, e1, e2, np.column_stack((c, -c)).ravel(),
+                         rep(half_length, 2), rep(np.asarray(block, np.int64), 2), kind_code,
+                         kmax=rep(kmax, 2))
+
+
+def clothoid_rows(origin: np.ndarray, e1: np.ndarray, e2: np.ndarray, sharpness: np.ndarray,
+                  length: np.ndarray, block: np.ndarray, kind_code: int,
+                  kmax: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Packed rows (keys of :class:`Path`, plus ``sharpness``) of clothoid pieces whose
+    curvature is zero at their origin: the one packing of every inserted clothoid
+    (rounding pairs, G645 transitions).
+
+    Parameters
+    ----------
+    origin, e1, e2 : numpy.ndarray, shape (m, n)
+        Zero-curvature end, unit tangent and unit normal there (the side it turns to).
+    sharpness : numpy.ndarray, shape (m,)
+        Curvature rate, 1/mm^2 (negative: traversed towards the zero-curvature end).
+    length : numpy.ndarray, shape (m,)
+        Piece lengths, mm.
+    block : numpy.ndarray of int, shape (m,)
+    kind_code : int
+    kmax : numpy.ndarray, shape (m,), optional
+        Largest curvature, 1/mm (default ``|sharpness| length``; a caller that has it
+        from its construction passes it, so its rows stay as they were).
+    """
+    m, n = origin.shape
+    kmax = np.abs(sharpness) * length if kmax is None else kmax
     return {
-        "origin": origin, "e1": e1, "e2": e2, "d": np.zeros((2 * k, n)),
-        "radius": rep(1.0 / kmax, 2), "omega": rep(kmax, 2), "theta0": np.zeros(2 * k),
-        "length": rep(half_length, 2), "block": rep(np.asarray(block, np.int64), 2),
-        "kind": np.full(2 * k, kind_code, dtype=np.int8), "dradius": np.zeros(2 * k),
-        "sharpness": np.column_stack((c, -c)).ravel(),
+        "origin": origin, "e1": e1, "e2": e2, "d": np.zeros((m, n)),
+        "radius": 1.0 / kmax, "omega": kmax, "theta0": np.zeros(m), "length": length,
+        "block": np.asarray(block, np.int64), "kind": np.full(m, kind_code, dtype=np.int8),
+        "dradius": np.zeros(m), "sharpness": sharpness,
     }
 
 

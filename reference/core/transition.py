@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import _fresnel, clothoid_pair_shape
+from .geometry import _fresnel, clothoid_pair_shape, clothoid_rows
 
 #: Fixed-point iterations stop when the relative change is below this (the solved
 #: quantities then agree with their defining equations to a few units of round-off).
@@ -258,16 +258,10 @@ def transition_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
         e2[rev] = e2[rev, ::-1]
         sharp[rev] = -sharp[rev, ::-1]
         length[rev] = length[rev, ::-1]
-    kmax = np.abs(sharp) * length
     m = k * PIECES
-    return {
-        "origin": origin.reshape(m, n), "e1": e1.reshape(m, n), "e2": e2.reshape(m, n),
-        "d": np.zeros((m, n)), "radius": (1.0 / kmax).ravel(), "omega": kmax.ravel(),
-        "theta0": np.zeros(m), "length": length.ravel(),
-        "block": np.repeat(np.asarray(block, np.int64), PIECES),
-        "kind": np.full(m, kind_code, dtype=np.int8), "dradius": np.zeros(m),
-        "sharpness": sharp.ravel(),
-    }
+    return clothoid_rows(origin.reshape(m, n), e1.reshape(m, n), e2.reshape(m, n),
+                         sharp.ravel(), length.ravel(),
+                         np.repeat(np.asarray(block, np.int64), PIECES), kind_code)
 
 
 __all__ = ["PIECES", "TransitionShape", "ramp_for_deviation", "ramp_offset", "s_shift",

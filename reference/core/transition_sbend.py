@@ -62,7 +62,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import _fresnel
+from .geometry import _fresnel, clothoid_rows
 from .transition import ramp_offset, s_shift
 
 #: Pieces per S-bend transition: ramp A, the S's four pieces, ramp B.
@@ -434,16 +434,10 @@ def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
     origin = world(pts, junction)
     zero = np.zeros_like(junction)
     e1, e2 = world(e1c, zero), world(e2c, zero)
-    kmax = np.abs(rates) * lengths
     m = k * SBEND_PIECES
-    return {
-        "origin": origin.reshape(m, n), "e1": e1.reshape(m, n), "e2": e2.reshape(m, n),
-        "d": np.zeros((m, n)), "radius": (1.0 / kmax).ravel(), "omega": kmax.ravel(),
-        "theta0": np.zeros(m), "length": lengths.ravel(),
-        "block": np.repeat(np.asarray(block, np.int64), SBEND_PIECES),
-        "kind": np.full(m, kind_code, dtype=np.int8), "dradius": np.zeros(m),
-        "sharpness": rates.ravel(),
-    }
+    return clothoid_rows(origin.reshape(m, n), e1.reshape(m, n), e2.reshape(m, n),
+                         rates.ravel(), lengths.ravel(),
+                         np.repeat(np.asarray(block, np.int64), SBEND_PIECES), kind_code)
 
 
 def _take(sh: SBendShape, i: np.ndarray) -> SBendShape:

@@ -20,6 +20,19 @@ def polyline(n: int, seed: int) -> str:
 
 
 
+def _tangent_arc(x: float, y: float, heading: float, r: float, turn: float):
+    """The arc of radius ``r`` leaving ``(x, y)`` along ``heading`` (rad) and turning by
+    ``turn`` (rad, > 0 counter-clockwise): its word (``G2``/``G3``, end, centre as ``I J``,
+    12 decimals), its end and the heading there."""
+    side = np.sign(turn)                            # +1: counter-clockwise (G3)
+    cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
+    i_, j_ = cx - x, cy - y
+    heading += turn
+    x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
+    word = "G3" if side > 0 else "G2"
+    return f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}", x, y, heading
+
+
 def line_arc_chain(n: int, seed: int, kink_deg: float = 0.0) -> str:
     """``n`` seeded blocks alternating a line of 1..5 mm and an arc tangent to it (radius
     1..20 mm, turning 10..120 degrees, either way), each line tangent to the arc before
@@ -42,13 +55,8 @@ def line_arc_chain(n: int, seed: int, kink_deg: float = 0.0) -> str:
             continue
         r = rng.uniform(1.0, 20.0)
         turn = np.radians(rng.uniform(10.0, 120.0)) * rng.choice((-1.0, 1.0))
-        side = np.sign(turn)                        # +1: counter-clockwise (G3)
-        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
-        i_, j_ = cx - x, cy - y
-        heading += turn
-        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
-        word = "G3" if side > 0 else "G2"
-        out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
+        word, x, y, heading = _tangent_arc(x, y, heading, r, turn)
+        out.append(word)
     return "\n".join(out) + "\nM30\n"
 
 
@@ -63,13 +71,8 @@ def arc_chain(n: int, seed: int, kink_deg: float = 60.0) -> str:
         heading += np.radians(rng.uniform(kink_deg / 2, kink_deg)) * rng.choice((-1.0, 1.0))
         r = rng.uniform(1.0, 20.0)
         turn = np.radians(rng.uniform(10.0, 120.0)) * rng.choice((-1.0, 1.0))
-        side = np.sign(turn)                        # +1: counter-clockwise (G3)
-        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
-        i_, j_ = cx - x, cy - y
-        heading += turn
-        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
-        word = "G3" if side > 0 else "G2"
-        out.append(f"{word} X{x:.12f} Y{y:.12f} I{i_:.12f} J{j_:.12f}")
+        word, x, y, heading = _tangent_arc(x, y, heading, r, turn)
+        out.append(word)
     return "\n".join(out) + "\nM30\n"
 
 
@@ -83,11 +86,7 @@ def s_bend_chain(n: int, seed: int, r_min: float = 20.0, r_max: float = 200.0) -
     for _ in range(n):
         r = rng.uniform(r_min, r_max)
         turn = np.radians(rng.uniform(20.0, 60.0)) * side
-        cx, cy = x - side * r * np.sin(heading), y + side * r * np.cos(heading)
-        i_, j_ = cx - x, cy - y
-        heading += turn
-        x, y = cx + side * r * np.sin(heading), cy - side * r * np.cos(heading)
-        out.append(f"{'G3' if side > 0 else 'G2'} X{x:.12f} Y{y:.12f} I{i_:.12f} "
-                   f"J{j_:.12f}")
+        word, x, y, heading = _tangent_arc(x, y, heading, r, turn)
+        out.append(word)
         side = -side
     return "\n".join(out) + "\nM30\n"
