@@ -857,3 +857,26 @@ def node_bounds_on(new: Grid, old: Grid, b_hat: np.ndarray, b_bar: np.ndarray
     on_old = old.s[idx] == new.s
     k = np.clip(idx - 1, 0, b_bar.size - 1)
     return np.where(on_old, b_hat[idx], b_bar[k])
+
+
+def speed_envelope_bounds(path: Path, lim: AxisArrays, grid: Grid
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pointwise speed bounds valid for every feasible motion, from the relaxation on ``grid``.
+
+    ``b(s) <= min(B_k, b_hat_k + M_k (s - s_k), b_hat_{k+1} + M_k (s_{k+1} - s))`` on
+    interval ``k`` for every motion of the continuous problem (steps 1 and 3 of the module
+    docstring: ``b_hat`` is the greatest element of the relaxation, ``B_k`` the interval
+    bound sharpened by it, ``M_k`` the slope bound of ``b``).
+
+    Returns
+    -------
+    b_hat : numpy.ndarray, shape (N + 1,)
+        mm^2/s^2.
+    B : numpy.ndarray, shape (N,)
+        mm^2/s^2 (``inf`` where nothing bounds it).
+    M : numpy.ndarray, shape (N,)
+        mm/s^2 (``inf`` where nothing bounds it).
+    """
+    _, _, rel, b_hat = lower_bound(path, lim, grid)
+    geo = _interval_data(path, lim, grid)
+    return b_hat, np.minimum(rel.b_bar, _monotone_peak(geo, b_hat)), rel.slope

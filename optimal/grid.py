@@ -224,3 +224,29 @@ def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces=2) -> Grid:
         rem = np.where(cut, rem // 2, rem)[parent]
         out = new
     return out
+
+
+def grid_from_nodes(path: Path, s: np.ndarray) -> Grid:
+    """Grid through given nodes (an oracle's final grid, kept as an array of nodes).
+
+    Parameters
+    ----------
+    path : Path
+        The path the nodes lie on.
+    s : numpy.ndarray, shape (N + 1,)
+        Strictly increasing nodes from 0 to the path length that include every segment
+        break, mm.
+
+    Returns
+    -------
+    Grid
+    """
+    s = np.asarray(s, dtype=np.float64)
+    brk = path.s_breaks
+    node = np.searchsorted(s, brk)
+    node = np.minimum(node, s.size - 1)
+    # breaks are nodes by construction; round-off of a few ulp is matched to the nearest
+    near = np.abs(s[np.maximum(node - 1, 0)] - brk) < np.abs(s[node] - brk)
+    node = np.where(near, np.maximum(node - 1, 0), node)
+    seg = np.repeat(np.arange(path.n_segments), np.diff(node))
+    return Grid(s=s, segment=seg, break_node=node)

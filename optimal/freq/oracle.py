@@ -35,6 +35,8 @@ from reference.core.rows import block_motion, block_rows
 
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
+from ..grid import grid_from_nodes
+from .humps import humps_bound
 from .lower import freq_lower_bound, segment_periods
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered, scaled,
                     verified)
@@ -146,6 +148,17 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             if c is not None:
                 cands.append(c)
     t_check = time.perf_counter() - tc
+    if cands and (min(c.duration for c in cands) + hold_t - lb) > tol * lb:
+        # the frequency rule over the whole path (optimal.freq.humps), from the acc
+        # relaxation's speed envelope; a verified upper bound limits the motions it must
+        # hold for (slower ones are not the minimum), which bounds the drift of the
+        # phases' threshold
+        tb = time.perf_counter()
+        t_up = min(c.duration for c in cands)
+        lb_humps = humps_bound(work, sub_lim, grid_from_nodes(work, acc.grid), t_up)
+        t_bound += time.perf_counter() - tb
+        if lb_humps + hold_t > lb:
+            lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)
     inner = (base_sol,) if acc is base_sol else (base_sol, acc)
     common = dict(grid=base_sol.grid, grid_points=base_sol.grid_points, iterations=base_sol.iterations,
                   backend=base_sol.backend, build_time_s=sum(x.build_time_s for x in inner),
