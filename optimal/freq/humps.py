@@ -56,10 +56,10 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    the pieces carry no ``g`` or ``LT`` term. The shortest path over the states "valley /
    peak / rising cut / falling cut in cell ``k``" with these edge costs is therefore at
    most the time of every motion with ``T <= T_up``, as long as every motion is one of
-   its paths. A path may leave out edges for strength and still have that: edges reach
-   ``K`` cells, enough for ``2 HUMP_CHAIN_PERIODS + 2`` periods at the speeds ``hi``
-   from every start, and a piece ending in a cut must hold ``HUMP_CHAIN_PERIODS`` periods
-   of ``R`` (``R >= sum ds / hi``), so every stretch longer than ``K`` cells splits into
+   its paths. A path may leave out edges for strength and still have that: edges from
+   each cell reach ``2 HUMP_CHAIN_PERIODS + 2`` periods at the speeds ``hi`` (and two
+   cells more), and a piece ending in a cut must hold ``HUMP_CHAIN_PERIODS`` periods
+   of ``R`` (``R >= sum ds / hi``), so every stretch longer than that reach splits into
    such pieces and a last one within reach. Without that floor on the pieces, a chain of
    cuts could follow every dip of the envelope, as no hump could.
 
@@ -86,8 +86,9 @@ from ..bounds import speed_envelope_bounds
 from ..grid import Grid
 from .lower import segment_periods
 
-__all__ = ["HUMP_CELL_TIME_REL", "HUMP_MAX_CELLS", "HUMP_CHAIN_PERIODS", "Envelope",
-           "hump_lower_bound", "humps_bound", "speed_envelope"]
+__all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_REL",
+           "HUMP_MAX_CELLS", "HUMP_REFINE_MARGIN", "Envelope",
+           "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound", "speed_envelope"]
 
 #: Cells are cut so that each takes at most this fraction of its period at the fastest
 #: speed the envelope allows in it. Each turn leaves out its cell's time (step 4 of the
@@ -95,6 +96,15 @@ __all__ = ["HUMP_CELL_TIME_REL", "HUMP_MAX_CELLS", "HUMP_CHAIN_PERIODS", "Envelo
 #: 3 % of a hump's shortest time on uniform paths, while the programme's work grows as
 #: the cells' count times the window's.
 HUMP_CELL_TIME_REL = 0.02
+
+#: Cells of the first, coarse run (:func:`humps_bound`): five times fewer turns' worth of
+#: cells, about 25 times less work; its bound is some 10-15 % below the fine one where
+#: the rule decides (measured on the corpus), so the fine run follows only where the
+#: coarse bound comes within HUMP_REFINE_MARGIN of the best bound known.
+HUMP_COARSE_CELL_TIME_REL = 0.1
+
+#: See HUMP_COARSE_CELL_TIME_REL.
+HUMP_REFINE_MARGIN = 0.2
 
 #: Ceiling on the number of cells (work and memory of the programme: about
 #: ``cells x window`` float64 operations). Above it the cells get longer, which only
@@ -125,6 +135,8 @@ class Envelope:
         Shortest phase a motion may have in the cell, s.
     accel : float
         Bound on ``|s''|`` of every motion (``abar`` of step 2), mm/s^2.
+    interval : numpy.ndarray of int64, shape (N,), optional
+        Grid interval of each cell (for cutting cells further).
     """
 
     s: np.ndarray
@@ -132,6 +144,7 @@ class Envelope:
     lo: np.ndarray
     period: np.ndarray
     accel: float
+    interval: np.ndarray | None = None
 
 
 def _tent(x: np.ndarray, s0, s1, b0, b1, B, M) -> np.ndarray:
@@ -145,9 +158,77 @@ def _tent(x: np.ndarray, s0, s1, b0, b1, B, M) -> np.ndarray:
     return np.minimum(t, B)
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class _Tents:
+    """The relaxation's bound ``phi`` on every interval (step 1), for cutting cells."""
+
+    s: np.ndarray        # (N + 1,) nodes, mm
+    b0: np.ndarray       # (N,) node bound at the start, mm^2/s^2
+    b1: np.ndarray       # (N,) node bound at the end
+    B: np.ndarray        # (N,) interval bound
+    M: np.ndarray        # (N,) slope, inf where none
+    top: np.ndarray      # (N,) where the tent peaks, from the start, mm
+    period: np.ndarray   # (N,) shortest phase, s
+    accel: float         # abar, mm/s^2
+
+
+def _tents(path: Path, lim: AxisArrays, grid: Grid,
+           bounds: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> _Tents:
+    b_hat, B, M = bounds if bounds is not None else speed_envelope_bounds(path, lim, grid)
+    b_hat = np.maximum(b_hat, 0.0)
+    s = grid.s
+    D = np.diff(s)
+    b0, b1 = b_hat[:-1], b_hat[1:]
+    good = np.isfinite(M) & (M > 0)
+    Mg = np.where(good, M, np.inf)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        top = np.where(good, np.clip((b1 - b0 + Mg * D) / (2 * np.where(good, Mg, 1.0)),
+                                     0.0, D), 0.0)
+    per = segment_periods(path, lim)[grid.segment] / (1.0 + RATIO_TOL)
+    a_bar = 0.5 * float(np.max(M[np.isfinite(M)], initial=0.0)) * (1.0 + RATIO_TOL)
+    if not np.all(np.isfinite(M)):
+        a_bar = math.inf
+    return _Tents(s, b0, b1, B, Mg, top, per, a_bar)
+
+
+def _cells(t: _Tents, k: np.ndarray, x0: np.ndarray, x1: np.ndarray) -> Envelope:
+    """Cells ``[x0, x1]`` inside intervals ``k`` (in order, covering the path)."""
+    good = np.isfinite(t.M[k])
+    args = (t.s[k], t.s[k + 1], t.b0[k], t.b1[k], t.B[k], t.M[k])
+    f0 = _tent(x0, *args)
+    f1 = _tent(x1, *args)
+    apex = np.clip(t.s[k] + t.top[k], x0, x1)
+    # phi is concave: its top on the cell is at the tent's apex clipped to the cell, or
+    # B where the slope bounds nothing
+    hi = np.where(good, np.maximum(np.maximum(f0, f1), _tent(apex, *args)),
+                  np.maximum(np.maximum(f0, f1), t.B[k]))
+    lo = np.minimum(f0, f1)
+    # the checker's slack on every speed limit
+    scale = 1.0 + RATIO_TOL
+    return Envelope(s=np.concatenate((x0, [t.s[-1]])),
+                    hi=np.sqrt(np.maximum(hi, 0.0)) * scale,
+                    lo=np.sqrt(np.maximum(lo, 0.0)) * scale, period=t.period[k],
+                    accel=t.accel, interval=k)
+
+
+def _split(t: _Tents, k: np.ndarray, x0: np.ndarray, x1: np.ndarray,
+           pieces: np.ndarray) -> Envelope:
+    """Cells ``[x0, x1]`` of intervals ``k``, each cut into ``pieces`` equal cells."""
+    pieces = np.maximum(pieces.astype(np.int64), 1)
+    rep = np.repeat(np.arange(k.size), pieces)
+    first = np.concatenate(([0], np.cumsum(pieces)[:-1]))
+    j = np.arange(rep.size) - first[rep]
+    w = x1[rep] - x0[rep]
+    a = x0[rep] + w * (j / pieces[rep])
+    b = np.where(j + 1 == pieces[rep], x1[rep], x0[rep] + w * ((j + 1) / pieces[rep]))
+    return _cells(t, k[rep], a, b)
+
+
 def speed_envelope(path: Path, lim: AxisArrays, grid: Grid, *,
                    cell_time_rel: float = HUMP_CELL_TIME_REL,
-                   max_cells: int = HUMP_MAX_CELLS) -> Envelope:
+                   max_cells: int = HUMP_MAX_CELLS,
+                   bounds: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+                   ) -> Envelope:
     """Cells and their speed bounds from the ``acc`` relaxation on ``grid``.
 
     Parameters
@@ -163,62 +244,59 @@ def speed_envelope(path: Path, lim: AxisArrays, grid: Grid, *,
         Largest cell time at the envelope's speed, as a fraction of the cell's period.
     max_cells : int
         Ceiling on the number of cells.
+    bounds : tuple of numpy.ndarray, optional
+        :func:`optimal.bounds.speed_envelope_bounds` on ``grid`` when the caller has it.
 
     Returns
     -------
     Envelope
     """
-    b_hat, B, M = speed_envelope_bounds(path, lim, grid)
-    b_hat = np.maximum(b_hat, 0.0)
-    s = grid.s
-    D = np.diff(s)
-    b0, b1 = b_hat[:-1], b_hat[1:]
-    good = np.isfinite(M) & (M > 0)
-    Mg = np.where(good, M, np.inf)
-    # the tent's top inside each interval
-    with np.errstate(invalid="ignore", divide="ignore"):
-        top = np.where(good, np.clip((b1 - b0 + Mg * D) / (2 * np.where(good, Mg, 1.0)),
-                                     0.0, D), 0.0)
-    peak = np.minimum(_tent(s[:-1] + top, s[:-1], s[1:], b0, b1, B, Mg),
-                      np.where(good, np.inf, B))
-    peak = np.maximum(peak, np.minimum(np.maximum(b0, b1), B))
-    per = segment_periods(path, lim)[grid.segment] / (1.0 + RATIO_TOL)
-    fast = D / np.sqrt(np.where(peak > 0, peak, np.inf))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        want = np.where(per > 0, fast / (cell_time_rel * per), 1.0)
-    want = np.where(np.isfinite(want), want, 1.0)
-    pieces = np.clip(np.ceil(want), 1, None)
+    return _envelope(_tents(path, lim, grid, bounds), cell_time_rel, max_cells)
+
+
+def _envelope(t: _Tents, cell_time_rel: float, max_cells: int) -> Envelope:
+    whole = _cells(t, np.arange(t.b0.size), t.s[:-1], t.s[1:])
+    pieces = _pieces(whole, cell_time_rel)
     total = float(pieces.sum())
     if total > max_cells:
         # longer cells only weaken the bound; spread what the ceiling allows
-        pieces = np.clip(np.floor(pieces * (max_cells - D.size) / total), 0, None) + 1
-    pieces = pieces.astype(np.int64)
-    k = np.repeat(np.arange(D.size), pieces)
-    first = np.concatenate(([0], np.cumsum(pieces)[:-1]))
-    j = np.arange(k.size) - first[k]
-    x0 = s[k] + D[k] * (j / pieces[k])
-    x1 = np.where(j + 1 == pieces[k], s[k + 1], s[k] + D[k] * ((j + 1) / pieces[k]))
-    args = (s[k], s[k + 1], b0[k], b1[k], B[k], Mg[k])
-    f0 = _tent(x0, *args)
-    f1 = _tent(x1, *args)
-    apex = np.clip(s[k] + top[k], x0, x1)
-    hi = np.maximum(np.maximum(f0, f1), np.minimum(_tent(apex, *args),
-                                                   np.where(good[k], np.inf, B[k])))
-    hi = np.where(good[k], hi, np.maximum(np.maximum(f0, f1), B[k]))
-    lo = np.minimum(f0, f1)
-    cells = np.concatenate((x0, [s[-1]]))
-    # the checker's slack on every speed limit
-    scale = 1.0 + RATIO_TOL
-    a_bar = 0.5 * float(np.max(M[np.isfinite(M)], initial=0.0)) * scale
-    if not np.all(np.isfinite(M)):
-        a_bar = math.inf
-    return Envelope(s=cells, hi=np.sqrt(np.maximum(hi, 0.0)) * scale,
-                    lo=np.sqrt(np.maximum(lo, 0.0)) * scale, period=per[k], accel=a_bar)
+        pieces = np.clip(np.floor(pieces * (max_cells - pieces.size) / total), 0, None) + 1
+    return _split(t, whole.interval, whole.s[:-1], whole.s[1:], pieces)
 
 
-def hump_lower_bound(env: Envelope, drift: float = 0.0,
-                     chain: float = HUMP_CHAIN_PERIODS) -> float:
-    """The shortest path of step 4 of the module docstring, s.
+def _pieces(env: Envelope, cell_time_rel: float) -> np.ndarray:
+    """Pieces per cell for cells of at most ``cell_time_rel`` periods at speed ``hi``."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        want = np.diff(env.s) / env.hi / (cell_time_rel * env.period)
+    want = np.where(np.isfinite(want) & (env.period > 0), want, 1.0)
+    return np.clip(np.ceil(want), 1, None)
+
+
+@dataclass(frozen=True, slots=True)
+class HumpPlan:
+    """The shortest path of step 4: its length and where it turns.
+
+    Attributes
+    ----------
+    time_s : float
+        Lower bound on the motion time over the cells, holds excluded, s.
+    valleys, peaks : numpy.ndarray of int64
+        Cells of the path's valleys (first and last cell included) and peaks, in order;
+        one more valley than peaks. Empty when the programme has no path.
+    """
+
+    time_s: float
+    valleys: np.ndarray
+    peaks: np.ndarray
+
+
+# state kinds of the programme, for the way back
+_VALLEY, _PEAK, _RISE_CUT, _FALL_CUT = 0, 1, 2, 3
+
+
+def hump_plan(env: Envelope, drift: float = 0.0,
+              chain: float = HUMP_CHAIN_PERIODS) -> HumpPlan:
+    """The shortest path of step 4 of the module docstring, with its turns.
 
     Parameters
     ----------
@@ -231,13 +309,13 @@ def hump_lower_bound(env: Envelope, drift: float = 0.0,
 
     Returns
     -------
-    float
-        Lower bound on the motion time over the cells, holds excluded, s.
+    HumpPlan
     """
     ds = np.diff(env.s)
     N = ds.size
+    none = np.zeros(0, np.int64)
     if N < 3:
-        return 0.0
+        return HumpPlan(0.0, none, none)
     hi = env.hi + 2.0 * drift
     lo = np.minimum(env.lo, env.hi) + 2.0 * drift
     g = env.period
@@ -246,19 +324,39 @@ def hump_lower_bound(env: Envelope, drift: float = 0.0,
     # reach of the edges: from every start, 2 chain + 2 of the largest period at speed hi
     cum = np.concatenate(([0.0], np.cumsum(fast)))
     need = (2.0 * chain + 2.0) * float(np.max(g))
-    reach = np.searchsorted(cum, cum[:-1] + need, side="left")
-    K = int(min(N - 1, max(2, int(np.max(reach - np.arange(N))) + 2)))
+    # edges from cell i reach cell last[i]; last is nondecreasing, so the cells whose
+    # edges reach c start at first[c]
+    last = np.minimum(np.searchsorted(cum, cum[:-1] + need, side="left") + 2, N - 1)
+    first = np.searchsorted(last, np.arange(N), side="left")
     inf = math.inf
-    V = np.full(N, inf)    # valley in cell k
-    P = np.full(N, inf)    # peak in cell k
-    U = np.full(N, inf)    # rising stretch cut in cell k
-    Dn = np.full(N, inf)   # falling stretch cut in cell k
+    # cost of the best path to each state, and its predecessor (kind, cell) for the way
+    # back: rows valley, peak, rising cut, falling cut
+    cost = np.full((4, N), inf)
+    pred_kind = np.full((4, N), -1, np.int8)
+    pred_cell = np.full((4, N), -1, np.int64)
+    V, P, U, Dn = cost
     V[0] = 0.0
+
+    def pull(row: int, c: int, a: np.ndarray, b: np.ndarray, i: np.ndarray) -> None:
+        """cost[row, c] = min over i of (a, from a valley; b, from a rising cut)."""
+        ka, kb = int(np.argmin(a)), int(np.argmin(b))
+        if a[ka] <= b[kb]:
+            cost[row, c], pred_kind[row, c], pred_cell[row, c] = a[ka], _VALLEY, i[ka]
+        else:
+            cost[row, c], pred_kind[row, c], pred_cell[row, c] = b[kb], _RISE_CUT, i[kb]
+
+    def push(row: int, tail: slice, new: np.ndarray, kind: int, c: int) -> None:
+        """cost[row, tail] = min(itself, new), remembering (kind, c) where it improves."""
+        better = new < cost[row, tail]
+        cost[row, tail] = np.where(better, new, cost[row, tail])
+        pred_kind[row, tail] = np.where(better, kind, pred_kind[row, tail])
+        pred_cell[row, tail] = np.where(better, c, pred_cell[row, tail])
+
     for c in range(N):
         if c > 0:
-            # rises ending in cell c, pulled from valleys and cuts in cells i = c-1 .. c-K;
+            # rises ending in cell c, pulled from valleys and cuts in cells i = c-1 .. first[c];
             # a valley's cell is left out, a cut (at its cell's start) leaves nothing out
-            lo_i = max(0, c - K)
+            lo_i = min(int(first[c]), c - 1)
             kk = np.arange(c - 1, lo_i - 1, -1)      # cells c-1 .. lo_i, nearest first
             suf = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
             Rx, dx = _sums(ds[kk], np.minimum(hi[kk], suf))
@@ -266,14 +364,14 @@ def hump_lower_bound(env: Envelope, drift: float = 0.0,
             i = kk
             gm = np.minimum(np.minimum.accumulate(g[i]), g[c])
             full = np.maximum(np.maximum(gm, R), _lost(d, hi[i], hi[c], gm))
-            P[c] = min(float(np.min(V[i] + full)), float(np.min(U[i] + Rc)))
+            pull(_PEAK, c, V[i] + full, U[i] + Rc, i)
             # a cut at the start of cell c: cells i+1 .. c-1 from a valley, cells
             # i .. c-1 from a cut, once they hold `chain` periods
-            U[c] = min(float(np.min(np.where(R >= chain * gm, V[i] + R, inf))),
-                       float(np.min(np.where(Rc >= chain * gm, U[i] + Rc, inf))))
+            pull(_RISE_CUT, c, np.where(R >= chain * gm, V[i] + R, inf),
+                 np.where(Rc >= chain * gm, U[i] + Rc, inf), i)
         if c + 1 < N and (P[c] < inf or Dn[c] < inf):
-            # falls starting in cell c, pushed to valleys and cuts j = c+1 .. c+K
-            hi_j = min(N - 1, c + K)
+            # falls starting in cell c, pushed to valleys and cuts j = c+1 .. last[c]
+            hi_j = max(int(last[c]), c + 1)
             j = np.arange(c + 1, hi_j + 1)
             tail = slice(c + 1, hi_j + 1)
             if P[c] < inf:
@@ -282,18 +380,34 @@ def hump_lower_bound(env: Envelope, drift: float = 0.0,
                 F, d = _sums(ds[kk], np.minimum(hi[kk], pre))
                 gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
                 full = np.maximum(np.maximum(gm, F), _lost(d, hi[j], hi[c], gm))
-                V[tail] = np.minimum(V[tail], P[c] + full)
+                push(_VALLEY, tail, P[c] + full, _PEAK, c)
                 # a cut at the start of cell j: cells c+1 .. j-1
-                Dn[tail] = np.minimum(Dn[tail], np.where(F >= chain * gm, P[c] + F, inf))
+                push(_FALL_CUT, tail, np.where(F >= chain * gm, P[c] + F, inf), _PEAK, c)
             if Dn[c] < inf:
                 kk = np.arange(c, hi_j)              # cut at cell c's start: c .. j-1
                 pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                F, _ = _sums(ds[kk], np.minimum(hi[kk], pre))
-                F = F[1:]
+                F = _sums(ds[kk], np.minimum(hi[kk], pre))[0][1:]
                 gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
-                V[tail] = np.minimum(V[tail], Dn[c] + F)
-                Dn[tail] = np.minimum(Dn[tail], np.where(F >= chain * gm, Dn[c] + F, inf))
-    return float(V[N - 1])
+                push(_VALLEY, tail, Dn[c] + F, _FALL_CUT, c)
+                push(_FALL_CUT, tail, np.where(F >= chain * gm, Dn[c] + F, inf), _FALL_CUT, c)
+    T = float(V[N - 1])
+    if not math.isfinite(T):
+        return HumpPlan(T, none, none)
+    valleys, peaks = [], []
+    kind, cell = _VALLEY, N - 1
+    while cell >= 0:
+        if kind == _VALLEY:
+            valleys.append(cell)
+        elif kind == _PEAK:
+            peaks.append(cell)
+        kind, cell = int(pred_kind[kind, cell]), int(pred_cell[kind, cell])
+    return HumpPlan(T, np.array(valleys[::-1], np.int64), np.array(peaks[::-1], np.int64))
+
+
+def hump_lower_bound(env: Envelope, drift: float = 0.0,
+                     chain: float = HUMP_CHAIN_PERIODS) -> float:
+    """:attr:`HumpPlan.time_s` of :func:`hump_plan`, s."""
+    return hump_plan(env, drift, chain).time_s
 
 
 def _sums(ds: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -311,7 +425,8 @@ def _lost(d: np.ndarray, u: np.ndarray, w: float, g: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(lt) & (lt > 0), lt, 0.0)
 
 
-def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float) -> float:
+def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
+                beat: float = 0.0) -> float:
     """Lower bound on the motion time under ``acc+freq`` (holds excluded), s.
 
     Parameters
@@ -324,6 +439,11 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float) -> floa
         Nodes of the ``acc`` relaxation.
     t_upper : float
         A verified upper bound of the minimum motion time (holds excluded), s.
+    beat : float
+        The best lower bound known so far, s. The programme runs on coarse cells
+        (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones only where that comes
+        within :data:`HUMP_REFINE_MARGIN` of ``beat``. Effort only: every run gives a
+        bound.
 
     Returns
     -------
@@ -332,10 +452,17 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float) -> floa
     """
     if path.n_segments == 0 or not math.isfinite(t_upper):
         return 0.0
-    env = speed_envelope(path, lim, grid)
-    if not np.any(env.period > 0):
+    t = _tents(path, lim, grid, None)
+    if not np.any(t.period > 0):
         return 0.0
-    drift = FREQ_ACCEL_TOL_REL * env.accel * t_upper
+    drift = FREQ_ACCEL_TOL_REL * t.accel * t_upper
     if not math.isfinite(drift):
         return 0.0
-    return hump_lower_bound(env, drift)
+    T = 0.0
+    for rel in (HUMP_COARSE_CELL_TIME_REL, HUMP_CELL_TIME_REL):
+        plan = hump_plan(_envelope(t, rel, HUMP_MAX_CELLS), drift)
+        if math.isfinite(plan.time_s):      # no path through the cells cannot happen
+            T = max(T, plan.time_s)         # with the cuts; kept honest
+        if T < (1.0 - HUMP_REFINE_MARGIN) * beat:
+            break
+    return T

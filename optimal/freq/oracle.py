@@ -155,7 +155,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         # phases' threshold
         tb = time.perf_counter()
         t_up = min(c.duration for c in cands)
-        lb_humps = humps_bound(work, sub_lim, grid_from_nodes(work, acc.grid), t_up)
+        lb_humps = humps_bound(work, sub_lim, grid_from_nodes(work, acc.grid), t_up,
+                               lb - hold_t)
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

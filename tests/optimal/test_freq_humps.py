@@ -13,16 +13,17 @@ import pytest
 
 import optimal
 from oracle_cases import XYZ, line_path
-from optimal.freq.humps import Envelope, hump_lower_bound, humps_bound
+from optimal.freq.humps import Envelope, hump_lower_bound, hump_plan, humps_bound
 from optimal.grid import grid_from_nodes
 from reference.core import AxisLimits, MachineLimits
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.profile import Profile
 
 
-def _enumerated(env: Envelope) -> float:
+def _enumerated(env: Envelope):
     """Step 3/4 of optimal.freq.humps by brute force: every alternating sequence of turn
-    cells valley(0) < peak < valley < ... < valley(N-1), no cuts, written out directly."""
+    cells valley(0) < peak < valley < ... < valley(N-1), no cuts, written out directly.
+    Returns the least time and the cost of any given sequence."""
     ds = np.diff(env.s)
     N = ds.size
     hi, lo, g = env.hi, env.lo, env.period
@@ -42,6 +43,9 @@ def _enumerated(env: Envelope) -> float:
         lt = min(d / u, (d - u * gm / 2) / w + gm / 2)
         return max(gm, t, lt if lt > 0 else 0.0)
 
+    def cost(seq):
+        return sum(stretch(a, b, i % 2 == 0) for i, (a, b) in enumerate(zip(seq, seq[1:])))
+
     best = math.inf
     inner = range(1, N - 1)
     for r in range(1, N - 1):
@@ -51,9 +55,8 @@ def _enumerated(env: Envelope) -> float:
             seq = (0,) + turns + (N - 1,)
             if any(b <= a for a, b in zip(seq, seq[1:])):
                 continue
-            t = sum(stretch(a, b, i % 2 == 0) for i, (a, b) in enumerate(zip(seq, seq[1:])))
-            best = min(best, t)
-    return best
+            best = min(best, cost(seq))
+    return best, cost
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -66,8 +69,16 @@ def test_shortest_path_matches_enumeration(seed):
     hi = rng.uniform(5.0, 60.0, N)
     lo = hi * rng.uniform(0.1, 1.0, N)
     env = Envelope(s=s, hi=hi, lo=lo, period=np.full(N, rng.uniform(0.01, 0.2)), accel=0.0)
-    ref = _enumerated(env)
-    assert hump_lower_bound(env, chain=1e12) == pytest.approx(ref, rel=1e-12)
+    ref, cost = _enumerated(env)
+    plan = hump_plan(env, chain=1e12)
+    assert plan.time_s == pytest.approx(ref, rel=1e-12)
+    # its way back is a valid sequence with that cost
+    assert plan.valleys[0] == 0 and plan.valleys[-1] == N - 1
+    assert plan.valleys.size == plan.peaks.size + 1
+    seq = np.empty(plan.valleys.size + plan.peaks.size, np.int64)
+    seq[0::2], seq[1::2] = plan.valleys, plan.peaks
+    assert np.all(np.diff(seq) > 0)
+    assert cost(tuple(seq)) == pytest.approx(ref, rel=1e-12)
     assert hump_lower_bound(env) <= ref * (1 + 1e-12)
 
 
