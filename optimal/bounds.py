@@ -860,7 +860,7 @@ def node_bounds_on(new: Grid, old: Grid, b_hat: np.ndarray, b_bar: np.ndarray
 
 
 def speed_envelope_bounds(path: Path, lim: AxisArrays, grid: Grid
-                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Pointwise speed bounds valid for every feasible motion, from the relaxation on ``grid``.
 
     ``b(s) <= min(B_k, b_hat_k + M_k (s - s_k), b_hat_{k+1} + M_k (s_{k+1} - s))`` on
@@ -876,7 +876,12 @@ def speed_envelope_bounds(path: Path, lim: AxisArrays, grid: Grid
         mm^2/s^2 (``inf`` where nothing bounds it).
     M : numpy.ndarray, shape (N,)
         mm/s^2 (``inf`` where nothing bounds it).
+    t : numpy.ndarray, shape (N,)
+        The lower estimate of the time on each interval, s: each holds on its own for
+        every feasible motion (step 4 integrates pointwise bounds of ``b``), so sums over
+        any intervals bound the time spent there; reduced by ``LB_ROUNDOFF_REL``.
     """
-    _, _, rel, b_hat = lower_bound(path, lim, grid)
+    _, t, rel, b_hat = lower_bound(path, lim, grid)
     geo = _interval_data(path, lim, grid)
-    return b_hat, np.minimum(rel.b_bar, _monotone_peak(geo, b_hat)), rel.slope
+    return (b_hat, np.minimum(rel.b_bar, _monotone_peak(geo, b_hat)), rel.slope,
+            t * (1.0 - LB_ROUNDOFF_REL))

@@ -226,27 +226,21 @@ def subdivide(grid: Grid, path: Path, mark: np.ndarray, pieces=2) -> Grid:
     return out
 
 
-def grid_from_nodes(path: Path, s: np.ndarray) -> Grid:
-    """Grid through given nodes (an oracle's final grid, kept as an array of nodes).
+
+def grid_on(path: Path, s: np.ndarray) -> Grid:
+    """The :class:`Grid` with nodes ``s`` (which contain every segment break): an
+    oracle's final grid, kept as an array of nodes, back as a grid.
 
     Parameters
     ----------
     path : Path
-        The path the nodes lie on.
     s : numpy.ndarray, shape (N + 1,)
-        Strictly increasing nodes from 0 to the path length that include every segment
-        break, mm.
+        Strictly increasing nodes from 0 to the path length, mm.
 
     Returns
     -------
     Grid
     """
     s = np.asarray(s, dtype=np.float64)
-    brk = path.s_breaks
-    node = np.searchsorted(s, brk)
-    node = np.minimum(node, s.size - 1)
-    # breaks are nodes by construction; round-off of a few ulp is matched to the nearest
-    near = np.abs(s[np.maximum(node - 1, 0)] - brk) < np.abs(s[node] - brk)
-    node = np.where(near, np.maximum(node - 1, 0), node)
-    seg = np.repeat(np.arange(path.n_segments), np.diff(node))
-    return Grid(s=s, segment=seg, break_node=node)
+    seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
+    return Grid(s=s, segment=seg, break_node=np.searchsorted(s, path.s_breaks))

@@ -63,9 +63,17 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    such pieces and a last one within reach. Without that floor on the pieces, a chain of
    cuts could follow every dip of the envelope, as no hump could.
 
-What it does not know: the acceleration inside a stretch beyond the envelope (``acc``
-has it, so the oracle keeps the larger of the two bounds), and the time in the cells left
-out, which :data:`HUMP_CELL_TIME_REL` keeps to a few per cent of a period per turn.
+5. *Per piece.* At a stop the speed is (within the checker's tolerances) zero and cannot
+   fall further, so no phase runs through it: every rest-to-rest piece is such a chain on
+   its own, and the programme bounds the time spent between the piece's ends. So does the
+   ``acc`` relaxation's time on the piece's intervals (its interval estimates integrate
+   pointwise bounds of ``b``, so each holds on its own). The bound is the sum over the
+   pieces of the larger of the two.
+
+What it does not know: the acceleration inside a stretch beyond the envelope, and the
+time in the cells left out, which :data:`HUMP_CELL_TIME_REL` keeps to a few per cent of a
+period per turn (:func:`hump_lower_bound` on a flat envelope shows it; the tests measure
+it). Where corners are a period or more apart it therefore adds little to ``acc``.
 
 Units: mm, s, mm/s.
 """
@@ -84,7 +92,7 @@ from reference.core.tolerances import RATIO_TOL
 
 from ..bounds import speed_envelope_bounds
 from ..grid import Grid
-from .lower import segment_periods
+from .lower import rest_pieces, segment_periods
 
 __all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_REL",
            "HUMP_MAX_CELLS", "HUMP_REFINE_MARGIN", "Envelope",
@@ -173,8 +181,8 @@ class _Tents:
 
 
 def _tents(path: Path, lim: AxisArrays, grid: Grid,
-           bounds: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> _Tents:
-    b_hat, B, M = bounds if bounds is not None else speed_envelope_bounds(path, lim, grid)
+           bounds: tuple[np.ndarray, ...] | None) -> _Tents:
+    b_hat, B, M, _ = bounds if bounds is not None else speed_envelope_bounds(path, lim, grid)
     b_hat = np.maximum(b_hat, 0.0)
     s = grid.s
     D = np.diff(s)
@@ -227,7 +235,7 @@ def _split(t: _Tents, k: np.ndarray, x0: np.ndarray, x1: np.ndarray,
 def speed_envelope(path: Path, lim: AxisArrays, grid: Grid, *,
                    cell_time_rel: float = HUMP_CELL_TIME_REL,
                    max_cells: int = HUMP_MAX_CELLS,
-                   bounds: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+                   bounds: tuple[np.ndarray, ...] | None = None
                    ) -> Envelope:
     """Cells and their speed bounds from the ``acc`` relaxation on ``grid``.
 
@@ -426,8 +434,15 @@ def _lost(d: np.ndarray, u: np.ndarray, w: float, g: np.ndarray) -> np.ndarray:
 
 
 def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
-                beat: float = 0.0) -> float:
+                beat: float = 0.0, segment_floor: np.ndarray | None = None) -> float:
     """Lower bound on the motion time under ``acc+freq`` (holds excluded), s.
+
+    Per rest-to-rest piece (:func:`optimal.freq.lower.rest_pieces`) the larger of the
+    ``acc`` relaxation's time on the piece and the turn programme on the piece's cells,
+    summed. Both bound the time spent between the piece's ends: the relaxation's
+    interval estimates hold one by one (:func:`optimal.bounds.speed_envelope_bounds`),
+    and a motion turns from falling to rising at each stop (its speed cannot fall below
+    zero), so the programme applies to each piece alone, from a valley to a valley.
 
     Parameters
     ----------
@@ -441,9 +456,13 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
         A verified upper bound of the minimum motion time (holds excluded), s.
     beat : float
         The best lower bound known so far, s. The programme runs on coarse cells
-        (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones only where that comes
-        within :data:`HUMP_REFINE_MARGIN` of ``beat``. Effort only: every run gives a
-        bound.
+        (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones only on the pieces
+        where that comes within :data:`HUMP_REFINE_MARGIN` of their ``acc`` time, and only
+        while the sum comes that near ``beat``. Effort only: every run gives a bound.
+    segment_floor : numpy.ndarray, shape (m,), optional
+        Certified time per segment of the base bound set
+        (:attr:`optimal.solution.OptimalSolution.segment_lower_bounds_s`, the ``jerk``
+        oracle's): taken per segment where larger than the ``acc`` relaxation's.
 
     Returns
     -------
@@ -452,17 +471,35 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     """
     if path.n_segments == 0 or not math.isfinite(t_upper):
         return 0.0
-    t = _tents(path, lim, grid, None)
-    if not np.any(t.period > 0):
-        return 0.0
+    bounds = speed_envelope_bounds(path, lim, grid)
+    t = _tents(path, lim, grid, bounds)
     drift = FREQ_ACCEL_TOL_REL * t.accel * t_upper
-    if not math.isfinite(drift):
+    if not np.any(t.period > 0) or not math.isfinite(drift):
         return 0.0
-    T = 0.0
+    pieces = rest_pieces(path)
+    ends = grid.break_node[pieces]                     # (P, 2) first and end interval
+    seg_t = np.bincount(grid.segment, weights=bounds[3], minlength=path.n_segments)
+    if segment_floor is not None and segment_floor.shape == seg_t.shape:
+        seg_t = np.maximum(seg_t, np.where(np.isfinite(segment_floor), segment_floor, 0.0))
+    acc = np.add.reduceat(seg_t, pieces[:, 0]) if pieces.size else np.zeros(0)
+    dp = np.zeros(pieces.shape[0])
+    todo = np.ones(pieces.shape[0], bool)
     for rel in (HUMP_COARSE_CELL_TIME_REL, HUMP_CELL_TIME_REL):
-        plan = hump_plan(_envelope(t, rel, HUMP_MAX_CELLS), drift)
-        if math.isfinite(plan.time_s):      # no path through the cells cannot happen
-            T = max(T, plan.time_s)         # with the cuts; kept honest
-        if T < (1.0 - HUMP_REFINE_MARGIN) * beat:
+        env = _envelope(t, rel, HUMP_MAX_CELLS)
+        # cells of each piece: those of its intervals (cells never straddle intervals)
+        lo = np.searchsorted(env.interval, ends[:, 0], side="left")
+        hi = np.searchsorted(env.interval, ends[:, 1], side="left")
+        for k in np.flatnonzero(todo):
+            a, b = lo[k], hi[k]
+            sub = Envelope(s=env.s[a:b + 1], hi=env.hi[a:b], lo=env.lo[a:b],
+                           period=env.period[a:b], accel=env.accel)
+            x = hump_lower_bound(sub, drift)
+            if math.isfinite(x):              # no path cannot happen with the cuts
+                dp[k] = max(dp[k], x)
+        T = float(np.sum(np.maximum(acc, dp)))
+        # fine cells only for the pieces where the coarse run comes near the acc bound,
+        # and only while the whole can come near the best bound known
+        todo = dp >= (1.0 - HUMP_REFINE_MARGIN) * acc
+        if T < (1.0 - HUMP_REFINE_MARGIN) * beat or not np.any(todo):
             break
     return T

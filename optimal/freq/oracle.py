@@ -35,7 +35,7 @@ from reference.core.rows import block_motion, block_rows
 
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
-from ..grid import grid_from_nodes
+from ..grid import grid_on
 from .humps import humps_bound
 from .lower import freq_lower_bound, segment_periods
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered, scaled,
@@ -155,8 +155,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         # phases' threshold
         tb = time.perf_counter()
         t_up = min(c.duration for c in cands)
-        lb_humps = humps_bound(work, sub_lim, grid_from_nodes(work, acc.grid), t_up,
-                               lb - hold_t)
+        lb_humps = humps_bound(work, sub_lim, grid_on(work, acc.grid), t_up,
+                               lb - hold_t, base_sol.segment_lower_bounds_s)
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

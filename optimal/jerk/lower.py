@@ -109,7 +109,7 @@ from reference.core.rules import RELAXED, curvature_jumps, is_tangential, step_j
 from reference.core.tolerances import ACCEL_CONTINUITY_TOL_REL, VEL_TOL_MM_S
 
 from ..bounds import lower_bound
-from ..grid import Grid
+from ..grid import grid_on
 from .tolerances import JERK_LB_ROUNDOFF_REL
 
 
@@ -150,12 +150,6 @@ def rest_to_rest_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) 
         vp = brentq(lambda x: 2.0 * half(x)[1] - L, delta, V, xtol=1e-15 * V, rtol=1e-15)
         return 2.0 * half(vp)[0]
     return L / V + V / A if V * V / A <= L else 2.0 * math.sqrt(L / A)
-
-
-def grid_on(path: Path, s: np.ndarray) -> Grid:
-    """The :class:`Grid` with nodes ``s`` (which contain every segment break)."""
-    seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
-    return Grid(s=s, segment=seg, break_node=np.searchsorted(s, path.s_breaks))
 
 
 def _max_fixed(f: np.ndarray, g: np.ndarray, gamma: np.ndarray, z_max: float,

@@ -14,7 +14,7 @@ import pytest
 import optimal
 from oracle_cases import XYZ, line_path
 from optimal.freq.humps import Envelope, hump_lower_bound, hump_plan, humps_bound
-from optimal.grid import grid_from_nodes
+from optimal.grid import grid_on
 from reference.core import AxisLimits, MachineLimits
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.profile import Profile
@@ -129,7 +129,7 @@ def test_zigzag_bound_is_sound_and_above_acc():
             hi_v = mid
     t_hand = hand(lo_v).duration
     acc = optimal.solve(path, lim, bounds="acc")
-    T = humps_bound(path, lim.for_axes(path.axes), grid_from_nodes(path, acc.grid), t_hand)
+    T = humps_bound(path, lim.for_axes(path.axes), grid_on(path, acc.grid), t_hand)
     assert T <= t_hand
     # measured: 8.3 s against 1.4 s (the hand motion: 22.6 s, the oracle's own 12.0 s)
     assert T > 4.0 * acc.lower_bound_s
