@@ -38,8 +38,8 @@ from ..status import SolveStatus
 from ..grid import grid_on
 from .humps import humps_bound
 from .lower import freq_lower_bound, segment_periods
-from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered, scaled,
-                    verified)
+from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
+                    line_pieces, pieced, scaled, verified)
 
 ProgressFn = Callable[..., object]
 
@@ -147,6 +147,12 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             c = verified(label, path, limits, prof, name, u.rest_breaks)
             if c is not None:
                 cands.append(c)
+    # pieces start and end at rest: the fastest candidate on each, joined
+    joined = pieced(path, cands, line_pieces(path, limits) if base == "acc" else None)
+    if joined is not None:
+        c = verified("fastest per piece", path, limits, joined, name)
+        if c is not None:
+            cands.append(c)
     t_check = time.perf_counter() - tc
     if cands and (min(c.duration for c in cands) + hold_t - lb) > tol * lb:
         # the frequency rule over the whole path (optimal.freq.humps), from the acc
@@ -182,7 +188,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     gap = (ub - lb) / lb if lb > 0 else math.inf
     status = SolveStatus.OPTIMAL if gap <= tol else SolveStatus.GAP_NOT_MET
     prof_h = with_holds(best.profile, path, holds)
-    freq_decides = best.name.startswith("fir") or best.time_scale > 1.0
+    # the frequency rule decided unless the winner is the base optimum as it is
+    freq_decides = best.name != f"{base} scaled" or best.time_scale > 1.0
     active = (("frequency",) * len(base_sol.active)) if freq_decides else base_sol.active
     base_cause = [r.cause for r in base_sol.blocks] if len(base_sol.blocks) == len(path.blocks) \
         else ["none" if b.n_segments > 0 else b.stop_reason for b in path.blocks]

@@ -48,6 +48,7 @@ Units: mm, s.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,7 @@ from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_prof
                                         scale_time, time_scale_factor,
                                         time_scale_factors_by_block)
 from reference.core.geometry import Path
+from reference.core.errors import ProfileError
 from reference.core.limits import MachineLimits
 from reference.core.phases import (acceleration_phases, min_phase_duration,
                                    moving_axes_by_segment, phase_frequencies)
@@ -65,8 +67,8 @@ from reference.core.rules import curvature_jump_speed_cap
 
 from .lower import path_rate_bounds, rest_pieces, segment_periods
 
-__all__ = ["Candidate", "ErodedPlan", "candidate_windows", "eroded_plans", "fir_filtered", "scaled",
-           "verified", "window_caps"]
+__all__ = ["Candidate", "ErodedPlan", "candidate_windows", "eroded_plans", "fir_filtered",
+           "line_pieces", "pieced", "scaled", "verified", "window_caps"]
 
 
 
@@ -150,6 +152,126 @@ def _scale_pieces(path: Path, prof: Profile, pieces: np.ndarray, lam_k: np.ndarr
     v = prof.v / np.concatenate((lam, lam[-1:]))
     return Profile(t=t, s=prof.s, v=v, a=prof.a / lam ** 2, j=prof.j / lam ** 3,
                    block=prof.block)
+
+
+def line_pieces(path: Path, limits: MachineLimits) -> dict[int, Profile]:
+    """The fastest ``acc+freq`` motion of every rest-to-rest piece that is one straight
+    segment, in closed form.
+
+    On a line of length ``L`` the path acceleration is at most ``A = min_i A_i / |d_i|``
+    and the speed at most ``V = min(F, min_i V_i / |d_i|)`` (``d`` the unit direction).
+    A ramp to ``v`` is a phase; it lasts ``tau = max(1/f, v/A)`` at the fastest (each phase
+    at least ``1/f``, DESIGN 6), and as a constant acceleration its effective duration is
+    its duration. So the motion is a trapezoid of time ``L/v + tau(v)`` with ``v tau <= L``:
+    decreasing in ``v`` while ``tau = 1/f`` (up to ``v = A/f``, or ``L f``), then
+    ``L/v + v/A``, least at ``v = sqrt(L A)``. The closed form of DESIGN 6
+    (``L/v + 1/f`` for ``v/A < 1/f``) is its first branch.
+
+    Parameters
+    ----------
+    path : Path
+    limits : MachineLimits
+
+    Returns
+    -------
+    dict
+        Piece index (of :func:`optimal.freq.lower.rest_pieces`) to the motion on it (path
+        positions absolute, time from 0).
+    """
+    out: dict[int, Profile] = {}
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    lim = limits.for_axes(work.axes)
+    per = segment_periods(work, lim)
+    line = (work.radius * np.abs(work.omega) == 0) & (work.sharpness == 0)
+    for k, (lo, hi) in enumerate(rest_pieces(work)):
+        if hi - lo != 1 or not line[lo] or per[lo] <= 0:
+            continue
+        d = np.abs(work.d[lo])
+        L, g = float(work.length[lo]), float(per[lo])
+        with np.errstate(divide="ignore"):
+            A = float(np.min(np.where(d > 0, lim.a_max / d, np.inf)))
+            V = float(min(work.feed[lo], np.min(np.where(d > 0, lim.v_max / d, np.inf))))
+        if not (L > 0 and np.isfinite(A) and np.isfinite(V)):
+            continue
+        best = None
+        for v in (min(V, A * g, L / g), min(V, math.sqrt(L * A))):
+            tau = max(g, v / A)
+            if v <= 0 or v * tau > L * (1 + 1e-12):
+                continue
+            T = L / v + tau
+            if best is None or T < best[0]:
+                best = (T, v, tau)
+        if best is None:
+            continue
+        _, v, tau = best
+        cruise = max(L / v - tau, 0.0)
+        a = v / tau
+        blk = int(work.block[lo])
+        out[k] = Profile.from_phases([tau, cruise, tau], [a, 0.0, -a], [0.0, 0.0, 0.0],
+                                     s0=float(work.s_breaks[lo]), block=[blk] * 3)
+    return out
+
+
+def pieced(path: Path, candidates: list[Candidate],
+           local: dict[int, Profile] | None = None) -> Profile | None:
+    """The fastest candidate on each rest-to-rest piece, joined at the stops.
+
+    Pieces start and end at rest, so a motion may take each piece from a different
+    candidate: the time is the sum of the pieces' best. The joined motion is judged by
+    the checker like any other (:func:`verified`); at a stop two candidates meet within
+    ``VEL_TOL_MM_S`` of rest and may change acceleration there, which the rules allow
+    (the frequency rule's phases end at the stop; the ``jerk`` candidates reach rest at
+    zero acceleration).
+
+    Parameters
+    ----------
+    path : Path
+    candidates : list of Candidate
+        Verified motions on ``path`` (holds excluded).
+    local : dict, optional
+        Motions of single pieces (piece index to profile over that piece alone, path
+        positions absolute), e.g. :func:`line_pieces`; they take part on their piece.
+
+    Returns
+    -------
+    Profile or None
+        ``None`` when one candidate is the fastest on every piece.
+    """
+    pieces = rest_pieces(path)
+    local = local or {}
+    if not candidates:
+        return None
+    lo_s = path.s_breaks[pieces[:, 0]]
+    seg_t = np.stack([c.profile.segment_times(path) for c in candidates])
+    piece_t = np.add.reduceat(seg_t, pieces[:, 0], axis=1)
+    best = np.argmin(piece_t, axis=0)
+    use_local = np.array([k in local and local[k].duration < piece_t[best[k], k]
+                          for k in range(pieces.shape[0])])
+    if not np.any(use_local) and np.all(best == best[0]):
+        return None
+    cuts = path.s_breaks[pieces[1:, 0]]
+    parts = {int(c): candidates[int(c)].profile.split_at(cuts) for c in np.unique(best)}
+    t, s, v, a, j, blk = [np.zeros(1)], [np.zeros(1)], [np.zeros(1)], [], [], []
+    for k, c in enumerate(best):
+        prof = local[k] if use_local[k] else parts[int(c)]
+        mid = 0.5 * (prof.s[:-1] + prof.s[1:])
+        piece = np.clip(np.searchsorted(lo_s, mid, side="right") - 1, 0, pieces.shape[0] - 1)
+        idx = np.flatnonzero(piece == k)
+        if idx.size == 0:
+            return None
+        k0, k1 = int(idx[0]), int(idx[-1]) + 1        # intervals k0 .. k1-1, contiguous
+        t.append(t[-1][-1] + prof.t[k0 + 1:k1 + 1] - prof.t[k0])
+        s.append(prof.s[k0 + 1:k1 + 1])
+        v.append(prof.v[k0 + 1:k1 + 1])
+        a.append(prof.a[k0:k1])
+        j.append(prof.j[k0:k1])
+        blk.append(prof.block[k0:k1])
+    try:
+        return Profile(t=np.concatenate(t), s=np.concatenate(s), v=np.concatenate(v),
+                       a=np.concatenate(a), j=np.concatenate(j), block=np.concatenate(blk))
+    except ProfileError:
+        return None      # the pieces do not meet within the tolerances: no candidate
 
 
 def scaled(path: Path, limits: MachineLimits, base_profile: Profile,

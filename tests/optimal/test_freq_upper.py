@@ -120,3 +120,70 @@ def test_filtered_motion_with_jerk_reach_keeps_the_axis_jerk_on_a_curve(radius):
         s, _, _, _ = p.state(np.arange(0.0, p.duration, dt))
         jerk = np.diff(path.evaluate(s)[0], 3, axis=0) / dt ** 3
         assert np.all(np.max(np.abs(jerk), axis=0) <= lim.j_max * (1 + 1e-3))
+
+
+# --- per-piece candidates: closed-form lines and the fastest motion per piece ----------
+
+def _xyz(v=500.0, a=2000.0, f=10.0):
+    from reference.core import AxisLimits, MachineLimits
+    return MachineLimits(tuple(AxisLimits(n, v, a, 1e6, 1.2, f) for n in "XYZ"), 0.004)
+
+
+@pytest.mark.parametrize("L, F, a, f, expected", [
+    # DESIGN 6: v/A < 1/f -> L/v + 1/f
+    (100.0, 100.0, 2000.0, 10.0, 100.0 / 100.0 + 0.1),
+    # v/A > 1/f: the classical trapezoid L/v + v/A
+    (100.0, 100.0, 200.0, 10.0, 100.0 / 100.0 + 100.0 / 200.0),
+    # too short to reach v: a triangle 2 sqrt(L/A) while its ramps last >= 1/f ...
+    (1.0, 100.0, 50.0, 10.0, 2.0 * np.sqrt(1.0 / 50.0)),
+    # ... and two ramps of exactly 1/f (peak L f) when they would not
+    (1.0, 100.0, 2000.0, 10.0, 0.2),
+])
+def test_line_pieces_closed_forms(L, F, a, f, expected):
+    """Rest-to-rest single lines: the closed forms of the fastest ``acc+freq`` motion, and
+    the checker accepts each."""
+    from oracle_cases import line_path
+    from optimal.freq.upper import line_pieces
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    path = line_path([[0, 0, 0], [L, 0, 0]], feed=F, stops=("start", "end"))
+    lim = _xyz(a=a, f=f)
+    prof = line_pieces(path, lim)[0]
+    assert prof.duration == pytest.approx(expected, rel=1e-12)
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["acc+freq"])
+
+
+def test_pieced_takes_the_faster_motion_on_each_piece():
+    """Two pieces (an exact stop between), two hand motions each faster on one piece: the
+    joined motion takes the sum of the faster halves and is accepted."""
+    from oracle_cases import line_path
+    from optimal.freq.upper import Candidate, pieced
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    path = line_path([[0, 0, 0], [40, 0, 0], [40, 30, 0]], feed=200.0,
+                     stops=("start", "exact", "end"))
+    lim = _xyz(f=10.0)
+
+    def trapezoid(s0, L, v):
+        # ramps of 1/f at v f <= A: accepted under acc+freq, time L/v + 0.1
+        return Profile.from_phases([0.1, L / v - 0.1, 0.1], [v / 0.1, 0.0, -v / 0.1],
+                                   [0.0] * 3, s0=s0)
+
+    def joined(p, q):
+        t = np.concatenate((p.t, p.t[-1] + q.t[1:]))
+        return Profile(t=t, s=np.concatenate((p.s, q.s[1:])), v=np.concatenate((p.v, q.v[1:])),
+                       a=np.concatenate((p.a, q.a)), j=np.concatenate((p.j, q.j)),
+                       block=np.concatenate((p.block, q.block)))
+
+    fast_a, slow_a = trapezoid(0.0, 40.0, 100.0), trapezoid(0.0, 40.0, 50.0)
+    fast_b, slow_b = trapezoid(40.0, 30.0, 100.0), trapezoid(40.0, 30.0, 50.0)
+    one, two = joined(fast_a, slow_b), joined(slow_a, fast_b)
+    for p in (one, two):
+        assert check_profile(path, lim, p).ok(BOUND_SETS["acc+freq"])
+    rep = check_profile(path, lim, one)
+    cands = [Candidate("one", one, 1.0, rep), Candidate("two", two, 1.0, rep)]
+    out = pieced(path, cands)
+    assert out.duration == pytest.approx(40.0 / 100.0 + 0.1 + 30.0 / 100.0 + 0.1, rel=1e-12)
+    assert check_profile(path, lim, out).ok(BOUND_SETS["acc+freq"])
+    # one motion fastest everywhere: nothing to join
+    assert pieced(path, cands[:1]) is None
