@@ -56,12 +56,15 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    the pieces carry no ``g`` or ``LT`` term. The shortest path over the states "valley /
    peak / rising cut / falling cut in cell ``k``" with these edge costs is therefore at
    most the time of every motion with ``T <= T_up``, as long as every motion is one of
-   its paths. A path may leave out edges for strength and still have that: edges from
-   each cell reach ``2 HUMP_CHAIN_PERIODS + 2`` periods at the speeds ``hi`` (and two
-   cells more), and a piece ending in a cut must hold ``HUMP_CHAIN_PERIODS`` periods
-   of ``R`` (``R >= sum ds / hi``), so every stretch longer than that reach splits into
-   such pieces and a last one within reach. Without that floor on the pieces, a chain of
-   cuts could follow every dip of the envelope, as no hump could.
+   its paths. A path may leave out edges for strength and still have that: a piece
+   ending in a cut must hold ``HUMP_CHAIN_PERIODS`` periods of ``R`` (without that floor
+   a chain of cuts could follow every dip of the envelope, as no hump could), and edges
+   from each cell reach ``HUMP_CHAIN_PERIODS + 1`` periods at the speeds ``hi`` (and two
+   cells more). A stretch within reach is one edge; a longer one is cut where its first
+   ``HUMP_CHAIN_PERIODS`` periods at ``hi`` end (``R >= sum ds / hi``, so the piece holds
+   them), inside the reach, and so on. Edges that reach further would not shorten any
+   path: a cut at that point already splits them at no more cost (the pieces' ``R`` add
+   to at most the whole's, and the whole's cost is at least its ``R``).
 
 5. *Per piece.* At a stop the speed is (within the checker's tolerances) zero and cannot
    fall further, so no phase runs through it: every rest-to-rest piece is such a chain on
@@ -123,7 +126,7 @@ HUMP_MAX_CELLS = 20_000
 #: that the speed before it stays below the speeds after it, so a chain of pieces could
 #: dip where a motion would need a whole hump; this many periods between such dips keeps
 #: that slack small against the two periods a hump costs, while edges need only reach
-#: ``2 x HUMP_CHAIN_PERIODS + 2`` periods (the work grows with the reach).
+#: ``HUMP_CHAIN_PERIODS + 1`` periods (the work grows with the reach).
 HUMP_CHAIN_PERIODS = 8.0
 
 
@@ -319,7 +322,8 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     -------
     HumpPlan
     """
-    ds = np.diff(env.s)
+    s = env.s
+    ds = np.diff(s)
     N = ds.size
     none = np.zeros(0, np.int64)
     if N < 3:
@@ -329,9 +333,9 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     g = env.period
     with np.errstate(divide="ignore"):
         fast = ds / hi
-    # reach of the edges: from every start, 2 chain + 2 of the largest period at speed hi
+    # reach of the edges: from every start, chain + 1 of the largest period at speed hi
     cum = np.concatenate(([0.0], np.cumsum(fast)))
-    need = (2.0 * chain + 2.0) * float(np.max(g))
+    need = (chain + 1.0) * float(np.max(g))
     # edges from cell i reach cell last[i]; last is nondecreasing, so the cells whose
     # edges reach c start at first[c]
     last = np.minimum(np.searchsorted(cum, cum[:-1] + need, side="left") + 2, N - 1)
@@ -360,44 +364,47 @@ def hump_plan(env: Envelope, drift: float = 0.0,
         pred_kind[row, tail] = np.where(better, kind, pred_kind[row, tail])
         pred_cell[row, tail] = np.where(better, c, pred_cell[row, tail])
 
-    for c in range(N):
-        if c > 0:
-            # rises ending in cell c, pulled from valleys and cuts in cells i = c-1 .. first[c];
-            # a valley's cell is left out, a cut (at its cell's start) leaves nothing out
-            lo_i = min(int(first[c]), c - 1)
-            kk = np.arange(c - 1, lo_i - 1, -1)      # cells c-1 .. lo_i, nearest first
-            suf = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-            Rx, dx = _sums(ds[kk], np.minimum(hi[kk], suf))
-            R, d, Rc = Rx[:-1], dx[:-1], Rx[1:]      # valley i = kk: cells i+1 .. c-1
-            i = kk
-            gm = np.minimum(np.minimum.accumulate(g[i]), g[c])
-            full = np.maximum(np.maximum(gm, R), _lost(d, hi[i], hi[c], gm))
-            pull(_PEAK, c, V[i] + full, U[i] + Rc, i)
-            # a cut at the start of cell c: cells i+1 .. c-1 from a valley, cells
-            # i .. c-1 from a cut, once they hold `chain` periods
-            pull(_RISE_CUT, c, np.where(R >= chain * gm, V[i] + R, inf),
-                 np.where(Rc >= chain * gm, U[i] + Rc, inf), i)
-        if c + 1 < N and (P[c] < inf or Dn[c] < inf):
-            # falls starting in cell c, pushed to valleys and cuts j = c+1 .. last[c]
-            hi_j = max(int(last[c]), c + 1)
-            j = np.arange(c + 1, hi_j + 1)
-            tail = slice(c + 1, hi_j + 1)
-            if P[c] < inf:
-                kk = np.arange(c + 1, hi_j)          # peak in cell c: cells c+1 .. j-1
-                pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                F, d = _sums(ds[kk], np.minimum(hi[kk], pre))
-                gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
-                full = np.maximum(np.maximum(gm, F), _lost(d, hi[j], hi[c], gm))
-                push(_VALLEY, tail, P[c] + full, _PEAK, c)
-                # a cut at the start of cell j: cells c+1 .. j-1
-                push(_FALL_CUT, tail, np.where(F >= chain * gm, P[c] + F, inf), _PEAK, c)
-            if Dn[c] < inf:
-                kk = np.arange(c, hi_j)              # cut at cell c's start: c .. j-1
-                pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                F = _sums(ds[kk], np.minimum(hi[kk], pre))[0][1:]
-                gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
-                push(_VALLEY, tail, Dn[c] + F, _FALL_CUT, c)
-                push(_FALL_CUT, tail, np.where(F >= chain * gm, Dn[c] + F, inf), _FALL_CUT, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for c in range(N):
+            if c > 0:
+                # rises ending in cell c, pulled from valleys and cuts in cells i = c-1 .. first[c];
+                # a valley's cell is left out, a cut (at its cell's start) leaves nothing out
+                lo_i = min(int(first[c]), c - 1)
+                kk = np.arange(c - 1, lo_i - 1, -1)      # cells c-1 .. lo_i, nearest first
+                suf = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
+                Rx = _sums(ds[kk], np.minimum(hi[kk], suf))
+                R, Rc = Rx[:-1], Rx[1:]                  # valley i = kk: cells i+1 .. c-1
+                i = kk
+                d = s[c] - s[i + 1]
+                gm = np.minimum(np.minimum.accumulate(g[i]), g[c])
+                full = np.maximum(np.maximum(gm, R), _lost(d, hi[i], hi[c], gm))
+                pull(_PEAK, c, V[i] + full, U[i] + Rc, i)
+                # a cut at the start of cell c: cells i+1 .. c-1 from a valley, cells
+                # i .. c-1 from a cut, once they hold `chain` periods
+                pull(_RISE_CUT, c, np.where(R >= chain * gm, V[i] + R, inf),
+                     np.where(Rc >= chain * gm, U[i] + Rc, inf), i)
+            if c + 1 < N and (P[c] < inf or Dn[c] < inf):
+                # falls starting in cell c, pushed to valleys and cuts j = c+1 .. last[c]
+                hi_j = max(int(last[c]), c + 1)
+                j = np.arange(c + 1, hi_j + 1)
+                tail = slice(c + 1, hi_j + 1)
+                if P[c] < inf:
+                    kk = np.arange(c + 1, hi_j)          # peak in cell c: cells c+1 .. j-1
+                    pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
+                    F = _sums(ds[kk], np.minimum(hi[kk], pre))
+                    d = s[j] - s[c + 1]
+                    gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
+                    full = np.maximum(np.maximum(gm, F), _lost(d, hi[j], hi[c], gm))
+                    push(_VALLEY, tail, P[c] + full, _PEAK, c)
+                    # a cut at the start of cell j: cells c+1 .. j-1
+                    push(_FALL_CUT, tail, np.where(F >= chain * gm, P[c] + F, inf), _PEAK, c)
+                if Dn[c] < inf:
+                    kk = np.arange(c, hi_j)              # cut at cell c's start: c .. j-1
+                    pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
+                    F = _sums(ds[kk], np.minimum(hi[kk], pre))[1:]
+                    gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
+                    push(_VALLEY, tail, Dn[c] + F, _FALL_CUT, c)
+                    push(_FALL_CUT, tail, np.where(F >= chain * gm, Dn[c] + F, inf), _FALL_CUT, c)
     T = float(V[N - 1])
     if not math.isfinite(T):
         return HumpPlan(T, none, none)
@@ -418,19 +425,21 @@ def hump_lower_bound(env: Envelope, drift: float = 0.0,
     return hump_plan(env, drift, chain).time_s
 
 
-def _sums(ds: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Running time ``sum ds / ub`` and distance over the cells between, shape (m + 1,):
-    entry ``t`` for the stretch whose far end is ``t`` cells away."""
-    with np.errstate(divide="ignore"):
-        R = np.concatenate(([0.0], np.cumsum(ds / ub)))
-    return R, np.concatenate(([0.0], np.cumsum(ds)))
+def _sums(ds: np.ndarray, ub: np.ndarray) -> np.ndarray:
+    """Running time ``sum ds / ub`` over the cells between, shape (m + 1,): entry ``t``
+    for the stretch whose far end is ``t`` cells away (called with floating-point errors
+    silenced: ``ub`` may be 0 or inf)."""
+    out = np.empty(ds.size + 1)
+    out[0] = 0.0
+    np.cumsum(ds / ub, out=out[1:])
+    return out
 
 
 def _lost(d: np.ndarray, u: np.ndarray, w: float, g: np.ndarray) -> np.ndarray:
-    """``LT`` of step 3: ``min(d / u, (d - u g / 2) / w + g / 2)``, s (0 where undefined)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lt = np.minimum(d / u, (d - u * g / 2.0) / w + g / 2.0)
-    return np.where(np.isfinite(lt) & (lt > 0), lt, 0.0)
+    """``LT`` of step 3: ``min(d / u, (d - u g / 2) / w + g / 2)``, s (0 where undefined;
+    called with floating-point errors silenced)."""
+    lt = np.minimum(d / u, (d - u * g / 2.0) / w + g / 2.0)
+    return np.where(lt > 0, lt, 0.0)
 
 
 def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
