@@ -91,7 +91,7 @@ import numpy as np
 from reference.core.geometry import Path
 from reference.core.limits import AxisArrays
 from reference.core.phases import FREQ_ACCEL_TOL_REL
-from reference.core.tolerances import RATIO_TOL
+from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
 
 from ..bounds import speed_envelope_bounds
 from ..grid import Grid
@@ -328,8 +328,11 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     none = np.zeros(0, np.int64)
     if N < 3:
         return HumpPlan(0.0, none, none)
-    hi = env.hi + 2.0 * drift
-    lo = np.minimum(env.lo, env.hi) + 2.0 * drift
+    # step 2's drift, and the checker's standstill: at a stop it accepts up to
+    # VEL_TOL_MM_S where the relaxation has b = 0
+    slack = 2.0 * drift + VEL_TOL_MM_S
+    hi = env.hi + slack
+    lo = np.minimum(env.lo, env.hi) + slack
     g = env.period
     with np.errstate(divide="ignore"):
         fast = ds / hi

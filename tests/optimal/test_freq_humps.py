@@ -18,6 +18,7 @@ from optimal.grid import grid_on
 from reference.core import AxisLimits, MachineLimits
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.profile import Profile
+from reference.core.tolerances import VEL_TOL_MM_S
 
 
 def _enumerated(env: Envelope):
@@ -26,7 +27,8 @@ def _enumerated(env: Envelope):
     Returns the least time and the cost of any given sequence."""
     ds = np.diff(env.s)
     N = ds.size
-    hi, lo, g = env.hi, env.lo, env.period
+    # the checker's standstill tolerance is added to every speed bound (step 2)
+    hi, lo, g = env.hi + VEL_TOL_MM_S, env.lo + VEL_TOL_MM_S, env.period
 
     def stretch(a, b, rising):
         cells = range(a + 1, b)
@@ -91,7 +93,9 @@ def test_flat_envelope_closed_form(L, V, g):
     per turn, which HUMP_CELL_TIME_REL keeps small."""
     N = 400
     s = np.linspace(0.0, L, N + 1)
-    env = Envelope(s=s, hi=np.full(N, V), lo=np.full(N, V), period=np.full(N, g), accel=0.0)
+    # the programme adds the standstill tolerance to every speed bound: V in effect
+    Ve = V - VEL_TOL_MM_S
+    env = Envelope(s=s, hi=np.full(N, Ve), lo=np.full(N, Ve), period=np.full(N, g), accel=0.0)
     tau = L / N / V
     assert abs(g / tau - round(g / tau)) < 1e-9
     expected = min(max(n * g, (N - n - 1) * tau) for n in range(2, N - 1, 2))
