@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import tomllib
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -381,3 +382,25 @@ def test_the_deviation_never_exceeds_the_tolerance_on_large_arcs():
         assert not np.isnan(sh.deviation).any()
         assert (sh.deviation <= tol).all()
         assert (sh.deviation >= tol * (1 - 2e-9)).all()
+
+
+def test_inspect_trace_and_readme_name_the_same_way_transition(tmp_path, capsys):
+    """Issue 13 item 5 (inspect lists the rounding per corner, the trace names it) and
+    the README's account of G645 between tangent arcs."""
+    from compare import cli
+    prog = tmp_path / "same.mpf"
+    prog.write_text("G90 G645 SOFT F5000\n" + same_way(200.0, 20.0))
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    assert "G2 transition = G645 at a tangential line-arc transition or between two " \
+           "tangent arcs" in out
+    row = next(r for r in out.splitlines() if r.strip().startswith("3/4"))
+    assert row.endswith("rounded (G2 transition)")
+    note = dict((e.stage, e.note) for e in plan(parse_text(prog.read_text()),
+                                                load_machine()).trace)["rounding"]
+    assert "1 G645 tangential transitions" in note
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    text = " ".join(readme.split())
+    assert ("Between two tangent arcs curving the same way with different radii no "
+            "monotone curvature ramp lands either") in text
+    assert "reference/core/transition_samedir.py" in text
