@@ -217,8 +217,9 @@ def _landing(t1, p2, r_in, r_out, rate, off):
 
 
 def _start(r_in, r_out, ramp, rate, flat_out):
-    """Small-angle start ``(theta1, phi2)``: the ramp on the sharper arc at ``J`` (it
-    starts ``L/2`` before ``J``, or the other ends ``L/2`` after it), ``L_p`` from
+    """Small-angle start ``(theta1, phi2)`` with the pair on the second arc where
+    ``flat_out`` (on the first elsewhere): the ramp on the other arc at ``J`` (ramp A
+    starting ``L/2`` before ``J``, or ramp B ending ``L/2`` after it), ``L_p`` from
     ``int e ds = 0`` with ``e`` piecewise linear (module docstring)."""
     k1, k2 = 1.0 / r_in, 1.0 / r_out
     # pair on the second arc: a = -L/2, b = a + 2 L + 2 L_p, heading
