@@ -150,8 +150,9 @@ def _write_rounding(out, program, table) -> None:
     lines = {b.index: b.line for b in program.blocks}
     out.write(f"rounding: {int(table.inserted.sum())} of {table.n} corners in G641..G645 "
               "rounded (shape: arc = tangent arc, G2 = clothoid pair, curvature continuous; "
-              "G2 transition = G645 at a tangential line-arc transition or S-bend, d = "
-              "length of the line replaced (S-bend: the longer of the arcs' parts); "
+              "G2 transition = G645 at a tangential line-arc transition or between two "
+              "tangent arcs, d = length of the line replaced (two arcs: the longer of "
+              "the arcs' parts); "
               "radius_mm = smallest radius); d = distance of the rounding's ends from the corner, "
               "dev = largest distance of the rounded path from the corner, F_G64 / F_round "
               "= speed through the corner under G64 / through the rounding (model "

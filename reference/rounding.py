@@ -23,13 +23,15 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    block only (named first: it is a path stop too), a stop at the break (exact stop,
    auxiliary output before motion, M0, a positioning axis, ...), a block without path
    motion between, a change of acceleration mode (BRISK/SOFT);
-3. transitions next to an arc: a tangential one (line into arc, arc into line, an
-   S-bend of two arcs) is rounded by G645 only ("G645 also inserts rounding" at
-   "tangential transitions with a curvature jump", 5.7), decided and sized apart
+3. transitions next to an arc: a tangential one (line into arc, arc into line, two
+   arcs in one plane: an S-bend, or curving the same way with another radius) is
+   rounded by G645 only ("G645 also inserts rounding" at "tangential transitions with a
+   curvature jump", 5.7), decided and sized apart
    (:func:`reference.rounding_tangential.tangential_transitions`: an S of two clothoid
    pairs that takes up the classical shift and a curvature ramp onto the arc,
    :mod:`reference.core.transition`; between arcs :mod:`reference.core.
-   transition_sbend`); other modes name it "tangential transition".
+   transition_sbend` and :mod:`reference.core.transition_samedir`); other modes name it
+   "tangential transition".
    A corner between a line and a circular arc, or between two circular arcs in one
    plane, is rounded by a tangent fillet (:func:`reference.rounding_arcs.arc_corners`,
    sized by the same mode parameters). Model limits of this version: corners next to
@@ -76,10 +78,11 @@ curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under 
 clothoid pair (G2), where the control inserts a polynomial of its own;
 G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
 G645's rounding of tangential transitions is modelled between a line and a circle and
-between two circles in one plane curving opposite ways (S-bends), the rounding of
-corners next to arcs between a line and a circle and between two circles in one plane
-(tangential arcs curving the same way, helices and spirals are named and passed as
-G64; a corner next to an arc gets a tangent arc, G1, also under SOFT); a window
+between two circles in one plane (curving opposite ways, S-bends, or the same way with
+another radius), the rounding of corners next to arcs between a line and a circle and
+between two circles in one plane (tangential arcs in different planes, helices and
+spirals are named and passed as G64; a corner next to an arc gets a tangent arc, G1,
+also under SOFT); a window
 reaches across short blocks only along a straight chain (several corners closer than
 their windows are rounded one by one, each clamped), and tangential transitions between
 short blocks are never rounded (no documented mode does; the compressors COMPON/COMPCAD,

@@ -10,19 +10,20 @@ named as the corner rounding names its own (:data:`reference.core.rounding.
 ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
 
 1. a line into a circular arc or an arc into a line (both in the geometry axes, the arc
-   a circle: no helix, no spiral), or an S-bend: a circle into a tangent circle in the
+   a circle: no helix, no spiral), an S-bend: a circle into a tangent circle in the
    same plane curving the other way (:mod:`reference.core.transition_sbend`, six
-   clothoid pieces through zero curvature); two arcs curving the same way (``1/R1 ->
-   1/R2``, one sign) need a clothoid piece between two non-zero curvatures, which the
-   path does not have (:mod:`reference.core.geometry`), and arcs in different planes
-   are not modelled: both are named, a model limit;
+   clothoid pieces through zero curvature), or a circle into a tangent circle in the
+   same plane curving the same way with another radius
+   (:mod:`reference.core.transition_samedir`, four pieces through zero curvature);
+   arcs in different planes are named, a model limit (the transitions are plane
+   curves), and so are helices and spirals;
 2. under BRISK no rounding: "Under BRISK only the acceleration limits apply (an
    acceleration step is allowed)" (6.3), so the curvature jump costs no speed;
 3. ``v_g64`` = the curvature-jump rule at the transition (6.3, the shared
    :func:`reference.core.rules.curvature_jump_speed_cap`); if it is not below the
    programmed speed and the arc's own limits (centripetal, path jerk on the arc: what
    the heuristic grants a curved segment, :data:`reference.rounding.CENTRIPETAL_SHARE`
-   and ``JERK_VELOCITY_SHARE``; at an S-bend both arcs'), G64 passes it without
+   and ``JERK_VELOCITY_SHARE``; between two arcs both arcs'), G64 passes it without
    reduction: none;
 4. the ramp length ``L`` from the tolerance: the deviation (in the arc's plane) may be
    at most ``min_i PATH_TRANS_POS_TOL_i / rho_i`` (``rho_i`` the axis' weight in the
@@ -31,11 +32,13 @@ ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
    the tolerance of tangential transitions);
 5. the block-length clamp (5.3, the G644 excerpt; ``c = rounding_length_clamp``): the
    rounding replaces at most ``c`` times each block (the line by ``line_trim ~ 1.6 L``,
-   the arc by ``L/2``; at an S-bend each arc by its trim), so ``L`` is reduced (the
-   S-bend's rate raised) until both fit; pieces at or below MIN_SEGMENT_LENGTH_MM:
+   the arc by ``L/2``; between two arcs each arc by its trim), so ``L`` is reduced
+   (between two arcs the rate raised) until both fit; pieces at or below
+   MIN_SEGMENT_LENGTH_MM:
    "rounding distance too small";
 6. ``v_round`` = the speed the rounding allows (centripetal at its smallest radius:
-   ``R`` at a line-arc transition, the S's peak ``1/(c L_s)`` at an S-bend; the path
+   ``R`` at a line-arc transition, the peak ``1/(c L_s)`` of the S or the pair between
+   two arcs (or the sharper arc, where that is smaller); the path
    jerk ``rho_i |q'''| v^3`` with ``|q'''| <= hypot(c, 1/r_min^2)``, one IPO cycle per
    piece); inserted only if ``v_round > v_g64`` and the corner rounding's time estimate
    favours it, else "rounding would be slower than G64".
@@ -55,8 +58,10 @@ from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
                               transition_rows, transition_shape)
-from .core.transition_sbend import (SBEND_PIECES, SBendShape, sbend_for_deviation,
-                                    sbend_rows, sbend_shape)
+from .core.transition_samedir import (SAMEDIR_PIECES, samedir_for_deviation,
+                                      samedir_rows, samedir_shape)
+from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_rows,
+                                    sbend_shape, scatter, take)
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
@@ -73,11 +78,15 @@ CLAMP_MARGIN = 1e-9
 #: Largest factor one clamp round raises an S-bend's rate by (a transition that found
 #: no landing heading has no trims to scale by: it is raised by this much).
 RATE_RAISE_MAX = 1e3
-#: Named where a tangential transition between arcs is passed as under G64: arcs
-#: curving the same way (``1/R1 -> 1/R2``, one sign) need a clothoid piece from one
-#: non-zero curvature to another, which the path does not have; arcs in different
-#: planes are not modelled either.
+#: Named where a tangential transition next to an arc is not between a line and an arc
+#: or two arcs (an inserted block's segment).
 _BETWEEN_ARCS = "tangential transition between arcs: rounding not modelled yet"
+#: Named where two tangent circular arcs lie in different planes: the transitions
+#: (:mod:`reference.core.transition_sbend`, :mod:`reference.core.transition_samedir`)
+#: are plane curves built in the arcs' one plane; a transition between planes would
+#: need a space curve (torsion), which the path's pieces do not have.
+_OTHER_PLANES = ("tangential transition between arcs in different planes: rounding not "
+                 "modelled (model limit)")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -101,7 +110,8 @@ class Transitions:
         rounding, mm/s (``nan`` where not evaluated).
     n_rows : numpy.ndarray of int, shape (r,)
         Rows per inserted transition (:data:`PIECES` line-arc, :data:`SBEND_PIECES`
-        S-bend), in the order of ``reason == 0``.
+        S-bend, :data:`SAMEDIR_PIECES` arcs curving the same way), in the order of
+        ``reason == 0``.
     rows : dict
         Packed rows of the inserted transitions, in the order of ``reason == 0``.
     """
@@ -209,19 +219,21 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     tangent = np.sign(w)[:, None] * (E2 * np.cos(phi)[:, None] - E1 * np.sin(phi)[:, None])
     along = np.where(line_arc[:, None] | arc_arc[:, None], tangent, -tangent)
     inward = -radial
-    # the second arc's normal at its start: an S-bend curves the other way in the plane
-    # (normals opposite, the shared test of two directions); arcs curving the same way
-    # would need a clothoid piece between two non-zero curvatures (_BETWEEN_ARCS)
+    # the second arc's normal at its start (the shared test of two directions): an
+    # S-bend curves the other way in the plane (normals opposite), arcs curving the same
+    # way have one normal; any other pair lies in two planes (_OTHER_PLANES)
     inward_b = inward.copy()
-    sbend = np.zeros(k, bool)
+    sbend, samedir = np.zeros(k, bool), np.zeros(k, bool)
     aa = np.flatnonzero(arc_arc & (reason < 0))
     if aa.size:
         th_b = path.theta0[b[aa]]
         inward_b[aa] = -(path.e1.take(b[aa], axis=0) * np.cos(th_b)[:, None]
                          + path.e2.take(b[aa], axis=0) * np.sin(th_b)[:, None])
         sbend[aa] = is_tangential(inward[aa], -inward_b[aa], FEASIBLE)
-    decide(arc_arc & ~sbend, _BETWEEN_ARCS)
-    R_b = np.where(sbend, path.radius[b], R)        # the second arc (= R at a line)
+        samedir[aa] = is_tangential(inward[aa], inward_b[aa], FEASIBLE)
+    decide(arc_arc & ~sbend & ~samedir, _OTHER_PLANES)
+    two = sbend | samedir
+    R_b = np.where(two, path.radius[b], R)          # the second arc (= R at a line)
     rho = np.sqrt(along ** 2 + inward ** 2)          # each axis' weight in the arc's plane
     moving = rho > 0
     wr = np.where(moving, rho, 1.0)
@@ -232,13 +244,15 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     length, deviation, radius = np.zeros(k), np.zeros(k), np.zeros(k)
     clamped = np.zeros(k, bool)
     o = np.flatnonzero(reason < 0)
-    la_shape, sb_shape = _zero_shape(0), None
-    la_at = sb_at = np.zeros(0, np.int64)
+    # the transitions between two arcs: (which, shape, rows function, rows each) per
+    # kind sized
+    la_shape, groups = _zero_shape(0), []
+    la_at = np.zeros(0, np.int64)
     if o.size:
         Ro = R[o]
         kappa = inward[o] / Ro[:, None]
-        k_in = np.where(sbend[o, None], kappa, 0.0)
-        k_out = np.where(sbend[o, None], inward_b[o] / R_b[o, None], kappa)
+        k_in = np.where(two[o, None], kappa, 0.0)
+        k_out = np.where(two[o, None], inward_b[o] / R_b[o, None], kappa)
         v_g64[o] = curvature_jump_speed_cap(k_in, k_out, lim.path_trans_jerk, t_ipo)
         v_prog = _programmed_speed(path, lim, a[o], b[o], along[o])
         # each arc's own limits: centripetal, and path jerk rho_i v^3 / R^2 <= share J_i
@@ -262,13 +276,13 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
         dev = dev * np.where(g0, machine.channel.g0_tolerance_factor, 1.0)
         c = machine.channel.rounding_length_clamp
         # per open transition: the rounding's trims, length, smallest radius, curvature
-        # rate, shortest piece, deviation (line-arc and S-bend sized apart, decided
-        # alike below)
+        # rate, shortest piece, deviation (line-arc, S-bend and same-way arcs sized
+        # apart, decided alike below)
         cut_in, cut_out, rlen, rmin, rate, piece, devo = (np.zeros(o.size)
                                                           for _ in range(7))
         small, cut = np.zeros(o.size, bool), np.zeros(o.size, bool)
-        la = ~sbend[o]
-        la_at, sb_at = o[la], o[~la]
+        la = ~two[o]
+        la_at = o[la]
         if la_at.size:
             sh, cut_la, small_la = _size_line_arc(path, R, arc, line, la_at, dev[la], c)
             la_shape = sh
@@ -278,19 +292,28 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
-        if sb_at.size:
-            sh, cut_sb, small_sb = _size_sbend(path, R, R_b, a, b, sb_at, dev[~la], c)
-            sb_shape = sh
-            cut_in[~la], cut_out[~la] = sh.trim_in, sh.trim_out
-            rlen[~la], rmin[~la], rate[~la] = sh.length, sh.min_radius, sh.rate
-            piece[~la] = np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
-            small[~la], cut[~la], devo[~la] = small_sb, cut_sb, sh.deviation
+        for kind, sized, shape_of, to_rows, n_p in (
+                (sbend, sbend_for_deviation, sbend_shape, sbend_rows, SBEND_PIECES),
+                (samedir, samedir_for_deviation, samedir_shape, samedir_rows,
+                 SAMEDIR_PIECES)):
+            sel = kind[o]
+            at = o[sel]
+            if not at.size:
+                continue
+            sh, cut_aa, small_aa = _size_arcs(path, R, R_b, a, b, at, dev[sel], c, sized,
+                                              shape_of)
+            groups.append((at, sh, to_rows, n_p))
+            cut_in[sel], cut_out[sel] = sh.trim_in, sh.trim_out
+            rlen[sel], rmin[sel], rate[sel] = sh.length, sh.min_radius, sh.rate
+            piece[sel] = np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
+            small[sel], cut[sel], devo[sel] = small_aa, cut_aa, sh.deviation
         clamped[o] = cut
         sub = np.zeros(k, bool)
         sub[o] = small
         decide(sub, "rounding distance too small")
         # the rounding's speed: centripetal at its smallest radius (line-arc: the arc's,
-        # the S curves less; S-bend: the S's peak), path jerk with |q^(3)| <=
+        # the S curves less; between arcs: the peak of the S or pair, or the sharper
+        # arc), path jerk with |q^(3)| <=
         # hypot(c, 1/r_min^2) (every piece has the rate c), one IPO cycle per piece
         # (5.3), the programmed speed
         v_c = _centripetal_speed(lim, rmin, moving[o], wr[o], centripetal_share)
@@ -305,7 +328,7 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
         lin = line_arc[o]
         acc, jerk = _path_dynamics(lim, along[o])
         v_in = np.where(lin, v_prog, v_arc_a)
-        v_out = np.where(lin, v_arc_a, np.where(sbend[o], v_arc_b, v_prog))
+        v_out = np.where(lin, v_arc_a, np.where(two[o], v_arc_b, v_prog))
         loss_round = time_loss(v_in, v_out, v_round[o], acc, acc, jerk, jerk, rlen,
                                cut_in, cut_out)
         loss_g64 = time_loss(v_in, v_out, v_g64[o], acc, acc, jerk, jerk, 0.0, 0.0)
@@ -319,21 +342,27 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
     done = np.where(ins, 1.0, 0.0)
     trim_in, trim_out = trim_in * done, trim_out * done
     # rows of the inserted ones, in their order: PIECES per line-arc transition,
-    # SBEND_PIECES per S-bend
+    # SBEND_PIECES per S-bend, SAMEDIR_PIECES between arcs curving the same way
     i_la = np.flatnonzero(ins[la_at])
-    i_sb = np.flatnonzero(ins[sb_at])
-    g_la, g_sb = la_at[i_la], sb_at[i_sb]
+    g_la = la_at[i_la]
     rows = transition_rows(junction[g_la], along[g_la], inward[g_la],
                            _take_shape(la_shape, i_la), arc_line[g_la], ka[g_la], _ROUNDING)
     n_rows = np.zeros(k, np.int64)
     n_rows[g_la] = PIECES
-    if g_sb.size:
-        more = sbend_rows(junction[g_sb], along[g_sb], inward[g_sb],
-                          _take_sbend(sb_shape, i_sb), ka[g_sb], _ROUNDING)
-        n_rows[g_sb] = SBEND_PIECES
-        order = np.argsort(np.concatenate((np.repeat(g_la, PIECES),
-                                           np.repeat(g_sb, SBEND_PIECES))), kind="stable")
-        rows = {key: np.concatenate((rows[key], more[key]))[order] for key in rows}
+    owner = [np.repeat(g_la, PIECES)]
+    more = [rows]
+    for at, sh, to_rows, n_p in groups:
+        i = np.flatnonzero(ins[at])
+        g = at[i]
+        if not g.size:
+            continue
+        more.append(to_rows(junction[g], along[g], inward[g], take(sh, i), ka[g],
+                            _ROUNDING))
+        owner.append(np.repeat(g, n_p))
+        n_rows[g] = n_p
+    if len(more) > 1:
+        order = np.argsort(np.concatenate(owner), kind="stable")
+        rows = {key: np.concatenate([m[key] for m in more])[order] for key in rows}
     return Transitions(reason, trim_in, trim_out, length * done, deviation * done,
                        radius * done, clamped & ins, v_g64, v_round, n_rows[ins], rows)
 
@@ -362,27 +391,33 @@ def _size_line_arc(path: Path, R: np.ndarray, arc: np.ndarray, line: np.ndarray,
     return sh, cut, small
 
 
-def _size_sbend(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.ndarray,
-                o: np.ndarray, dev: np.ndarray, c: float):
-    """S-bend transitions ``o`` (:mod:`reference.core.transition_sbend`): the shape whose
-    deviation is ``dev`` (mm, shape (j,)); where a trim exceeds the block-length clamp
-    ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``) until both
-    fit; whether it was cut, and whether it is too small (bool, shape (j,) each)."""
+def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.ndarray,
+               o: np.ndarray, dev: np.ndarray, c: float, for_deviation, shape_of):
+    """Transitions ``o`` between two arcs (an S-bend, :mod:`reference.core.
+    transition_sbend`, or arcs curving the same way, :mod:`reference.core.
+    transition_samedir`: ``for_deviation`` and ``shape_of`` of that module): the shape
+    whose deviation is ``dev`` (mm, shape (j,)); where a trim exceeds the block-length
+    clamp ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``)
+    until both fit; whether it was cut, and whether it is too small (bool, shape (j,)
+    each)."""
     r1, r2 = R[o], R_b[o]
-    sh = sbend_for_deviation(r1, r2, dev)
-    rate = sh.rate
+    sh = for_deviation(r1, r2, dev)
+    rate = sh.rate.copy()
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
     cut = np.zeros(o.size, bool)
     for _ in range(CLAMP_ROUNDS):
         over = np.maximum(sh.trim_in / cap_in, sh.trim_out / cap_out)
         over = np.where(np.isnan(over), RATE_RAISE_MAX, over)
-        hit = over > 1.0
-        if not hit.any():
+        hit = np.flatnonzero(over > 1.0)
+        if not hit.size:
             break
-        cut |= hit
-        rate = np.where(hit, rate * np.minimum(over, RATE_RAISE_MAX) / (1.0 - CLAMP_MARGIN),
-                        rate)
-        sh = sbend_shape(r1, r2, rate)
+        cut[hit] = True
+        rate[hit] = rate[hit] * np.minimum(over[hit], RATE_RAISE_MAX) / (1.0 - CLAMP_MARGIN)
+        # only the transitions cut are re-sized, their deviation measured once below
+        sh = scatter(sh, hit, shape_of(r1[hit], r2[hit], rate[hit], deviation=False))
+    again = np.flatnonzero(cut)
+    if again.size:
+        sh = scatter(sh, again, shape_of(r1[again], r2[again], rate[again]))
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
@@ -432,10 +467,6 @@ def _zero_shape(k: int) -> TransitionShape:
 
 def _take_shape(shape: TransitionShape, i: np.ndarray) -> TransitionShape:
     return TransitionShape(*(getattr(shape, f)[i] for f in TransitionShape.__slots__))
-
-
-def _take_sbend(shape: SBendShape, i: np.ndarray) -> SBendShape:
-    return SBendShape(*(getattr(shape, f)[i] for f in SBendShape.__slots__))
 
 
 __all__ = ["PIECES", "SBEND_PIECES", "Transitions", "tangential_transitions"]

@@ -66,6 +66,9 @@ ROUNDING_REASONS: tuple[str, ...] = (
     # no longer given (G644 2xxx/3xxx at arc corners are modelled); kept so that the
     # codes of the reasons after it stay
     "G644 dynamic rounding (2xxx, 3xxx) at arc corners: not modelled yet",  # 20
+    # G645 between tangent arcs: a model limit (reference.rounding_tangential)
+    "tangential transition between arcs in different planes: rounding not modelled "
+    "(model limit)",                                                  # 21
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
 

@@ -161,27 +161,31 @@ def _s_of(theta, r_in, r_out, rate, xq, yq):
 
 def _illinois(f, lo, hi, f_lo, f_hi, tol, ftol):
     """Vectorised Illinois root of ``f`` in brackets ``[lo, hi]`` (``f_lo < 0 < f_hi``),
-    until every bracket is narrower than ``tol`` or its last value below ``ftol``; the
-    last iterates."""
+    each until its bracket is narrower than ``tol`` or its last value below ``ftol``;
+    the last iterates. A root that is done is no longer moved, so each one is what it
+    would be alone (not depending on the others in the batch)."""
     side = np.zeros(lo.shape, np.int8)
     x = 0.5 * (lo + hi)
     fx = np.full(lo.shape, np.inf)
     for _ in range(ROOT_MAX_ITER):
         w = hi - lo
-        if np.all((w <= tol) | (np.abs(fx) <= ftol)):
+        todo = ~((w <= tol) | (np.abs(fx) <= ftol))
+        if not todo.any():
             break
         with np.errstate(divide="ignore", invalid="ignore"):
-            x = lo - f_lo * w / (f_hi - f_lo)
-        bad = ~((x > lo) & (x < hi))
-        x = np.where(bad, 0.5 * (lo + hi), x)
-        fx = f(x)
-        neg = fx < 0
+            xn = lo - f_lo * w / (f_hi - f_lo)
+        bad = ~((xn > lo) & (xn < hi))
+        xn = np.where(bad, 0.5 * (lo + hi), xn)
+        fn = f(xn)
+        x, fx = np.where(todo, xn, x), np.where(todo, fn, fx)
+        neg = todo & (fn < 0)
+        pos = todo & ~(fn < 0)
         # Illinois: halve the value kept twice on the same side
         f_hi = np.where(neg & (side == -1), 0.5 * f_hi, f_hi)
-        f_lo = np.where(~neg & (side == 1), 0.5 * f_lo, f_lo)
-        lo, f_lo = np.where(neg, x, lo), np.where(neg, fx, f_lo)
-        hi, f_hi = np.where(neg, hi, x), np.where(neg, f_hi, fx)
-        side = np.where(neg, -1, 1).astype(np.int8)
+        f_lo = np.where(pos & (side == 1), 0.5 * f_lo, f_lo)
+        lo, f_lo = np.where(neg, xn, lo), np.where(neg, fn, f_lo)
+        hi, f_hi = np.where(pos, xn, hi), np.where(pos, fn, f_hi)
+        side = np.where(neg, -1, np.where(pos, 1, side)).astype(np.int8)
     return x
 
 
@@ -243,50 +247,77 @@ def _points(pieces, s: np.ndarray) -> np.ndarray:
     """Canonical points at distances ``s`` (shape (k, N)) from the rounding's start,
     shape (k, N, 2)."""
     origin, e1, e2, rates, lengths = pieces
+    k, p = rates.shape
     ends = np.cumsum(lengths, axis=1)
-    idx = np.minimum((s[:, :, None] >= ends[:, None, :]).sum(axis=2), SBEND_PIECES - 1)
-
-    def take(a):
-        if a.ndim == 3:
-            return np.take_along_axis(a, idx[:, :, None], axis=1)
-        return np.take_along_axis(a, idx, axis=1)
-
-    start = take(ends - lengths)
-    return _clothoid_xy(take(origin), take(e1), take(e2), take(rates), take(lengths),
+    idx = np.minimum((s[:, :, None] >= ends[:, None, :]).sum(axis=2), p - 1)
+    # each point's piece as a row of the flattened (k p) arrays: one gather per array
+    # (numpy's take_along_axis cost about 3x as much here)
+    flat = idx + (np.arange(k) * p)[:, None]
+    start = (ends - lengths).ravel()[flat]
+    return _clothoid_xy(origin.reshape(-1, 2)[flat], e1.reshape(-1, 2)[flat],
+                        e2.reshape(-1, 2)[flat], rates.ravel()[flat], lengths.ravel()[flat],
                         s - start)
 
 
-def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray) -> np.ndarray:
+def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
+              centre_out: np.ndarray) -> np.ndarray:
     """Distance of canonical points ``p`` (k, N, 2) from the programmed contour: the
-    first arc (``x <= 0`` near ``J``) and the second (``x >= 0``); where a point's
-    radial projection falls beyond an arc's end at ``J``, that arc's nearest point is
-    ``J``."""
+    first arc (``x <= 0`` near ``J``, centre ``(0, r_in)``) and the second (``x >= 0``,
+    centre ``(0, centre_out)``: ``-r_out`` at an S-bend, ``+r_out`` for arcs curving the
+    same way); where a point's radial projection falls beyond an arc's end at ``J``, that
+    arc's nearest point is ``J``.
+
+    From a circle of centre ``(0, c)`` through ``J`` (``c^2 = r^2``) the distance is
+    ``|x^2 + y (y - 2 c)| / (hypot(x, y - c) + r)``: ``hypot(x, y - c) - r`` would lose
+    ``r eps`` to cancellation (2.4e-9 of a 1e-4 mm deviation on a 1000 mm arc, above the
+    sizing's margin :data:`DEVIATION_REL_TOL`), this form a few ``eps`` of it."""
     x, y = p[..., 0], p[..., 1]
     at_j = np.hypot(x, y)
-    d1 = np.where(x <= 0, np.abs(np.hypot(x, y - r_in[:, None]) - r_in[:, None]), at_j)
-    d2 = np.where(x >= 0, np.abs(np.hypot(x, y + r_out[:, None]) - r_out[:, None]), at_j)
+    xx = x * x
+
+    def from_circle(c, r):
+        return np.abs(xx + y * (y - 2.0 * c)) / (np.hypot(x, y - c) + r)
+
+    d1 = np.where(x <= 0, from_circle(r_in[:, None], r_in[:, None]), at_j)
+    d2 = np.where(x >= 0, from_circle(centre_out[:, None], r_out[:, None]), at_j)
     return np.minimum(d1, d2)
 
 
 def sbend_deviation(sh: SBendShape) -> np.ndarray:
     """Largest distance of the rounding from the programmed arcs, mm, shape (k,)
     (module docstring: sampled, then refined on finer grids)."""
-    pieces = _canonical_pieces(sh)
+    return pieces_deviation(_canonical_pieces(sh), sh.r_in, sh.r_out, -sh.r_out)
+
+
+def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
+                     centre_out: np.ndarray) -> np.ndarray:
+    """Largest distance of clothoid pieces between two tangent arcs from the arcs, mm,
+    shape (k,): :data:`DEV_SAMPLES` samples per piece, the largest refined on ever
+    finer grids (module docstring), for every transition between two arcs.
+
+    Parameters
+    ----------
+    pieces : tuple
+        Canonical zero-curvature ends, ``e1``, ``e2`` (shape (k, p, 2) each), signed
+        rates and lengths (shape (k, p)) of the ``p`` pieces in path order.
+    r_in, r_out, centre_out : numpy.ndarray, shape (k,)
+        Radii of the arcs and the canonical ``y`` of the second arc's centre, mm.
+    """
     lengths = pieces[4]
-    k = sh.rate.size
+    k, n_pieces = lengths.shape
     s, xy = _samples(pieces, DEV_SAMPLES)
-    dev = _distance(xy, sh.r_in, sh.r_out)
+    dev = _distance(xy, r_in, r_out, centre_out)
     i = dev.argmax(axis=1)
     rows = np.arange(k)
     best, at = dev[rows, i], s[rows, i]
     total = lengths.sum(axis=1)
     # the maximum lies within one sample spacing of the best sample: each round covers
     # that span with REFINE_POINTS points and shrinks it by REFINE_SHRINK
-    h = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), SBEND_PIECES - 1)] / DEV_SAMPLES
+    h = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), n_pieces - 1)] / DEV_SAMPLES
     off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
     for _ in range(REFINE_ROUNDS):
         x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
-        d = _distance(_points(pieces, x), sh.r_in, sh.r_out)
+        d = _distance(_points(pieces, x), r_in, r_out, centre_out)
         j = d.argmax(axis=1)
         better = d[rows, j] > best
         best = np.where(better, d[rows, j], best)
@@ -296,12 +327,13 @@ def sbend_deviation(sh: SBendShape) -> np.ndarray:
     # through the best point and its neighbours at the last spacing
     x = np.clip(at[:, None] + h[:, None] * np.array([-1.0, 1.0])[None, :], 0.0,
                 total[:, None])
-    nb = _distance(_points(pieces, x), sh.r_in, sh.r_out)
+    nb = _distance(_points(pieces, x), r_in, r_out, centre_out)
     curv = nb[:, 0] + nb[:, 1] - 2.0 * best
     with np.errstate(divide="ignore", invalid="ignore"):
         v = at + 0.5 * h * (nb[:, 0] - nb[:, 1]) / curv
     v = np.where((curv < 0) & (np.abs(v - at) <= h), v, at)
-    top = _distance(_points(pieces, np.clip(v, 0.0, total)[:, None]), sh.r_in, sh.r_out)
+    top = _distance(_points(pieces, np.clip(v, 0.0, total)[:, None]), r_in, r_out,
+                    centre_out)
     return np.maximum(np.maximum(best, top[:, 0]), nb.max(axis=1))
 
 
@@ -349,23 +381,16 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
                     np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_s)))
     if deviation and ok.any():
         dev = np.full_like(rate, np.nan)
-        dev[ok] = sbend_deviation(_take(sh, np.flatnonzero(ok)))
+        dev[ok] = sbend_deviation(take(sh, np.flatnonzero(ok)))
         sh = _replace(sh, deviation=dev)
     return sh
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
                         ) -> SBendShape:
-    """The S-bend transitions that deviate from the arcs by ``deviation``.
-
-    The deviation grows about like ``1/c^2`` (all lengths scale like ``1/c``, the
-    deviation like their square over the radius): Newton steps in ``log c`` with the
-    slope measured by the last two (secant; -2 at first), from the small-angle estimate
-    ``c = sqrt(1.8 / (R^3 e))`` (``R = min(R1, R2)``; measured for ``R1 = R2``), each
-    step only for the transitions not yet done; a rate for which no heading lands
-    (pieces far too long) is raised by :data:`RATE_BRACKET_STEP`. The aim is
-    ``deviation (1 - DEVIATION_REL_TOL)``, met to half of that margin: the result never
-    exceeds ``deviation`` and is at most ``1.5 DEVIATION_REL_TOL`` below it.
+    """The S-bend transitions that deviate from the arcs by ``deviation``
+    (:func:`size_for_deviation` from the small-angle estimate ``c = sqrt(1.8 / (R^3
+    e))``, ``R = min(R1, R2)``, measured for ``R1 = R2``).
 
     Parameters
     ----------
@@ -378,9 +403,42 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
+    return size_for_deviation(sbend_shape, r_in, r_out, deviation, 0.5 * np.log(
+        1.8 / (np.minimum(r_in, r_out) ** 3 * deviation)))
+
+
+def size_for_deviation(shape_of, r_in: np.ndarray, r_out: np.ndarray,
+                       deviation: np.ndarray, log_rate: np.ndarray):
+    """The transitions between two arcs whose rate makes them deviate by ``deviation``;
+    the one sizing of every two-arc transition.
+
+    The deviation grows about like ``1/c^2`` (all lengths scale like ``1/c``, the
+    deviation like their square over the radius): Newton steps in ``log c`` with the
+    slope measured by the last two (secant; -2 at first), from a small-angle estimate
+    ``log_rate``, each step only for the transitions not yet done; a rate for
+    which no heading lands (``theta`` nan: pieces far too long) is raised by
+    :data:`RATE_BRACKET_STEP`. The aim is ``deviation (1 - DEVIATION_REL_TOL)``, met to
+    half of that margin: the result never exceeds ``deviation`` and is at most ``1.5
+    DEVIATION_REL_TOL`` below it.
+
+    Parameters
+    ----------
+    shape_of : callable
+        ``shape_of(r_in, r_out, rate)``: the transitions of that rate, a frozen dataclass
+        with ``rate`` and ``deviation`` (``nan`` where none lands) among its fields,
+        shape (k,) each.
+    r_in, r_out, deviation : numpy.ndarray, shape (k,)
+        mm (``deviation > 0``).
+    log_rate : numpy.ndarray, shape (k,)
+        ``log c`` of the first estimate (``c`` in 1/mm^2).
+
+    Returns
+    -------
+    The ``shape_of`` result of the rates found.
+    """
     aim = np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
-    x = 0.5 * np.log(1.8 / (np.minimum(r_in, r_out) ** 3 * deviation))
-    sh = sbend_shape(r_in, r_out, np.exp(x))
+    x = np.array(log_rate, dtype=np.float64)
+    sh = shape_of(r_in, r_out, np.exp(x))
     gx = np.log(sh.deviation) - aim                   # nan: no landing heading
     x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
     for _ in range(ROOT_MAX_ITER):
@@ -397,25 +455,34 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
         x_old[todo] = np.where(lost, x_old[todo], xs)
         g_old[todo] = np.where(lost, g_old[todo], gs)
         x[todo] = xs + step
-        part = sbend_shape(r_in[todo], r_out[todo], np.exp(x[todo]))
-        sh = _scatter(sh, todo, part)
+        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]))
+        sh = scatter(sh, todo, part)
         gx[todo] = np.log(part.deviation) - aim[todo]
     return sh
 
 
 def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
                sh: SBendShape, block: np.ndarray, kind_code: int) -> dict[str, np.ndarray]:
-    """Packed rows of the transitions, :data:`SBEND_PIECES` per transition in path order.
+    """Packed rows of the transitions, :data:`SBEND_PIECES` per transition in path order
+    (:func:`pieces_rows`)."""
+    return pieces_rows(_canonical_pieces(sh), junction, along, inward, block, kind_code)
+
+
+def pieces_rows(pieces, junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
+                block: np.ndarray, kind_code: int) -> dict[str, np.ndarray]:
+    """Packed rows of canonical clothoid pieces between two arcs, ``p`` per transition in
+    path order; the one placement of every two-arc transition in the world.
 
     Parameters
     ----------
+    pieces : tuple
+        As :func:`pieces_deviation`.
     junction : numpy.ndarray, shape (k, n)
         Where the arcs meet.
     along : numpy.ndarray, shape (k, n)
         Unit tangent there, in the direction of travel.
     inward : numpy.ndarray, shape (k, n)
         Unit normal towards the first arc's centre.
-    sh : SBendShape
     block : numpy.ndarray of int, shape (k,)
     kind_code : int
 
@@ -425,7 +492,8 @@ def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
         Keys of :class:`reference.core.geometry.Path` rows, plus ``sharpness``.
     """
     k, n = junction.shape
-    pts, e1c, e2c, rates, lengths = _canonical_pieces(sh)
+    pts, e1c, e2c, rates, lengths = pieces
+    p = rates.shape[1]
 
     def world(xy, offset):
         return (offset[:, None, :] + xy[..., 0:1] * along[:, None, :]
@@ -434,29 +502,31 @@ def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
     origin = world(pts, junction)
     zero = np.zeros_like(junction)
     e1, e2 = world(e1c, zero), world(e2c, zero)
-    m = k * SBEND_PIECES
+    m = k * p
     return clothoid_rows(origin.reshape(m, n), e1.reshape(m, n), e2.reshape(m, n),
                          rates.ravel(), lengths.ravel(),
-                         np.repeat(np.asarray(block, np.int64), SBEND_PIECES), kind_code)
+                         np.repeat(np.asarray(block, np.int64), p), kind_code)
 
 
-def _take(sh: SBendShape, i: np.ndarray) -> SBendShape:
-    return SBendShape(*(getattr(sh, f)[i] for f in SBendShape.__slots__))
+def take(sh, i: np.ndarray):
+    """The transitions ``i`` of a shape (any frozen dataclass of arrays shape (k,))."""
+    return type(sh)(*(getattr(sh, f)[i] for f in type(sh).__slots__))
 
 
-def _scatter(sh: SBendShape, i: np.ndarray, part: SBendShape) -> SBendShape:
-    """``sh`` with the transitions ``i`` replaced by ``part``."""
+def scatter(sh, i: np.ndarray, part):
+    """``sh`` with the transitions ``i`` replaced by ``part`` (same dataclass)."""
     out = []
-    for f in SBendShape.__slots__:
+    for f in type(sh).__slots__:
         a = getattr(sh, f).copy()
         a[i] = getattr(part, f)
         out.append(a)
-    return SBendShape(*out)
+    return type(sh)(*out)
 
 
 def _replace(sh: SBendShape, **kw) -> SBendShape:
     return SBendShape(*(kw.get(f, getattr(sh, f)) for f in SBendShape.__slots__))
 
 
-__all__ = ["SBEND_PIECES", "SBendShape", "sbend_deviation", "sbend_for_deviation",
-           "sbend_rows", "sbend_shape"]
+__all__ = ["SBEND_PIECES", "SBendShape", "pieces_deviation", "pieces_rows", "sbend_deviation",
+           "sbend_for_deviation", "sbend_rows", "sbend_shape", "scatter", "size_for_deviation",
+           "take"]

@@ -4,7 +4,9 @@ A seeded CAM-like polyline of 10^4 lines (0.5..5 mm, turns of 5..120 degrees, F6
 is planned by the heuristic under G64 and under each rounding mode, on the default
 machine with BRISK and SOFT; a seeded chain of 10^4 lines and tangent arcs under G645
 (tangential transitions with curvature jumps), a seeded chain of tangent arcs curving
-alternately under G645 (S-bends, MD33120 = 0.05 mm), and the same line-arc chain with a corner where
+alternately under G645 (S-bends, MD33120 = 0.05 mm), a seeded chain of tangent arcs all
+curving the same way with jumping radii under G645 (the same MD33120), and the same
+line-arc chain with a corner where
 each line leaves its arc (corners next to arcs), and a seeded chain of 10^4 arcs each
 leaving the one before at a corner (corners between two arcs); then the short-segment
 program (../shared/corpus/lcnc_short_segments_0.001.ngc converted to G642 by
@@ -53,7 +55,8 @@ from reference.prepare import build_path  # noqa: E402
 TARGET = 1.30
 sys.path.insert(0, str(HERE.parent / "reference"))
 from corpus_sinumerik import short_segments_g642  # noqa: E402
-from seeded_programs import arc_chain, line_arc_chain, polyline, s_bend_chain  # noqa: E402
+from seeded_programs import (arc_chain, line_arc_chain, polyline, s_bend_chain,  # noqa: E402
+                             same_way_chain)
 
 
 def timed(text: str, machine, repeat: int = 5):
@@ -140,6 +143,12 @@ def main(argv=None) -> None:
     head = "G17 G90 {} SOFT F8000\n"
     r, r_pl = row(f"SOFT G645 S-bends, {n} blocks", n,
                   *paired(head.format("G64") + sbends, head.format("G645") + sbends,
+                          _with_trans_tol("default", 0.05)))
+    worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
+    # G645 between tangent arcs curving the same way (radii 5..200 mm; the same MD33120)
+    same = same_way_chain(n, 5)
+    r, r_pl = row(f"SOFT G645 same-way arcs, {n} blocks", n,
+                  *paired(head.format("G64") + same, head.format("G645") + same,
                           _with_trans_tol("default", 0.05)))
     worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
     # corners next to arcs (each line leaves its arc at a 30..60 degree corner)

@@ -6,7 +6,8 @@ programs: every corpus program (``../shared/corpus``; the LinuxCNC ones converte
 under G64 and the rounding modes, BRISK and SOFT, :func:`corpus_in_mode`), the
 short-segment program under G642, and seeded polylines, line-arc chains (with and
 without corners next to the arcs) and arc chains (corners between two arcs) under G64
-and the rounding modes; on both bundled machines. Per case: every segment array of the built path, its rounding table and block
+and the rounding modes, and chains of tangent arcs (S-bends, arcs curving the same way)
+under G64 and G645; on both bundled machines. Per case: every segment array of the built path, its rounding table and block
 spans, and of the plan (with its own check) the profile, total time, block rows, corner
 rows and trace (less its wall time). ``compare`` prints the largest relative difference
 ``|a - b| / max(1, |a|)`` of the float columns and every mismatch; a speed-up that only
@@ -32,7 +33,8 @@ from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
-from seeded_programs import arc_chain, line_arc_chain, polyline  # noqa: E402
+from seeded_programs import (arc_chain, line_arc_chain, polyline, s_bend_chain,  # noqa: E402
+                             same_way_chain)
 
 MODES = ("G64", "G641 ADIS=0.2", "G642", "G642 CTOL=0.02", "G645", "G645 CTOL=0.05",
          "G643", "G644")
@@ -68,6 +70,11 @@ def programs(n: int = 1500) -> dict[str, str]:
         for mode in ("G64", "G642 CTOL=0.02", "G641 ADIS=0.2", "G645 CTOL=0.02", "G643",
                      "G644", "G642"):
             progs[f"arcs|{mode} {acc}"] = f"G17 G90 {mode} {acc} F6000\nG1 X0 Y0\n" + arcs
+        # tangential transitions between arcs (G645): S-bends and arcs curving the same way
+        for name, chain in (("sbends", s_bend_chain(n // 5, 5, r_min=5.0)),
+                            ("sameway", same_way_chain(n // 5, 5))):
+            for mode in ("G64", "G645"):
+                progs[f"{name}|{mode} {acc}"] = f"G17 G90 {mode} {acc} F8000\n" + chain
     return progs
 
 

@@ -5,6 +5,7 @@ faster than the certified lower bound (issue 13 item 3)."""
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -18,6 +19,9 @@ from reference.machine import load_machine
 from reference.nc import parse_file
 from reference.prepare import build_path
 from test_corpus_machines import MACHINES, _machine_file
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
+from seeded_programs import same_way_chain  # noqa: E402
 
 #: Four corners between arcs (test_rounding_arc_arc.ARCS with RND=1 at the third).
 ARCS_ONLY = ("G1 X0 Y0\nG2 X10 Y0 I5 J0\nG2 X-2 Y12 I0 J12\nG3 X-10 Y4 I0 J-8 RND=1\n"
@@ -46,6 +50,14 @@ PROGRAMS = {
     # passes the curvature jump at the programmed speed
     "g645_soft_s_bend": "G90 G645 SOFT F5000\nG1 X0 Y0\nG3 X60 Y60 I0 J60\n"
                         "G2 X120 Y120 I60 J0\nM30\n",
+    # G645 between two arcs curving the same way, R 200 -> 20 (four clothoid pieces,
+    # reference.core.transition_samedir), rounded on the default machines; linuxcnc_xyz
+    # passes the curvature jump at the programmed speed
+    "g645_soft_same_way": "G90 G645 SOFT F5000\nG1 X0 Y0\nG3 X200 Y200 I0 J200\n"
+                          "G3 X180 Y220 I-20 J0\nM30\n",
+    # nine such transitions (radii 5..300 mm): on the default machine three rounded,
+    # three passed by G64 without reduction, three where the rounding would be slower
+    "g645_soft_same_way_chain": "G90 G645 SOFT F5000\n" + same_way_chain(10, 2, 5.0, 300.0),
     # corners between two arcs: tangent fillets (G641 ADIS with one RND; G642 CTOL under
     # SOFT), each turn and both senses
     "g641_arc_arc_corner": "G90 G641 ADIS=0.5 BRISK F3000\n" + ARCS_ONLY,
@@ -53,7 +65,7 @@ PROGRAMS = {
 }
 #: Programs whose roundings are clothoid pairs on every bundled machine (checked below).
 G2 = ("g642_soft_shallow", "g645_soft_zigzag", "g641_soft_adis", "g645_soft_line_arc",
-      "g645_soft_s_bend")
+      "g645_soft_s_bend", "g645_soft_same_way", "g645_soft_same_way_chain")
 
 
 @pytest.mark.parametrize("machine", sorted(MACHINES))
@@ -89,18 +101,23 @@ def test_rounded_program_compares_with_a_certificate(name: str, machine: str,
         t = path.rounding
         assert t.g2[t.inserted].all()
         # two clothoid pieces per corner, five per G645 line-arc transition, six per
-        # S-bend (both blocks arcs)
+        # S-bend, four between arcs curving the same way (both blocks arcs)
         arc_blocks = np.unique(path.block[path.kind == KIND_CODES.index("arc")])
         s_bend = np.isin(t.block, arc_blocks) & np.isin(t.next_block, arc_blocks)
+        per_arc_arc = 4 if name.startswith("g645_soft_same_way") else 6
         n_pieces = 2 * int(np.sum(t.inserted & ~t.tangential)) + 5 * int(
-            np.sum(t.inserted & t.tangential & ~s_bend)) + 6 * int(
+            np.sum(t.inserted & t.tangential & ~s_bend)) + per_arc_arc * int(
             np.sum(t.inserted & t.tangential & s_bend))
         assert np.count_nonzero(path.sharpness) == n_pieces
         # the S-bend is rounded on the default machines (the jump caps G64 below the
         # feed there), not on linuxcnc_xyz (G64 passes it at the programmed speed)
         rounds = machine.startswith("default")
-        assert n_pieces > 0 or (name == "g645_soft_s_bend" and not rounds)
-        if name == "g645_soft_s_bend":
+        assert n_pieces > 0 or (name in ("g645_soft_s_bend", "g645_soft_same_way",
+                                         "g645_soft_same_way_chain") and not rounds)
+        if name == "g645_soft_same_way_chain":
+            assert t.n == 9 and t.tangential.all()
+            assert int(t.inserted.sum()) == (3 if rounds else 0), t.reason
+        if name in ("g645_soft_s_bend", "g645_soft_same_way"):
             assert t.n == 1 and t.tangential.all()
             assert bool(t.inserted[0]) == rounds, t.reason
         if name == "g645_soft_line_arc" and machine == "default":

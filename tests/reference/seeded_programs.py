@@ -90,3 +90,18 @@ def s_bend_chain(n: int, seed: int, r_min: float = 20.0, r_max: float = 200.0) -
         out.append(word)
         side = -side
     return "\n".join(out) + "\nM30\n"
+
+
+def same_way_chain(n: int, seed: int, r_min: float = 5.0, r_max: float = 200.0) -> str:
+    """``n`` seeded tangent arcs all curving the same way (radius log-uniform in ``r_min ..
+    r_max`` mm, turning 15..45 degrees): a chain of tangential transitions between arcs
+    whose curvatures have one sign and jump in size (body only, ``G1 X0 Y0`` then ``G3``
+    words with the centre as ``I J``, 12 decimals, then ``M30``)."""
+    rng = np.random.default_rng(seed)
+    heading, x, y, out = 0.0, 0.0, 0.0, ["G1 X0 Y0"]
+    for _ in range(n):
+        r = float(np.exp(rng.uniform(np.log(r_min), np.log(r_max))))
+        turn = np.radians(rng.uniform(15.0, 45.0))
+        word, x, y, heading = _tangent_arc(x, y, heading, r, turn)
+        out.append(word)
+    return "\n".join(out) + "\nM30\n"

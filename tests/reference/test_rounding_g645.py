@@ -243,12 +243,14 @@ def test_no_transition_and_why(text, mach, why):
 
 
 def test_model_limits_are_named():
-    """Arc into an arc curving the same way (a clothoid from 1/R1 to 1/R2 would not
-    start at zero curvature; S-bends are rounded, test_rounding_sbend.py) and a helix
-    are passed as under G64, named."""
-    same_way = "G17 G90 G645 SOFT F6000\nG1 X0 Y0\nG3 X20 Y20 I0 J20\nG3 X10 Y30 I-10 J0\n"
-    assert reasons(build_path(parse_text(same_way), machine())) == [
-        "tangential transition between arcs: rounding not modelled yet"]
+    """Arcs tangent at the junction in two planes (the transitions are plane curves;
+    arcs in one plane are rounded, test_rounding_sbend.py, test_rounding_samedir.py)
+    and a helix are passed as under G64, named."""
+    planes = ("G90 G645 SOFT F6000\nG17 G1 X0 Y0 Z0\nG3 X20 Y20 I0 J20\n"
+              "G19 G3 Y30 Z10 J0 K10\n")
+    assert reasons(build_path(parse_text(planes), machine())) == [
+        "tangential transition between arcs in different planes: rounding not modelled "
+        "(model limit)"]
     # the line along the helix's start tangent (5 pi mm in the plane per 2 mm in Z)
     x0 = 20.0 - 5.0 * math.pi
     helix = (f"G17 G90 G645 SOFT F6000\nG1 X{x0!r} Y0 Z2\nG1 X20 Z0\n"

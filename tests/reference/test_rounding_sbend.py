@@ -248,10 +248,11 @@ def test_v_g64_is_the_curvature_jump_rule_by_hand():
      "rounding would be slower than G64"),
     # only G645 rounds tangential transitions (5.7 "G645 also inserts rounding")
     ("G17 G90 G642 SOFT F5000\n" + s_bend(60.0, 60.0), "tangential transition"),
-    # arcs curving the same way: a clothoid from 1/R1 to 1/R2 would not start at zero
-    # curvature, which the path does not support: a model limit, named
-    ("G17 G90 G645 SOFT F5000\nG1 X0 Y0\nG3 X20 Y20 I0 J20\nG3 X10 Y30 I-10 J0\nM30\n",
-     "tangential transition between arcs: rounding not modelled yet"),
+    # arcs tangent at the junction in two planes (XY, then YZ): a model limit, named
+    # (arcs curving the same way in one plane: test_rounding_samedir.py)
+    ("G90 G645 SOFT F5000\nG17 G1 X0 Y0 Z0\nG3 X20 Y20 I0 J20\nG19 G3 Y30 Z10 J0 K10\n"
+     "M30\n", "tangential transition between arcs in different planes: rounding not "
+     "modelled (model limit)"),
 ])
 def test_no_rounding_and_why(text, why):
     mach = machine()

@@ -1,0 +1,406 @@
+"""G645 at tangential transitions between two arcs curving the same way with different
+radii (issue 13 item 2; reference/rounding_tangential.py, reference/core/
+transition_samedir.py), against hand geometry, an ODE integration of the curvature
+profile and finite differences of positions.
+
+spec 5.7: "At tangential transitions with a curvature jump (e.g. line to arc), G645 also
+inserts rounding, using MD33120 PATH_TRANS_POS_TOL. That MD is used only at tangential
+transitions." "[M] At tangential transitions, G645 inserts a rounding block only if the
+curvature jump would otherwise force the axis acceleration beyond its limit (i.e. a
+velocity reduction)."
+spec 5.8: "model the inserted block as a clothoid-like curvature ramp of length L. The
+classical clothoid lateral shift p ~ L^2/(24R) must stay <= PATH_TRANS_POS_TOL ...
+Insert only if this beats the non-rounded limit of 6.3."
+spec 6.3: "the centripetal acceleration jumps by da_i = v^2 |k2 n2,i - k1 n1,i| ...
+v <= min_i sqrt(PATH_TRANS_JERK_LIM_i T_ipo / |k2 n2_i - k1 n1_i|) ... Apply this limit
+under SOFT. Under BRISK only the acceleration limits apply (an acceleration step is
+allowed)."
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from reference.core.constraints import BOUND_SETS, check_profile
+from reference.core.geometry import KIND_CODES
+from reference.core.transition_samedir import samedir_for_deviation, samedir_shape
+from reference.machine import load_machine, machine_from_dict
+from reference.nc import parse_text
+from reference.planner import plan
+from reference.prepare import build_path
+from seeded_programs import same_way_chain
+from test_rounding_g645 import machine, reasons
+
+ROUNDING = KIND_CODES.index("rounding")
+ARC = KIND_CODES.index("arc")
+T_IPO = 0.004
+#: A wide tolerance (mm) under which the default feed's transitions pay (the bundled
+#: 0.005 mm makes the rounding's pieces short and its curvature rate steep).
+WIDE = {"PATH_TRANS_POS_TOL": 0.05}
+
+
+def bundled(name: str, tol: float):
+    """A bundled machine with PATH_TRANS_POS_TOL = ``tol`` (mm) on every axis."""
+    d = tomllib.loads(resources.files("reference.machines").joinpath(f"{name}.toml")
+                      .read_text())
+    for ax in d["axis"].values():
+        ax["PATH_TRANS_POS_TOL"] = tol
+    return machine_from_dict(d)
+
+
+def same_way(r1: float, r2: float, word: str = "G3") -> str:
+    """A quarter arc of radius ``r1`` from the origin (start tangent +x), then a tangent
+    quarter arc of radius ``r2`` curving the same way (body only)."""
+    if word == "G3":           # left turns: centres (0, r1), then (r1 - r2, r1)
+        return (f"G1 X0 Y0\nG3 X{r1} Y{r1} I0 J{r1}\n"
+                f"G3 X{r1 - r2} Y{r1 + r2} I{-r2} J0\nM30\n")
+    return (f"G1 X0 Y0\nG2 X{r1} Y{-r1} I0 J{-r1}\n"
+            f"G2 X{r1 - r2} Y{-r1 - r2} I{-r2} J0\nM30\n")
+
+
+def integrate(sh, i: int):
+    """The rounding by an ODE solver from its curvature profile alone (hand model:
+    ``1/R1 -> 0`` over ``L``, ``0 -> c L_p -> 0`` over ``2 L_p``, ``0 -> 1/R2`` over
+    ``L``, all linear in the arc length), started on the first arc ``trim_in`` before
+    the junction with its tangent (frame: junction at the origin, tangent +x, centres
+    (0, R1) and (0, R2)). Returns the dense solution and the length."""
+    r1, r2 = float(sh.r_in[i]), float(sh.r_out[i])
+    c, lp = float(sh.rate[i]), float(sh.piece[i])
+    l1, l2 = float(sh.ramp_in[i]), float(sh.ramp_out[i])
+    b = np.cumsum([0.0, l1, lp, lp, l2])
+
+    def kappa(s):
+        if s < b[1]:
+            return (1.0 / r1) * (1.0 - s / l1)
+        if s < b[2]:
+            return c * (s - b[1])
+        if s < b[3]:
+            return c * (b[3] - s)
+        return (1.0 / r2) * (s - b[3]) / l2
+
+    a0 = -float(sh.trim_in[i]) / r1
+    start = [r1 * math.sin(a0), r1 * (1 - math.cos(a0)), a0]
+    sol = solve_ivp(lambda s, z: [math.cos(z[2]), math.sin(z[2]), kappa(s)], (0, b[-1]),
+                    start, rtol=1e-12, atol=1e-14, dense_output=True,
+                    max_step=min(lp, l1, l2) / 20)
+    return sol, b[-1]
+
+
+def contour_distance(x, y, r1, r2):
+    """Hand geometry: distance from the two programmed arcs near the junction (the first
+    for x <= 0, centre (0, R1); the second for x >= 0, centre (0, R2); beyond an arc's
+    end its nearest point is the junction)."""
+    j = np.hypot(x, y)
+    d1 = np.where(x <= 0, np.abs(np.hypot(x, y - r1) - r1), j)
+    d2 = np.where(x >= 0, np.abs(np.hypot(x, y - r2) - r2), j)
+    return np.minimum(d1, d2)
+
+
+#: Flatter into sharper and back, a near-equal pair, and ratios 20 and 1/40, where the
+#: pair on the flatter arc no longer lands and sits on the sharper one.
+CASES = [(60.0, 20.0, 0.005), (20.0, 60.0, 0.005), (100.0, 90.0, 0.01), (10.0, 3.0, 0.002),
+         (200.0, 10.0, 0.005), (5.0, 200.0, 0.01)]
+
+
+# ------------------------------------------------------------------ the geometry alone
+@pytest.mark.parametrize("r1, r2, tol", CASES)
+def test_the_rounding_lands_on_the_second_arc_with_its_tangent(r1, r2, tol):
+    """Exactness (module model): integrated from its curvature profile alone, the
+    rounding that leaves the first arc ``trim_in`` before the junction ends on the
+    second arc ``trim_out`` after it (hand geometry: centre (0, R2), angle
+    ``trim_out / R2``) with that arc's tangent; both trims are positive (the arcs are
+    only shortened)."""
+    sh = samedir_for_deviation([r1], [r2], [tol])
+    assert sh.trim_in[0] > 0 and sh.trim_out[0] > 0
+    sol, total = integrate(sh, 0)
+    x, y, heading = sol.y[:, -1]
+    b = float(sh.trim_out[0]) / r2
+    assert x == pytest.approx(r2 * math.sin(b), abs=1e-8)
+    assert y == pytest.approx(r2 * (1 - math.cos(b)), abs=1e-8)
+    assert heading == pytest.approx(b, abs=1e-9)
+    assert total == pytest.approx(float(sh.length[0]), rel=1e-14)
+
+
+@pytest.mark.parametrize("r1, r2, tol", CASES)
+def test_the_deviation_is_path_trans_pos_tol(r1, r2, tol):
+    """spec 5.7/5.8: the rounding stays within PATH_TRANS_POS_TOL of the programmed
+    contour and uses it: the largest distance of the integrated curve (60001 samples)
+    from the two arcs (hand geometry) is the tolerance (to the sampling's resolution),
+    never above it."""
+    sh = samedir_for_deviation([r1], [r2], [tol])
+    assert tol * (1 - 2e-9) <= float(sh.deviation[0]) <= tol
+    sol, total = integrate(sh, 0)
+    x, y, _ = sol.sol(np.linspace(0.0, total, 60001))
+    dev = contour_distance(x, y, r1, r2).max()
+    assert dev <= tol * (1 + 1e-7)
+    assert dev >= tol * (1 - 1e-5)
+
+
+@pytest.mark.parametrize("r1, r2, tol", CASES[:4])
+def test_the_curvature_leaves_the_interval_and_the_pair_sits_on_the_flatter_arc(r1, r2,
+                                                                              tol):
+    """Module docstring: no monotone ramp lands, the curvature falls to zero at both
+    ramps; for ratios up to 16 the pair sits on the flatter arc: the trim of the flatter
+    arc holds the pair (``L/2 + ...``), the sharper arc is cut by about ``L/2`` (its
+    ramp's line within 0.06 L of the common tangent). Checked on the integrated curve:
+    its heading where ramp A ends is that of line A (``-theta1``)."""
+    sh = samedir_for_deviation([r1], [r2], [tol])
+    ramp = float(sh.ramp_in[0])
+    flat_trim, sharp_trim = ((sh.trim_out[0], sh.trim_in[0]) if r2 > r1
+                             else (sh.trim_in[0], sh.trim_out[0]))
+    assert abs(sharp_trim - 0.5 * ramp) <= 0.06 * ramp
+    assert flat_trim > 2.0 * ramp
+    sol, _ = integrate(sh, 0)
+    assert sol.sol(ramp)[2] == pytest.approx(-float(sh.theta[0]), abs=1e-10)
+
+
+def test_vectorised_sizes_agree_with_one_at_a_time():
+    """Many transitions sized in one call give what each gives alone (no cross-talk
+    between the vectorised Newton and rate iterations), never above the tolerance."""
+    rng = np.random.default_rng(5)
+    r1 = rng.uniform(1, 100, 40)
+    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, 40))
+    tol = rng.uniform(0.001, 0.05, 40)
+    sh = samedir_for_deviation(r1, r2, tol)
+    assert not np.isnan(sh.theta).any()
+    assert (sh.deviation <= tol).all()
+    np.testing.assert_allclose(sh.deviation, tol, rtol=2e-9)
+    again = samedir_shape(r1, r2, sh.rate)
+    np.testing.assert_array_equal(again.deviation, sh.deviation)
+    for i in (0, 17, 39):
+        one = samedir_for_deviation(r1[i:i + 1], r2[i:i + 1], tol[i:i + 1])
+        assert float(one.rate[0]) == pytest.approx(float(sh.rate[i]), rel=1e-8)
+
+
+# ------------------------------------------------------------------ on a rounded path
+def _curvature_fd(path, s, h):
+    """Curvature vectors by central second differences of positions alone (independent
+    of the path's own derivatives), shape (N, n)."""
+    q = [path.evaluate(s + d)[0] for d in (-h, 0.0, h)]
+    return (q[0] - 2.0 * q[1] + q[2]) / (h * h)
+
+
+@pytest.mark.parametrize("word", ["G3", "G2"])
+@pytest.mark.parametrize("r1, r2", [(200.0, 20.0), (20.0, 200.0)])
+def test_g645_rounds_same_way_arcs_g2_continuous_and_keeps_the_arcs(word, r1, r2):
+    """Both senses, flatter into sharper and back: four clothoid pieces attributed to the
+    first arc's block; every break is continuous in position and tangent (from both
+    sides) and in curvature by finite differences of positions (the unrounded path jumps
+    by ``|1/R2 - 1/R1|`` there); the arcs left are the programmed circles, shortened by
+    the trims; the whole path stays within PATH_TRANS_POS_TOL of the programmed arcs
+    (dense samples, hand geometry) and uses it."""
+    text = "G17 G90 G645 SOFT F5000\n" + same_way(r1, r2, word)
+    mach = machine({"X": WIDE, "Y": WIDE})
+    path = build_path(parse_text(text), mach)
+    t = path.rounding
+    assert reasons(path) == ["rounded"] and t.tangential.all() and t.g2.all()
+    k = np.flatnonzero(path.kind == ROUNDING)
+    assert k.size == 4
+    assert [int(path.blocks[int(b)].line) for b in path.block[k]] == [3] * 4
+    sb = path.s_breaks[1:-1]
+    seg = np.arange(path.n_segments)
+    qa, ta, _, _ = path.evaluate(sb, segment=seg[:-1])
+    qb, tb, _, _ = path.evaluate(sb, segment=seg[1:])
+    np.testing.assert_allclose(qa, qb, atol=1e-9)
+    np.testing.assert_allclose(ta, tb, atol=1e-9)
+    h = 1e-3
+    jump = np.abs(_curvature_fd(path, sb + 2 * h, h) - _curvature_fd(path, sb - 2 * h, h))
+    # continuous: over 4 h the curvature changes by at most (rate 4 h), the rate bounded
+    # by 1/(R L) of the steepest piece; the jump it replaced is 1/20 - 1/200 = 0.045
+    steepest = float(np.max(np.abs(path.sharpness)))
+    assert jump.max() <= 4 * h * steepest * 1.01 + 1e-6
+    plain = build_path(parse_text("G17 G90 G64 SOFT F5000\n" + same_way(r1, r2, word)),
+                       mach)
+    sp = plain.s_breaks[1:-1]
+    raw = np.abs(_curvature_fd(plain, sp + 2 * h, h) - _curvature_fd(plain, sp - 2 * h, h))
+    assert raw.max() == pytest.approx(abs(1 / r2 - 1 / r1), rel=1e-3)
+    arcs = np.flatnonzero(path.kind == ARC)
+    sign = 1.0 if word == "G3" else -1.0
+    centres = [np.array([0.0, sign * r1]), np.array([r1 - r2, sign * r1])]
+    for j, centre, r in zip(arcs, centres, (r1, r2)):
+        assert path.radius[j] == pytest.approx(r, rel=1e-12)
+        ends, _, _, _ = path.evaluate(path.s_breaks[[j, j + 1]], segment=np.array([j, j]))
+        np.testing.assert_allclose(np.hypot(*(ends[:, :2] - centre).T), r, atol=1e-9)
+    trims = 0.5 * math.pi * np.array([r1, r2]) - path.length[arcs]
+    assert max(trims) == pytest.approx(float(t.distance_mm[0]), rel=1e-12)
+    s = np.linspace(path.s_breaks[k[0]], path.s_breaks[k[-1] + 1], 40001)
+    q = path.evaluate(s)[0][:, :2]
+    # the programmed contour near the junction (first arc before it, second after:
+    # hand geometry in the canonical frame, junction (r1, sign r1), tangent +y)
+    along, inward = (q[:, 1] - sign * r1) * sign, r1 - q[:, 0]
+    dist = contour_distance(along, inward, r1, r2)
+    tol = WIDE["PATH_TRANS_POS_TOL"]
+    assert dist.max() <= tol * (1 + 1e-7) and dist.max() >= tol * (1 - 1e-4)
+    assert tol * (1 - 2e-9) <= t.deviation_mm[0] <= tol
+
+
+def test_v_g64_is_the_curvature_jump_rule_by_hand():
+    """spec 6.3 by hand: from 1/200 to 1/20 in one direction the normal component jumps
+    by 1/20 - 1/200 = 0.045 (the X axis at the junction, where the tangent is Y), so
+    ``v = sqrt(J T_ipo / 0.045)`` with PATH_TRANS_JERK_LIM = MAX_AX_JERK (40 m/s^3) on the
+    test machine."""
+    path = build_path(parse_text("G17 G90 G645 SOFT F5000\n" + same_way(200.0, 20.0)),
+                      machine())
+    assert path.rounding.v_g64[0] == pytest.approx(math.sqrt(40000.0 * T_IPO / 0.045),
+                                                   rel=1e-12)
+
+
+@pytest.mark.parametrize("text, mach, why", [
+    ("G17 G90 G645 BRISK F5000\n" + same_way(200.0, 20.0), {},
+     "curvature jump allowed under BRISK (acceleration step)"),
+    # the jump caps G64 at 59.6 mm/s: at F3000 (50 mm/s) it costs nothing
+    ("G17 G90 G645 SOFT F3000\n" + same_way(200.0, 20.0), {},
+     "G64 passes the curvature jump without reduction"),
+    # 60 -> 30 at F8000: the cap is 98 mm/s, the rounding's steep rate (0.005 mm) allows
+    # 70 mm/s: slower
+    ("G17 G90 G645 SOFT F8000\n" + same_way(60.0, 30.0), {},
+     "rounding would be slower than G64"),
+    # only G645 rounds tangential transitions (5.7 "G645 also inserts rounding")
+    ("G17 G90 G642 SOFT F5000\n" + same_way(200.0, 20.0), {}, "tangential transition"),
+    # arcs tangent at the junction in two planes (XY, then YZ): a model limit, named
+    ("G90 G645 SOFT F5000\nG17 G1 X0 Y0 Z0\nG3 X20 Y20 I0 J20\nG19 G3 Y30 Z10 J0 K10\n"
+     "M30\n", {}, "tangential transition between arcs in different planes: rounding not "
+     "modelled (model limit)"),
+])
+def test_no_rounding_and_why(text, mach, why):
+    """Each case named per transition, in the planner trace and in the block rows."""
+    m = machine(**mach)
+    path = build_path(parse_text(text), m)
+    assert reasons(path) == [why]
+    assert not (path.kind == ROUNDING).any()
+    note = dict((e.stage, e.note) for e in plan(parse_text(text), m, path=path).trace)
+    assert why in note["rounding"]
+    assert set(path.rounding.decision_by_block().values()) == {f"none: {why}"}
+
+
+def test_the_block_length_clamp_raises_the_rate():
+    """spec 5.3 / the G644 excerpt: the rounding replaces at most ``c`` times each block.
+    200 -> 20 mm quarter arcs with PATH_TRANS_POS_TOL = 0.05 mm: unclamped (c = 0.5) the
+    rounding replaces 12.2 mm of the first arc and 2.44 mm of the second (the pair on
+    the flatter arc); with c = 0.05 at most 1.57 mm of the second: the rate is raised
+    until both trims fit (the second at the cap), the deviation then below the
+    tolerance."""
+    text = "G17 G90 G645 SOFT F5000\n" + same_way(200.0, 20.0)
+    free = build_path(parse_text(text), machine({"X": WIDE, "Y": WIDE}))
+    caps = 0.05 * 0.5 * math.pi * np.array([200.0, 20.0])
+    arcs = np.flatnonzero(free.kind == ARC)
+    cut = 0.5 * math.pi * np.array([200.0, 20.0]) - free.length[arcs]
+    assert not free.rounding.clamped[0] and cut[1] > caps[1]
+    mach = machine({"X": WIDE, "Y": WIDE}, rounding_length_clamp=0.05)
+    path = build_path(parse_text(text), mach)
+    t = path.rounding
+    assert reasons(path) == ["rounded"] and bool(t.clamped[0])
+    arcs = np.flatnonzero(path.kind == ARC)
+    cut = 0.5 * math.pi * np.array([200.0, 20.0]) - path.length[arcs]
+    assert (cut <= caps * (1 + 1e-12)).all()
+    # the clamp loop stops as soon as both fit; the trims scale nearly (not exactly:
+    # the headings depend on L/R) like 1/rate, so the cut lands just below the cap
+    # (measured 5.7e-5 relative)
+    assert cut[1] == pytest.approx(caps[1], rel=1e-4)
+    assert t.deviation_mm[0] < 0.05
+
+
+@pytest.mark.parametrize("mfile", ["default", "linuxcnc_xyz"])
+def test_g645_keeps_its_limits_and_passes_faster_than_the_cap(mfile):
+    """The heuristic on the rounded path keeps every limit of its bound set
+    (check_profile) on both bundled machines; where the transition is rounded (default
+    machine: the jump caps G64 at sqrt(J T / 0.045)) the planned speed inside the
+    rounding stays above that cap and the program is not slower than under G64."""
+    mach = load_machine(mfile)
+    out = {}
+    for mode in ("G64", "G645"):
+        prog = parse_text(f"G17 G90 {mode} SOFT F5000\n" + same_way(200.0, 20.0))
+        path = build_path(prog, mach)
+        res = plan(prog, mach, path=path)
+        rep = check_profile(path, mach.limits, res.profile)
+        assert rep.ok(BOUND_SETS[res.bound_set]), rep
+        out[mode] = (path, res)
+    path, res = out["G645"]
+    t = path.rounding
+    if mfile == "default":
+        assert t.inserted.all()
+        k = np.flatnonzero(path.kind == ROUNDING)
+        s = np.linspace(path.s_breaks[k[0]], path.s_breaks[k[-1] + 1], 200)
+        v = res.profile.state(res.profile.time_at(s))[1]
+        assert v.min() > t.v_g64[0]
+        assert res.profile.duration < out["G64"][1].profile.duration
+    else:       # the jump there is allowed at the programmed speed: named
+        assert reasons(path) == ["G64 passes the curvature jump without reduction"]
+
+
+@pytest.mark.parametrize("mfile", ["default", "linuxcnc_xyz"])
+def test_a_seeded_chain_of_same_way_arcs_is_rounded_where_it_pays(mfile):
+    """60 tangent arcs curving the same way (radii 5..200 mm) in one call, on both
+    bundled machines with PATH_TRANS_POS_TOL = 0.05 mm: every transition is decided and
+    named, on the default machine many are rounded (four pieces each); the built path is
+    continuous in position, tangent and curvature at every break, and the heuristic
+    keeps its limits on it."""
+    mach = bundled(mfile, 0.05)
+    prog = parse_text("G17 G90 G645 SOFT F8000\n" + same_way_chain(61, 11))
+    path = build_path(prog, mach)
+    t = path.rounding
+    assert t.n == 60 and t.tangential.all()
+    assert (t.reason >= 0).all()
+    assert np.count_nonzero(path.sharpness) == 4 * int(t.inserted.sum())
+    if mfile == "default":        # 14 of 60 (measured), the rest named
+        assert t.inserted.sum() >= 10
+    sb = path.s_breaks[1:-1]
+    seg = np.arange(path.n_segments)
+    qa, ta, ka, _ = path.evaluate(sb, segment=seg[:-1])
+    qb, tb, kb, _ = path.evaluate(sb, segment=seg[1:])
+    np.testing.assert_allclose(qa, qb, atol=1e-9)
+    np.testing.assert_allclose(ta, tb, atol=1e-9)
+    rounded = np.isin(path.block[:-1], t.block[t.inserted]) | (path.kind[:-1] == ROUNDING)
+    np.testing.assert_allclose(ka[rounded], kb[rounded], atol=1e-9)
+    res = plan(prog, mach, path=path)
+    rep = check_profile(path, mach.limits, res.profile)
+    assert rep.ok(BOUND_SETS[res.bound_set]), rep
+
+
+def test_the_deviation_never_exceeds_the_tolerance_on_large_arcs():
+    """spec 5.7 ("within the tolerance"): the sizing aims 1e-9 below the tolerance, so
+    the deviation must be measured to better than that. ``hypot - R`` loses ``R eps``
+    (2.4e-9 of 1e-4 mm on a 1000 mm arc): these two transitions (found among 20000
+    random ones) came out 5.7e-10 and 1.4e-10 above the tolerance with it, and one
+    S-bend 2.4e-10 above. Both kinds, the found cases and 2000 random ones (radii 1 ..
+    1100 mm, tolerances 1e-4 .. 0.1 mm): never above."""
+    from reference.core.transition_sbend import sbend_for_deviation
+    rng = np.random.default_rng(0)
+    r1 = np.concatenate(([1078.73175691, 1087.08508762], np.exp(rng.uniform(0, 7, 2000))))
+    r2 = np.concatenate(([67.44073227, 709.30494186], np.exp(rng.uniform(0, 7, 2000))))
+    tol = np.concatenate(([0.00010065, 0.00010808],
+                          np.exp(rng.uniform(np.log(1e-4), np.log(0.1), 2000))))
+    for sized in (samedir_for_deviation, sbend_for_deviation):
+        sh = sized(r1, r2, tol)
+        assert not np.isnan(sh.deviation).any()
+        assert (sh.deviation <= tol).all()
+        assert (sh.deviation >= tol * (1 - 2e-9)).all()
+
+
+def test_inspect_trace_and_readme_name_the_same_way_transition(tmp_path, capsys):
+    """Issue 13 item 5 (inspect lists the rounding per corner, the trace names it) and
+    the README's account of G645 between tangent arcs."""
+    from compare import cli
+    prog = tmp_path / "same.mpf"
+    prog.write_text("G90 G645 SOFT F5000\n" + same_way(200.0, 20.0))
+    assert cli.main(["inspect", str(prog)]) == 0
+    out = capsys.readouterr().out
+    assert "G2 transition = G645 at a tangential line-arc transition or between two " \
+           "tangent arcs" in out
+    row = next(r for r in out.splitlines() if r.strip().startswith("3/4"))
+    assert row.endswith("rounded (G2 transition)")
+    note = dict((e.stage, e.note) for e in plan(parse_text(prog.read_text()),
+                                                load_machine()).trace)["rounding"]
+    assert "1 G645 tangential transitions" in note
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    text = " ".join(readme.split())
+    assert ("Between two tangent arcs curving the same way with different radii no "
+            "monotone curvature ramp lands either") in text
+    assert "reference/core/transition_samedir.py" in text
