@@ -104,6 +104,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     t_bound = base_sol.bound_time_s + (acc.bound_time_s if acc is not base_sol else 0.0) \
         + time.perf_counter() - tb
     tc = time.perf_counter()
+    if progress:
+        progress("frequency rule: candidate motions", 0.8)
     cands = []
     if base_sol.profile is not None:
         c = scaled(path, limits, base_sol.profile, name)
@@ -159,6 +161,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         # relaxation's speed envelope; a verified upper bound limits the motions it must
         # hold for (slower ones are not the minimum), which bounds the drift of the
         # phases' threshold
+        if progress:
+            progress("frequency lower bound: where the motion turns", 0.9)
         tb = time.perf_counter()
         t_up = min(c.duration for c in cands)
         lb_humps = humps_bound(work, sub_lim, grid_on(work, acc.grid), t_up,
