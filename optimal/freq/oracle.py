@@ -131,7 +131,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     for W in (candidate_windows(work, sub_lim, T_max, jerk) if T_max > 0 else ()):
         # (jerk reach, rest share): the variants of optimal.freq.upper.eroded_plans,
         # none always faster
-        variants = ((False, 0.0),) if W == 0 else (
+        variants = ((False, 0.0), (False, ERODED_REST_SHARE)) if W == 0 else (
             ((False, 0.0), (True, 0.0), (True, ERODED_REST_SHARE)) if jerk
             else ((False, 0.0), (False, ERODED_REST_SHARE)))
         for reach, rest_share in variants:
@@ -145,7 +145,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                                 window_s=W) if W > 0 else u.profile
             label = (f"fir {W * 1e3:.3g} ms (eroded caps{', jerk reach' if reach else ''}"
                      f"{', slow corners at rest' if rest_share else ''})" if W > 0
-                     else "adapted caps")
+                     else f"adapted caps{' (slow corners at rest)' if rest_share else ''}")
             c = verified(label, path, limits, prof, name, u.rest_breaks)
             if c is not None:
                 cands.append(c)
