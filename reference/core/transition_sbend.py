@@ -44,8 +44,9 @@ programmed arcs). The curvature overshoot is the S's peak ``k_s = c L_s`` (about
 much shorter ramp than at a line-arc transition.
 
 *Sizing.* The largest distance from the programmed contour (the two arcs) has no closed
-form: it is sampled along the rounding (:data:`DEV_SAMPLES` per piece) and the largest
-sample refined on ever finer grids around it (:data:`REFINE_ROUNDS`). The rate ``c`` is the root of
+form: it is sampled along the rounding (:data:`DEV_SAMPLES` per piece), the largest
+sample refined on finer grids around it (:data:`SCAN_ROUNDS`) and then by Newton steps
+on the distance's slope (:func:`pieces_deviation`). The rate ``c`` is the root of
 "deviation = tolerance" (the deviation grows like ``1/c^2``; Newton-secant steps in
 ``log c``).
 
@@ -72,15 +73,25 @@ SBEND_PIECES = 6
 #: turn and the deviation has at most one bump per piece; 12 samples put several on
 #: each).
 DEV_SAMPLES = 12
-#: Refinement rounds: each evaluates :data:`REFINE_POINTS` points evenly over the
-#: span ``+-h`` around the best so far (``h`` at first the sample spacing) and divides
-#: ``h`` by :data:`REFINE_SHRINK` (the points' own spacing, so the maximum stays
-#: inside); after 6 rounds ``h`` is 4^-6 ~ 2.4e-4 of the sample spacing, and the vertex
-#: of the parabola through the last three points then puts the maximum's value (a
-#: smooth maximum: flat to second order) far below round-off of the tolerance.
-REFINE_ROUNDS = 6
+#: Scan rounds after the samples (:func:`sbend_deviation`): each evaluates
+#: :data:`REFINE_POINTS` points evenly over the span ``+-h`` around the best so far
+#: (``h`` at first the sample spacing) and divides ``h`` by :data:`REFINE_SHRINK` (the
+#: points' own spacing, so the maximum stays inside). Two rounds pick the highest of
+#: the local maxima on the plateau near the junction (~1e-5 apart in value, ~0.1 mm in
+#: place at R ~ 100 mm); Newton steps then find the maximum in the last span.
+SCAN_ROUNDS = 2
 REFINE_POINTS = 9
 REFINE_SHRINK = 4.0
+#: Cap of the Newton steps on the distance's slope (3-6 in practice) and the step
+#: below which they stop, relative to the rounding's length (the maximum's value is then
+#: exact to round-off: it is flat to second order).
+NEWTON_MAX_ITER = 12
+NEWTON_STEP_TOL = 1e-12
+#: Rounds of the fallback refinement by sampling where the Newton steps do not converge
+#: (as the scan; after 6 rounds ``h`` is 4^-6 ~ 2.4e-4 of the sample spacing, and the
+#: vertex of the parabola through the last three points puts a smooth maximum's value
+#: far below round-off of the tolerance).
+REFINE_ROUNDS = 6
 #: Iteration cap of the ``theta`` root (bracketed secant with the Illinois correction;
 #: 8-25 steps over a batch in practice) and of the ``log c`` root (4-7 in practice).
 ROOT_MAX_ITER = 100
@@ -219,81 +230,200 @@ def _canonical_pieces(sh: SBendShape):
             lengths)
 
 
-def _clothoid_xy(origin, e1, e2, rate, length, s_local):
-    """Positions on clothoid pieces at distances ``s_local`` from each piece's start
-    (the model of :mod:`reference.core.geometry`, positions only); ``origin``, ``e1``,
-    ``e2`` shape (..., 2), the rest shape (...)."""
+def _samples(pieces, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n + 1`` evenly spaced points on each piece (both ends): distances from the
+    rounding's start and the points' canonical ``x`` and ``y``, shape (k, 6 (n + 1))
+    each (the model of :mod:`reference.core.geometry`, positions only: ``sigma`` from
+    the zero-curvature end, ``q = o + a C(sigma / a) e1 + a S(sigma / a) e2`` with
+    ``a = sqrt(pi / c)``)."""
+    origin, e1, e2, rates, lengths = pieces
+    k = rates.shape[0]
+    s_local = lengths[:, :, None] * np.linspace(0.0, 1.0, n + 1)[None, None, :]
+    sigma = np.where(rates[:, :, None] < 0, lengths[:, :, None] - s_local, s_local)
+    scale = np.sqrt(np.pi / np.abs(rates))[:, :, None]
+    fs, fc = _fresnel(sigma / scale)
+    fc, fs = scale * fc, scale * fs
+    x = origin[:, :, None, 0] + fc * e1[:, :, None, 0] + fs * e2[:, :, None, 0]
+    y = origin[:, :, None, 1] + fc * e1[:, :, None, 1] + fs * e2[:, :, None, 1]
+    starts = np.cumsum(lengths, axis=1) - lengths
+    return ((starts[:, :, None] + s_local).reshape(k, -1), x.reshape(k, -1),
+            y.reshape(k, -1))
+
+
+def _packed(pieces) -> np.ndarray:
+    """The pieces of each transition as one array, shape (k, p, 9): zero-curvature
+    end (2), ``e1`` (2), ``e2`` (2), signed rate, length, distance of the piece's start
+    from the rounding's start (one gather per point instead of one per field)."""
+    origin, e1, e2, rates, lengths = pieces
+    starts = np.cumsum(lengths, axis=1) - lengths
+    return np.concatenate((origin, e1, e2, rates[..., None], lengths[..., None],
+                           starts[..., None]), axis=2)
+
+
+def _on_pieces(packed: np.ndarray, s: np.ndarray, derivatives: bool = True):
+    """Canonical points, unit tangents and second derivatives at distances ``s`` (shape
+    (k,) or (k, N)) from the rounding's start, shape ``s.shape + (2,)`` each (the model
+    of :mod:`reference.core.geometry`: ``sigma`` from the zero-curvature end, the
+    heading ``c sigma^2 / 2`` from ``e1`` towards ``e2``, the tangent reversed on a
+    piece whose zero-curvature end is its last point); the points alone unless
+    ``derivatives``."""
+    k = s.shape[0]
+    ends = packed[:, :, 7] + packed[:, :, 8]
+    rows = np.arange(k).reshape((k,) + (1,) * (s.ndim - 1))
+    p = packed.shape[1]
+    ends = ends.reshape((k,) + (1,) * (s.ndim - 1) + (p,))
+    idx = np.minimum((s[..., None] >= ends).sum(axis=-1), p - 1)
+    g = packed[rows, idx]                                       # s.shape + (9,)
+    e1, e2, rate, length = g[..., 2:4], g[..., 4:6], g[..., 6], g[..., 7]
+    s_local = s - g[..., 8]
     c = np.abs(rate)
     sigma = np.clip(np.where(rate < 0, length - s_local, s_local), 0.0, length)
     scale = np.sqrt(np.pi / c)
     fs, fc = _fresnel(sigma / scale)
-    return (origin + (scale * fc)[..., None] * e1 + (scale * fs)[..., None] * e2)
+    p = g[..., 0:2] + (scale * fc)[..., None] * e1 + (scale * fs)[..., None] * e2
+    if not derivatives:
+        return p
+    phi = 0.5 * c * sigma * sigma
+    cos, sin = np.cos(phi)[..., None], np.sin(phi)[..., None]
+    tangent = np.where(rate[..., None] < 0, -1.0, 1.0) * (cos * e1 + sin * e2)
+    second = (c * sigma)[..., None] * (cos * e2 - sin * e1)
+    return p, tangent, second
 
 
-def _samples(pieces, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``n + 1`` evenly spaced points on each piece (both ends): distances from the
-    rounding's start, shape (k, 6 (n + 1)), and canonical points, shape (k, 6 (n + 1),
-    2)."""
-    origin, e1, e2, rates, lengths = pieces
-    k = rates.shape[0]
-    s_local = lengths[:, :, None] * np.linspace(0.0, 1.0, n + 1)[None, None, :]
-    xy = _clothoid_xy(origin[:, :, None, :], e1[:, :, None, :], e2[:, :, None, :],
-                      rates[:, :, None], lengths[:, :, None], s_local)
-    starts = np.cumsum(lengths, axis=1) - lengths
-    return (starts[:, :, None] + s_local).reshape(k, -1), xy.reshape(k, -1, 2)
+def _circle(first: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
+            centre_out: np.ndarray):
+    """Centre height ``y_c`` and radius of the programmed circle that measures the
+    distance: the first where ``first`` (``x <= 0``), else the second
+    (:func:`_distance`)."""
+    return np.where(first, r_in, centre_out), np.where(first, r_in, r_out)
 
 
-def _points(pieces, s: np.ndarray) -> np.ndarray:
-    """Canonical points at distances ``s`` (shape (k, N)) from the rounding's start,
-    shape (k, N, 2)."""
-    origin, e1, e2, rates, lengths = pieces
-    k, p = rates.shape
-    ends = np.cumsum(lengths, axis=1)
-    idx = np.minimum((s[:, :, None] >= ends[:, None, :]).sum(axis=2), p - 1)
-    # each point's piece as a row of the flattened (k p) arrays: one gather per array
-    # (numpy's take_along_axis cost about 3x as much here)
-    flat = idx + (np.arange(k) * p)[:, None]
-    start = (ends - lengths).ravel()[flat]
-    return _clothoid_xy(origin.reshape(-1, 2)[flat], e1.reshape(-1, 2)[flat],
-                        e2.reshape(-1, 2)[flat], rates.ravel()[flat], lengths.ravel()[flat],
-                        s - start)
-
-
-def _distance(p: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
+def _distance(x: np.ndarray, y: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
               centre_out: np.ndarray) -> np.ndarray:
-    """Distance of canonical points ``p`` (k, N, 2) from the programmed contour: the
-    first arc (``x <= 0`` near ``J``, centre ``(0, r_in)``) and the second (``x >= 0``,
-    centre ``(0, centre_out)``: ``-r_out`` at an S-bend, ``+r_out`` for arcs curving the
-    same way); where a point's radial projection falls beyond an arc's end at ``J``, that
-    arc's nearest point is ``J``.
+    """Distance of canonical points ``(x, y)`` (shape (k, N) each; radii shape (k,))
+    from the programmed contour: the first arc (``x <= 0`` near ``J``, centre ``(0,
+    r_in)``) and the second (``x >= 0``, centre ``(0, centre_out)``: ``-r_out`` at an
+    S-bend, ``+r_out`` for arcs curving the same way).
 
-    From a circle of centre ``(0, c)`` through ``J`` (``c^2 = r^2``) the distance is
-    ``|x^2 + y (y - 2 c)| / (hypot(x, y - c) + r)``: ``hypot(x, y - c) - r`` would lose
-    ``r eps`` to cancellation (2.4e-9 of a 1e-4 mm deviation on a 1000 mm arc, above the
-    sizing's margin :data:`DEVIATION_REL_TOL`), this form a few ``eps`` of it."""
-    x, y = p[..., 0], p[..., 1]
-    at_j = np.hypot(x, y)
-    xx = x * x
+    Where a point's radial projection falls beyond an arc's end at ``J``, that arc's
+    nearest point is ``J``; ``J`` lies on the other circle, whose distance is at most
+    the distance from ``J``, so the contour distance is that from the first circle for
+    ``x < 0`` and from the second for ``x > 0`` (at ``x = 0`` both give ``|y|`` near
+    ``J``: the distance is continuous there, with its gradient, only its second
+    derivative along the rounding jumps). It is computed as ``|x^2 + y^2 - 2 y y_c| /
+    (|p - centre| + R)`` (``= ||p - centre| - R|``, centre ``(0, y_c)``, ``|y_c| =
+    R``): ``|p - centre| - R`` would lose ``R eps`` to cancellation (2.4e-9 of a 1e-4 mm
+    deviation on a 1000 mm arc, above the sizing's margin :data:`DEVIATION_REL_TOL`),
+    this form a few ``eps`` of it (the denominator ``~2 R`` needs no more)."""
+    yc, r = _circle(x <= 0, r_in[:, None], r_out[:, None], centre_out[:, None])
+    qy = y - yc
+    return np.abs(x * x + y * (y - 2.0 * yc)) / (np.sqrt(x * x + qy * qy) + r)
 
-    def from_circle(c, r):
-        return np.abs(xx + y * (y - 2.0 * c)) / (np.hypot(x, y - c) + r)
 
-    d1 = np.where(x <= 0, from_circle(r_in[:, None], r_in[:, None]), at_j)
-    d2 = np.where(x >= 0, from_circle(centre_out[:, None], r_out[:, None]), at_j)
-    return np.minimum(d1, d2)
+def _distance_slopes(packed, s, first, r_in, r_out, centre_out):
+    """Distance from one programmed circle (the first where ``first``, else the second)
+    of the points at ``s`` and its first and second derivatives along the rounding,
+    shape (k,) each (``packed`` (k, 6, 9), the rest (k,)): with ``q = p - centre`` and
+    ``D = |q| - R``, ``d = |D|``, ``d' = sign(D) q.t / |q|`` and ``d'' = sign(D)
+    ((1 + q.p'') / |q| - (q.t)^2 / |q|^3)`` (``|t| = 1``)."""
+    p, tangent, second = _on_pieces(packed, s)
+    x, y = p[:, 0], p[:, 1]
+    yc, r = _circle(first, r_in, r_out, centre_out)
+    qy = y - yc
+    norm = np.sqrt(x * x + qy * qy)
+    num = x * x + y * (y - 2.0 * yc)                  # |q|^2 - R^2
+    sign = np.sign(num)
+    qt = x * tangent[:, 0] + qy * tangent[:, 1]
+    qa = x * second[:, 0] + qy * second[:, 1]
+    slope = sign * qt / norm
+    bend = sign * ((1.0 + qa) / norm - qt * qt / norm ** 3)
+    return np.abs(num) / (norm + r), slope, bend
+
+
+def _crossing(packed, a, b, xa, xb):
+    """Where the roundings cross ``x = 0`` (the normal at ``J``) between ``a`` and
+    ``b`` (shape (m,); ``x`` is ``xa <= 0`` at ``a`` and ``xb > 0`` at ``b``, and grows
+    along the rounding: its heading stays within a quarter turn of the common tangent),
+    by Newton steps on ``x(s)`` (slope the tangent's ``x``) from the secant's root,
+    kept inside ``[a, b]``; shape (m,)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = a - xa * (b - a) / (xb - xa)
+    t = np.where((t >= a) & (t <= b), t, 0.5 * (a + b))
+    for _ in range(NEWTON_MAX_ITER):
+        p, tangent, _ = _on_pieces(packed, t)
+        nxt = np.clip(t - p[:, 0] / tangent[:, 0], a, b)
+        stop = np.all(np.abs(nxt - t) <= NEWTON_STEP_TOL * b)
+        t = nxt
+        if stop:
+            break
+    return t
+
+
+def _bracket_max(packed, a, b, first, start, r_in, r_out, centre_out):
+    """Largest distance from one programmed circle (``first``: the first) over
+    ``[a, b]`` (shape (m,) each, ``packed`` (m, 6, 9)), taken to have one local maximum
+    there (:func:`sbend_deviation`). Where the distance falls from ``a`` (rises to
+    ``b``) the maximum is that end; else Newton steps on the slope from ``start``, kept
+    inside a bracket that each step's slope sign shrinks (a step leaving it, or a point
+    where the distance is not concave, bisects instead), until a step is below
+    :data:`NEWTON_STEP_TOL` of ``b``. Returns the value, shape (m,), and whether it
+    converged."""
+    d_a, g_a, _ = _distance_slopes(packed, a, first, r_in, r_out, centre_out)
+    d_b, g_b, _ = _distance_slopes(packed, b, first, r_in, r_out, centre_out)
+    at_a = g_a <= 0
+    at_b = ~at_a & (g_b >= 0)
+    value = np.where(at_a, d_a, np.where(at_b, d_b, -np.inf))
+    inner = np.flatnonzero(~(at_a | at_b))
+    done = np.ones(a.shape, dtype=bool)
+    if not inner.size:
+        return value, done
+    pk, lo, hi = packed[inner], a[inner], b[inner]
+    fi, r1, r2, c2 = first[inner], r_in[inner], r_out[inner], centre_out[inner]
+    x = start[inner]
+    x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+    conv = np.zeros(inner.size, dtype=bool)
+    for _ in range(NEWTON_MAX_ITER):
+        _, slope, bend = _distance_slopes(pk, x, fi, r1, r2, c2)
+        lo = np.where(slope > 0, x, lo)
+        hi = np.where(slope > 0, hi, x)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nxt = x - slope / bend
+        nxt = np.where((bend < 0) & (nxt >= lo) & (nxt <= hi), nxt, 0.5 * (lo + hi))
+        conv = np.abs(nxt - x) <= NEWTON_STEP_TOL * b[inner]
+        x = nxt
+        if conv.all():
+            break
+    value[inner] = _distance_slopes(pk, x, fi, r1, r2, c2)[0]
+    done[inner] = conv
+    return value, done
 
 
 def sbend_deviation(sh: SBendShape) -> np.ndarray:
     """Largest distance of the rounding from the programmed arcs, mm, shape (k,)
-    (module docstring: sampled, then refined on finer grids)."""
+    (:func:`pieces_deviation`)."""
     return pieces_deviation(_canonical_pieces(sh), sh.r_in, sh.r_out, -sh.r_out)
 
 
 def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
                      centre_out: np.ndarray) -> np.ndarray:
     """Largest distance of clothoid pieces between two tangent arcs from the arcs, mm,
-    shape (k,): :data:`DEV_SAMPLES` samples per piece, the largest refined on ever
-    finer grids (module docstring), for every transition between two arcs.
+    shape (k,), for every transition between two arcs.
+
+    Sampled (:data:`DEV_SAMPLES` per piece); the maximum lies within one sample spacing
+    ``h`` of the largest sample (the samples separate the local maxima: module
+    docstring). :data:`SCAN_ROUNDS` rounds then each evaluate :data:`REFINE_POINTS`
+    points over ``+-h`` around the best so far and divide ``h`` by
+    :data:`REFINE_SHRINK` (near ``J`` the deviation is a plateau with local maxima
+    ~1e-5 apart in value and less than a sample spacing apart in place: the scan picks
+    the highest). In the last window the distance is a smooth function of the arc
+    length (the curvature is continuous across the pieces) on either side of the point
+    where the rounding crosses the normal at ``J`` (:func:`_distance`: the circle that
+    measures it changes there, and with it the distance's second derivative); the
+    window is cut there and the largest distance on each part from its own circle found
+    by :func:`_bracket_max` (Newton steps: a smooth maximum is flat to second order, so
+    its value is then exact to round-off). The few transitions not converged in
+    :data:`NEWTON_MAX_ITER` steps are refined by sampling (:func:`_refine_sampled`).
+    The result is never below the largest point evaluated.
 
     Parameters
     ----------
@@ -305,35 +435,81 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
     """
     lengths = pieces[4]
     k, n_pieces = lengths.shape
-    s, xy = _samples(pieces, DEV_SAMPLES)
-    dev = _distance(xy, r_in, r_out, centre_out)
+    s, sx, sy = _samples(pieces, DEV_SAMPLES)
+    dev = _distance(sx, sy, r_in, r_out, centre_out)
     i = dev.argmax(axis=1)
     rows = np.arange(k)
     best, at = dev[rows, i], s[rows, i]
     total = lengths.sum(axis=1)
-    # the maximum lies within one sample spacing of the best sample: each round covers
-    # that span with REFINE_POINTS points and shrinks it by REFINE_SHRINK
-    h = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), n_pieces - 1)] / DEV_SAMPLES
+    h0 = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), n_pieces - 1)] / DEV_SAMPLES
+    packed = _packed(pieces)
     off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
-    for _ in range(REFINE_ROUNDS):
+    h = h0
+    for _ in range(SCAN_ROUNDS):
         x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
-        d = _distance(_points(pieces, x), r_in, r_out, centre_out)
+        p = _on_pieces(packed, x, derivatives=False)
+        d = _distance(p[..., 0], p[..., 1], r_in, r_out, centre_out)
         j = d.argmax(axis=1)
         better = d[rows, j] > best
         best = np.where(better, d[rows, j], best)
         at = np.where(better, x[rows, j], at)
         h = h / REFINE_SHRINK
-    # the maximum is smooth (a distance from one arc): the vertex of the parabola
-    # through the best point and its neighbours at the last spacing
+    lo, hi = np.maximum(at - h, 0.0), np.minimum(at + h, total)
+    # the window's parts either side of the crossing, each with its circle
+    ends = _on_pieces(packed, np.stack((lo, hi), axis=1), derivatives=False)[..., 0]
+    split = np.flatnonzero((ends[:, 0] <= 0) & (ends[:, 1] > 0))
+    cross = _crossing(packed[split], lo[split], hi[split], ends[split, 0], ends[split, 1])
+    mid = hi.copy()
+    mid[split] = cross
+    which = np.concatenate((rows, split))
+    a = np.concatenate((lo, cross))
+    b = np.concatenate((mid, hi[split]))
+    first = np.concatenate((ends[:, 0] <= 0, np.zeros(split.size, dtype=bool)))
+    value, done = _bracket_max(packed[which], a, b, first, at[which], r_in[which],
+                               r_out[which], centre_out[which])
+    np.maximum.at(best, which, value)
+    ok = np.ones(k, dtype=bool)
+    np.logical_and.at(ok, which, done)
+    if not ok.all():
+        rest = np.flatnonzero(~ok)
+        best[rest] = np.maximum(best[rest], _refine_sampled(
+            packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
+            centre_out[rest]))
+    return best
+
+
+def _refine_sampled(packed: np.ndarray, at: np.ndarray, h: np.ndarray, best: np.ndarray,
+                    r_in: np.ndarray, r_out: np.ndarray, centre_out: np.ndarray
+                    ) -> np.ndarray:
+    """The largest distance within ``h`` of ``at`` by sampling: each of
+    :data:`REFINE_ROUNDS` rounds evaluates :data:`REFINE_POINTS` points over ``+-h``
+    around the best so far and divides ``h`` by :data:`REFINE_SHRINK`; then the vertex
+    of the parabola through the best point and its neighbours."""
+    k = at.size
+    rows = np.arange(k)
+    total = (packed[:, -1, 7] + packed[:, -1, 8])
+    off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
+
+    def dist(s):
+        p = _on_pieces(packed, s, derivatives=False)
+        return _distance(p[..., 0], p[..., 1], r_in, r_out, centre_out)
+
+    for _ in range(REFINE_ROUNDS):
+        x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
+        d = dist(x)
+        j = d.argmax(axis=1)
+        better = d[rows, j] > best
+        best = np.where(better, d[rows, j], best)
+        at = np.where(better, x[rows, j], at)
+        h = h / REFINE_SHRINK
     x = np.clip(at[:, None] + h[:, None] * np.array([-1.0, 1.0])[None, :], 0.0,
                 total[:, None])
-    nb = _distance(_points(pieces, x), r_in, r_out, centre_out)
+    nb = dist(x)
     curv = nb[:, 0] + nb[:, 1] - 2.0 * best
     with np.errstate(divide="ignore", invalid="ignore"):
         v = at + 0.5 * h * (nb[:, 0] - nb[:, 1]) / curv
     v = np.where((curv < 0) & (np.abs(v - at) <= h), v, at)
-    top = _distance(_points(pieces, np.clip(v, 0.0, total)[:, None]), r_in, r_out,
-                    centre_out)
+    top = dist(np.clip(v, 0.0, total)[:, None])
     return np.maximum(np.maximum(best, top[:, 0]), nb.max(axis=1))
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
+from dataclasses import fields
 from itertools import compress
 from typing import Callable, NamedTuple
 
@@ -41,7 +42,8 @@ from . import causes as C
 from .adaptation import adaptation_factors, adapted_units
 from .corners import junction_limits
 from .limit_curves import segment_limits
-from .lookahead import NodeSpeeds, Units, horizon_caps, lookahead_passes, planning_units
+from .lookahead import (NodeSpeeds, Units, cruise_splits, horizon_caps, lookahead_passes,
+                        planning_units)
 from .parameters import CAUSE_REL_TOL, DEFAULT_PARAMETERS, PlannerParameters
 from .profiles import (CASE_FALL_ACC, CASE_RISE_ACC, UnitProfiles, case_name,
                        unit_profiles)
@@ -87,6 +89,30 @@ def rounding_note(path: Path) -> str:
 # ----------------------------------------------------------------- composition
 def _noop(stage: str, fraction: float) -> None:
     return None
+
+
+def _plan_changed(units: Units, v_nodes: np.ndarray, old_units: Units,
+                  old_prof: UnitProfiles, old_v: np.ndarray) -> UnitProfiles:
+    """:func:`_plan_all`, the rows of units that were planned before (the same segments
+    between the same node speeds) taken from ``old_prof``: a unit's profile depends on
+    its own segments' cap and limits and its end speeds only, so this is what planning
+    every unit again gives, element by element."""
+    first, old_first = units.first_segment, old_units.first_segment
+    j = np.minimum(np.searchsorted(old_first, first), max(old_first.size - 1, 0))
+    same = np.zeros(first.size, dtype=bool)
+    if old_first.size:
+        same = ((old_first[j] == first) & (old_units.n_segments[j] == units.n_segments)
+                & (old_v[j] == v_nodes[:-1]) & (old_v[j + 1] == v_nodes[1:]))
+    new = np.flatnonzero(~same)
+    part = _replan(units, new, v_nodes)
+    out = {}
+    for f in fields(UnitProfiles):
+        a_old, a_new = getattr(old_prof, f.name), getattr(part, f.name)
+        arr = np.empty((first.size,) + a_old.shape[1:], dtype=a_old.dtype)
+        arr[same] = a_old[j[same]]
+        arr[new] = a_new
+        out[f.name] = arr
+    return UnitProfiles(**out)
 
 
 def _replan(units: Units, idx: np.ndarray, v_nodes: np.ndarray) -> UnitProfiles:
@@ -179,9 +205,20 @@ def plan(program: Program, machine: Machine, *, path: Path | None = None,
     horizon = horizon_caps(path, seg, modes, ch.lookahead_blocks)
     base_units = planning_units(path, seg, junc, modes, horizon, params.soft_merge_cap_ratio,
                                 params.soft_merge_accel_ratio)
+    speeds = lookahead_passes(base_units)
+    prof = _plan_all(base_units, speeds.v)
+    # merged breaks passed at the unit's cap: planned apart, each side ramps with its
+    # own dynamics (lookahead.cruise_splits: never slower)
+    split = cruise_splits(path, seg, base_units, prof.v_peak, prof.dist_rise,
+                          prof.dist_cruise, prof.dist_fall)
+    if split.any():
+        old_units, old_prof, old_v = base_units, prof, speeds.v
+        base_units = planning_units(path, seg, junc, modes, horizon,
+                                    params.soft_merge_cap_ratio,
+                                    params.soft_merge_accel_ratio, split)
+        speeds = lookahead_passes(base_units)
+        prof = _plan_changed(base_units, speeds.v, old_units, old_prof, old_v)
     units = base_units
-    speeds = lookahead_passes(units)
-    prof = _plan_all(units, speeds.v)
     n_h = int(np.sum(units.node_cause == C.HORIZON))
     trace.append(("lookahead", f"horizon {ch.lookahead_blocks} blocks (v = 0 assumed at its "
                                f"end; binding at {n_h} nodes); {units.n_units} planning units "

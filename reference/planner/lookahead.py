@@ -34,7 +34,10 @@ Three steps, all O(n) in the number of segments:
    dynamics are far lower (a short curved segment at its speed cap: a clothoid pair
    of a rounding, whose jerk budget the centripetal part uses up) from imposing them on
    the lines beside it: those ramp with their own limits, and the curved segment is
-   passed at about the speed it is entered with.
+   passed at about the speed it is entered with. Once planned, merged breaks that a
+   unit with mixed dynamics passes at its cap (cruising: no ramp crosses them) are cut
+   where a part would move faster on its own, and the units planned again
+   (:func:`cruise_splits`; only the changed units' profiles are computed again).
 
 3. **Passes** (:func:`lookahead_passes`): a backward pass from the end and a forward pass
    from the start over the units, each step the closed-form reachable speed of
@@ -57,6 +60,12 @@ from .corners import JunctionLimits
 from .limit_curves import SegmentLimits
 from .profiles import ramp_reach
 from .stops import SegmentModes
+
+#: A part of a unit moves faster on its own (:func:`cruise_splits`) only where its cap,
+#: acceleration or jerk exceeds the unit's by more than this, relative: the two pieces
+#: of a clothoid pair differ by round-off (1e-13), and a gain below 1e-9 is not worth
+#: planning the program again.
+SPLIT_GAIN_REL = 1e-9
 
 
 # ----------------------------------------------------------------- horizon
@@ -189,11 +198,11 @@ def _limit_nodes(node_cap, node_cause, cap, cap_cause):
 
 def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
                  own_cap: np.ndarray, through: np.ndarray, ratio: float,
-                 accel_ratio: float) -> np.ndarray:
+                 accel_ratio: float, split: np.ndarray | None = None) -> np.ndarray:
     """True at interior breaks where two SOFT segments become one unit (greedy runs):
-    both SOFT, no stop, the break lets ``accel_ratio`` of the smaller acceleration
-    through, the two segments' accelerations and jerks within ``accel_ratio`` of each
-    other, and the effective caps of the run within ``ratio``."""
+    both SOFT, no stop, not ``split``, the break lets ``accel_ratio`` of the smaller
+    acceleration through, the two segments' accelerations and jerks within
+    ``accel_ratio`` of each other, and the effective caps of the run within ``ratio``."""
     m = path.n_segments
     merge = np.zeros(m + 1, dtype=bool)
     if m < 2:
@@ -205,6 +214,8 @@ def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
                  & (through[1:m] >= accel_ratio * np.minimum(a0, a1))
                  & (np.minimum(a0, a1) >= accel_ratio * np.maximum(a0, a1))
                  & (np.minimum(j0, j1) >= accel_ratio * np.maximum(j0, j1)))
+    if split is not None:
+        cand &= ~split
     idx = np.flatnonzero(cand)
     if idx.size == 0:
         return merge
@@ -242,7 +253,7 @@ def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
 
 def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
                    modes: SegmentModes, horizon: np.ndarray, merge_ratio: float,
-                   merge_accel_ratio: float) -> Units:
+                   merge_accel_ratio: float, split: np.ndarray | None = None) -> Units:
     """Group segments into planning units and set their node limits.
 
     Parameters
@@ -257,6 +268,8 @@ def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
         ``soft_merge_cap_ratio``.
     merge_accel_ratio : float
         ``soft_merge_accel_ratio``.
+    split : numpy.ndarray of bool, shape (m + 1,), optional
+        Breaks never merged (:func:`cruise_splits`).
 
     Returns
     -------
@@ -267,7 +280,7 @@ def planning_units(path: Path, seg: SegmentLimits, junc: JunctionLimits,
     own = np.minimum(np.minimum(junc.g64, junc.curvature), horizon)
     own = np.where(modes.stop, 0.0, own)
     merge = _merge_flags(path, seg, modes, own, junc.through_accel, merge_ratio,
-                         merge_accel_ratio)
+                         merge_accel_ratio, split)
     nodes = np.flatnonzero(~merge)          # includes 0 and m
     first = nodes[:-1]
     count = np.diff(nodes)
@@ -395,6 +408,99 @@ def _keeps_own(v_own: np.ndarray, v_from: np.ndarray, dist: np.ndarray, acc_fit:
                     + (v_own + v_from) * acc_fit / (2.0 * jerk) <= dist))
         keeps |= brisk & (v_own <= np.sqrt(v_from * v_from + 2.0 * acc * dist))
     return keeps
+
+
+def cruise_splits(path: Path, seg: SegmentLimits, units: Units, v_peak: np.ndarray,
+                  dist_rise: np.ndarray, dist_cruise: np.ndarray, dist_fall: np.ndarray
+                  ) -> np.ndarray:
+    """Merged breaks to plan apart: True there, shape (m + 1,).
+
+    A merge lets a ramp continue through a break, and the unit then runs with the
+    smallest cap, acceleration and jerk of its segments over its whole length and in the
+    ramps from and to its nodes, so a segment with lower dynamics slows those beside it
+    (three S-bends: the S pieces' jerk, 0.5-0.7 of the arcs', ramped the arcs from and
+    to rest and made the G645 program slower than under G64). Where the planned motion
+    cruises at the unit's cap no ramp crosses a break: cut there, the motion planned
+    before stays feasible (each part has the same or a higher cap, acceleration and
+    jerk; the break's own limit is at least the cap, as the merge required, and the
+    motion crosses it at zero acceleration), so the passes find node speeds at least as
+    high and each part ramps with its own dynamics. A unit is cut only where one of the
+    parts would move faster on its own: a higher cap, or higher dynamics in the part
+    that holds the unit's rise (its first) or fall (its last), by more than
+    :data:`SPLIT_GAIN_REL`; elsewhere the same motion would be planned again.
+
+    Parameters
+    ----------
+    path : Path
+    seg : SegmentLimits
+    units : Units
+    v_peak, dist_rise, dist_cruise, dist_fall : numpy.ndarray, shape (u,)
+        Of the units' profiles (:class:`reference.planner.profiles.UnitProfiles`): peak
+        speed (mm/s), rise, cruise and fall distances (mm).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (m + 1,)
+    """
+    m = path.n_segments
+    split = np.zeros(m + 1, dtype=bool)
+    multi = np.flatnonzero((units.n_segments > 1) & (dist_cruise > 0)
+                           & (v_peak >= units.cap))
+    if multi.size == 0:
+        return split
+    unit_of = np.repeat(np.arange(units.n_units), units.n_segments)
+    # segments whose own dynamics the unit lowers
+    g = 1.0 + SPLIT_GAIN_REL
+    lowered = ((seg.cap > g * units.cap[unit_of]) | (seg.accel > g * units.acc_up[unit_of])
+               | (seg.accel > g * units.acc_dn[unit_of])
+               | (seg.jerk > g * units.jerk_up[unit_of])
+               | (seg.jerk > g * units.jerk_dn[unit_of]))
+    mixed = np.zeros(units.n_units, dtype=bool)
+    np.logical_or.at(mixed, unit_of, lowered)
+    multi = multi[mixed[multi]]
+    if multi.size == 0:
+        return split
+    lo = units.s_start[multi] + dist_rise[multi]
+    hi = lo + dist_cruise[multi]
+    # the interior breaks of those units inside their cruise
+    first, count = units.first_segment[multi], units.n_segments[multi]
+    owner = np.repeat(np.arange(multi.size), count - 1)
+    brk = (np.arange(owner.size) - np.repeat(np.cumsum(count - 1) - (count - 1), count - 1)
+           + first[owner] + 1)
+    s_brk = path.s_breaks[brk]
+    inside = (s_brk > lo[owner]) & (s_brk < hi[owner])
+    cut, cut_owner = brk[inside], owner[inside]
+    # the parts the cuts leave, and whether one of them would move faster on its own: a
+    # higher cap, or higher dynamics in the part that holds the unit's rise (its first)
+    # or fall (its last); elsewhere the motion stays the cruise and a new plan of the
+    # program would give the same (a cost, no gain)
+    starts = np.concatenate((first, cut))
+    part_owner = np.concatenate((np.arange(multi.size), cut_owner))
+    order = np.argsort(starts, kind="stable")
+    starts, part_owner = starts[order], part_owner[order]
+    ends = np.append(starts[1:], m)
+    ends = np.where(np.append(part_owner[1:], -1) == part_owner, ends,
+                    (first + count)[part_owner])
+    # the smallest over [start, end) of each part: reduceat over (start, end) pairs,
+    # every second result (an end may be m: one padding element)
+    pairs = np.stack((starts, ends), axis=1).ravel()
+
+    def part_min(x):
+        return np.minimum.reduceat(np.append(x, np.inf), pairs)[::2]
+
+    cap_p, acc_p, jerk_p = part_min(seg.cap), part_min(seg.accel), part_min(seg.jerk)
+    u = multi[part_owner]
+    at_first = starts == units.first_segment[u]
+    at_last = ends == units.first_segment[u] + units.n_segments[u]
+    faster = ((cap_p > g * units.cap[u])
+              | (at_first & (dist_rise[u] > 0)
+                 & ((acc_p > g * units.acc_up[u]) | (jerk_p > g * units.jerk_up[u])))
+              | (at_last & (dist_fall[u] > 0)
+                 & ((acc_p > g * units.acc_dn[u]) | (jerk_p > g * units.jerk_dn[u]))))
+    gains = np.zeros(multi.size, dtype=bool)
+    np.logical_or.at(gains, part_owner, faster)
+    split[cut[gains[cut_owner]]] = True
+    return split
 
 
 def lookahead_passes(units: Units) -> NodeSpeeds:

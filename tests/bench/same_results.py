@@ -7,8 +7,10 @@ under G64 and the rounding modes, BRISK and SOFT, :func:`corpus_in_mode`), the
 short-segment program under G642, and seeded polylines, line-arc chains (with and
 without corners next to the arcs) and arc chains (corners between two arcs) under G64
 and the rounding modes, and chains of tangent arcs (S-bends, arcs curving the same way)
-under G64 and G645; on both bundled machines. Per case: every segment array of the built path, its rounding table and block
-spans, and of the plan (with its own check) the profile, total time, block rows, corner
+under G64 and G645; on both bundled machines; and a seeded S-bend chain under G64 and
+G645 on both with PATH_TRANS_POS_TOL = 0.05 mm (most of them rounded). Per case: every
+segment array of the built path, its rounding table and block spans, and of the plan
+(with its own check) the profile, total time, block rows, corner
 rows and trace (less its wall time). ``compare`` prints the largest relative difference
 ``|a - b| / max(1, |a|)`` of the float columns and every mismatch; a speed-up that only
 reorders work must show 0 (bit-identical), and at most round-off otherwise.
@@ -33,6 +35,7 @@ from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
+from bench_rounding import _with_trans_tol  # noqa: E402
 from seeded_programs import (arc_chain, line_arc_chain, polyline, s_bend_chain,  # noqa: E402
                              same_way_chain)
 
@@ -97,12 +100,25 @@ def _plain(x):
     return x
 
 
+def sbend_programs(n: int = 1500) -> dict[str, str]:
+    """Name -> program text of the S-bend cases (a seeded chain of tangent arcs curving
+    alternately), run with MD33120 PATH_TRANS_POS_TOL = 0.05 mm so that G645 rounds
+    most of them (:func:`dump`)."""
+    chain = s_bend_chain(n, 5)
+    return {f"sbends|{mode} {acc}": f"G17 G90 {mode} {acc} F8000\n" + chain
+            for acc in ("BRISK", "SOFT") for mode in ("G64", "G645", "G645 CTOL=0.02")}
+
+
 def dump(out: str) -> None:
-    """Build and plan every case on both machines; pickle what they produced."""
+    """Build and plan every case on both machines (the S-bend cases on both with
+    PATH_TRANS_POS_TOL = 0.05 mm); pickle what they produced."""
     res = {}
-    for name in (None, "linuxcnc_xyz"):
-        machine = load_machine(name) if name else load_machine()
-        for key, text in programs().items():
+    runs = [(name, load_machine(name) if name else load_machine(), programs())
+            for name in (None, "linuxcnc_xyz")]
+    runs += [(f"{name}@0.05", _with_trans_tol(name, 0.05), sbend_programs())
+             for name in ("default", "linuxcnc_xyz")]
+    for name, machine, progs in runs:
+        for key, text in progs.items():
             try:
                 prog = parse_text(text, key.split("|")[0])
                 path = build_path(prog, machine)

@@ -186,3 +186,108 @@ def test_soft_lines_beside_a_clothoid_pair_ramp_with_their_own_jerk():
         hand = J / np.abs(p.d[line]).max()
         assert np.abs(prof.j[seg == line]).max() == pytest.approx(hand, rel=1e-9)
     assert r.time_s < r64.time_s
+
+
+def quarter_arcs(n: int, r: float) -> str:
+    """``n`` tangent quarter arcs of radius ``r`` curving alternately (``n - 1`` S-bends),
+    from the origin heading +x (body only)."""
+    out, x, y, heading, side = ["G1 X0 Y0"], 0.0, 0.0, 0.0, 1.0
+    for _ in range(n):
+        cx, cy = x - side * r * math.sin(heading), y + side * r * math.cos(heading)
+        heading += side * math.pi / 2
+        nx, ny = cx + side * r * math.sin(heading), cy - side * r * math.cos(heading)
+        out.append(f"{'G3' if side > 0 else 'G2'} X{nx:.9f} Y{ny:.9f} "
+                   f"I{cx - x:.9f} J{cy - y:.9f}")
+        x, y, side = nx, ny, -side
+    return "\n".join(out) + "\nM30\n"
+
+
+def with_trans_tol(name: str, tol_mm: float):
+    """The bundled machine ``name`` with PATH_TRANS_POS_TOL = ``tol_mm`` on every axis."""
+    import tomllib
+    from importlib import resources
+    from reference.machine import machine_from_dict
+    d = tomllib.loads(resources.files("reference.machines").joinpath(f"{name}.toml")
+                      .read_text())
+    for ax in d["axis"].values():
+        ax["PATH_TRANS_POS_TOL"] = tol_mm
+    return machine_from_dict(d)
+
+
+@pytest.mark.parametrize("feed", (6000, 7000))
+def test_three_s_bends_under_g645_are_not_slower_than_g64(feed):
+    """spec 5.8 "Insert only if this beats the non-rounded limit of 6.3", 5.2 group 2.
+    Three S-bends between quarter arcs of R = 100 mm (MD33120 = 0.01 mm), SOFT: G645
+    rounds all three, and the S pieces' path jerk (0.4-0.7 of the arcs') made the whole
+    program one planning unit that ramped from and to rest with it (7000 mm/min: 5.74 s
+    against 5.53 s under G64; 6000: 6.404 s against 6.394 s). The reference is the G64
+    plan of the same program: the first arc ramps from rest exactly as there (the same
+    segment, planned with its own jerk: the largest jerk of the start ramp equals the
+    G64 plan's), and the rounded program is faster."""
+    m = with_trans_tol("default", 0.01)
+    body = quarter_arcs(4, 100.0)
+    r64 = plan(parse_text(f"G17 G90 G64 SOFT F{feed}\n" + body, "t.mpf"), m)
+    r = plan(parse_text(f"G17 G90 G645 SOFT F{feed}\n" + body, "t.mpf"), m)
+    assert r.ok and r64.ok
+    assert n_rounded(r) == 3
+    assert r.time_s < r64.time_s
+
+    def start_jerk(res):
+        prof = res.profile
+        ramp = prof.s[1:] <= 5.0                       # the start ramp: its first 5 mm
+        return np.abs(prof.j[ramp]).max()
+
+    assert start_jerk(r) == pytest.approx(start_jerk(r64), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", MACHINES)
+@pytest.mark.parametrize("accel", ("BRISK", "SOFT"))
+def test_rounded_s_bend_chain_is_not_slower_than_g64(name, accel):
+    """spec 4.3 / 5.2 group 2 on a seeded chain of S-bends (tangent arcs of 20..200 mm
+    curving alternately, MD33120 = 0.05 mm so that G645 rounds most of them), at three
+    feeds: never slower than the same program under G64, strictly faster where rounded
+    (under SOFT on the default mill it rounds some; under BRISK a curvature jump is
+    allowed, and the LinuxCNC machine's PATH_TRANS_JERK_LIM passes them: none)."""
+    from seeded_programs import s_bend_chain
+    m = with_trans_tol(name, 0.05)
+    body = s_bend_chain(30, 3)
+    rounded = 0
+    for feed in (3000, 8000, 15000):
+        head = f"G17 G90 {{}} {accel} F{feed}\n"
+        rounded += assert_not_slower(head.format("G64") + body, head.format("G645") + body,
+                                     m, f"{name} {accel} F{feed}")
+    assert (rounded > 0) == (accel == "SOFT" and name == "default")
+
+
+def test_units_cut_at_their_cruise_are_planned_as_a_full_replan(monkeypatch):
+    """After the cut (reference.planner.lookahead.cruise_splits) only the units that
+    changed are planned again; the reference is planning every unit again: the same
+    profile, bit for bit. The program: a line to an exact stop (a unit the cut leaves
+    as it was), then the three S-bends (cut)."""
+    import reference.planner.engine as engine
+    m = with_trans_tol("default", 0.01)
+    prog = parse_text("G17 G90 G645 SOFT F7000\nG1 X-80 Y0\nG1 X-40 Y0 G9\n"
+                      + quarter_arcs(4, 100.0), "t.mpf")
+    cuts, replanned = [], []
+    real_cuts, real_replan = engine.cruise_splits, engine._replan
+
+    def counted(*args):
+        out = real_cuts(*args)
+        cuts.append(int(out.sum()))
+        return out
+
+    def replan(units, idx, v):
+        replanned.append((idx.size, units.n_units))
+        return real_replan(units, idx, v)
+
+    monkeypatch.setattr(engine, "cruise_splits", counted)
+    monkeypatch.setattr(engine, "_replan", replan)
+    r = plan(prog, m)
+    assert cuts[0] > 0 and 0 < replanned[0][0] < replanned[0][1]
+    monkeypatch.setattr(engine, "_plan_changed",
+                        lambda units, v, *old: engine._plan_all(units, v))
+    full = plan(prog, m)
+    assert cuts[0] > 0
+    for name in ("t", "s", "v", "a", "j"):
+        np.testing.assert_array_equal(getattr(r.profile, name), getattr(full.profile, name))
+    assert r.time_s == full.time_s

@@ -129,6 +129,25 @@ def test_the_deviation_is_path_trans_pos_tol(r1, r2, tol):
     assert dev >= tol * (1 - 1e-5)
 
 
+@pytest.mark.parametrize("r1, r2, tol", [(115.2, 177.7, 0.05), (72.0, 196.0, 0.05),
+                                         (30.0, 30.0, 0.05)])
+def test_the_largest_deviation_is_found_on_the_plateau_near_the_junction(r1, r2, tol):
+    """spec 5.7/5.8 (within PATH_TRANS_POS_TOL, using it): at large radii the deviation
+    near the junction is a plateau with local maxima ~1e-5 apart in value and ~0.1 mm
+    apart in place, either side of the normal at the junction where the measuring arc
+    changes (the first case, from the seeded chain of the benchmark, has two within one
+    sample spacing of the search). The largest distance of the integrated curve from
+    the two arcs (hand geometry) on 400001 samples (spacing ~5e-5 mm: the sampled
+    maximum is below the true one by at most ~1e-11 mm at these curvatures) is the
+    sized deviation to 1e-9, and never above it by more than that."""
+    sh = sbend_for_deviation([r1], [r2], [tol])
+    sol, total = integrate(sh, 0)
+    x, y, _ = sol.sol(np.linspace(0.0, total, 400001))
+    dense = contour_distance(x, y, r1, r2).max()
+    assert dense == pytest.approx(float(sh.deviation[0]), rel=1e-9)
+    assert dense <= tol * (1 + 1e-9)
+
+
 @pytest.mark.parametrize("r1, r2, tol", CASES[:3])
 def test_the_lines_between_the_ramps_are_apart_by_the_classical_shifts(r1, r2, tol):
     """Closed form (the classical clothoid shift, spec 5.8 ``p ~ L^2/(24 R)``): ramp A
