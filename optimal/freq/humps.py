@@ -30,8 +30,10 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    whole phase (a stretch ends only where a phase of the other sign begins; the motion
    starts and ends at rest), which lasts at least its effective duration ``>= g_P``.
    Every bound below is on ``w``; ``v <= w + delta`` and ``w <= v + delta <= e + delta`` turn
-   them into bounds on ``v`` with the cell speeds raised by ``2 delta``
-   (``hi = e_hi + 2 delta``, ``lo = e_lo + 2 delta``).
+   them into bounds on ``v`` with the cell speeds raised by ``2 delta``, and by the
+   checker's standstill tolerance ``VEL_TOL_MM_S`` (the relaxation has ``b = 0`` at stops,
+   the checker accepts that speed there): ``hi = e_hi + 2 delta + VEL_TOL_MM_S``, ``lo``
+   alike.
 3. *One stretch.* A rising stretch from a valley ``a`` (in cell ``i``) to a peak ``p`` (in
    cell ``c``) has ``w(s) <= w(s') <= e(s') + delta`` for every ``s' in [s, p]``; with
    step 1, in each cell ``k`` strictly between ``i`` and ``c``:
