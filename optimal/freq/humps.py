@@ -19,7 +19,7 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    greatest element), interval bounds ``Bbar_k`` and slopes ``M_k`` valid for every motion
    of the ``acc`` problem, hence for every motion of ``acc+freq``:
    ``v(s)^2 <= phi(s) = min(Bbar_k, b_hat_k + M_k (s - s_k), b_hat_{k+1} + M_k (s_{k+1} - s))``
-   on interval ``k``. On each *cell* (a piece of an interval, :func:`speed_envelope`)
+   on interval ``k``. On each *cell* (a piece of an interval, :func:`_envelope`)
    ``e_hi = sqrt(max phi)`` bounds ``v`` at every point of the cell and
    ``e_lo = sqrt(min phi)`` at *some* point of it (``phi`` is concave, so its least value is
    at an end of the cell).
@@ -101,7 +101,7 @@ from .lower import rest_pieces, segment_periods
 
 __all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_REL",
            "HUMP_MAX_CELLS", "HUMP_MERGE_SHARE", "HUMP_REFINE_MARGIN", "Envelope",
-           "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound", "speed_envelope"]
+           "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound"]
 
 #: Cells are cut so that each takes at most this fraction of its period at the fastest
 #: speed the envelope allows in it. Each turn leaves out its cell's time (step 4 of the
@@ -244,37 +244,10 @@ def _split(t: _Tents, k: np.ndarray, x0: np.ndarray, x1: np.ndarray,
     return _cells(t, k[rep], a, b)
 
 
-def speed_envelope(path: Path, lim: AxisArrays, grid: Grid, *,
-                   cell_time_rel: float = HUMP_CELL_TIME_REL,
-                   max_cells: int = HUMP_MAX_CELLS,
-                   bounds: tuple[np.ndarray, ...] | None = None
-                   ) -> Envelope:
-    """Cells and their speed bounds from the ``acc`` relaxation on ``grid``.
-
-    Parameters
-    ----------
-    path : Path
-        Restricted to its moving axes, at least one segment.
-    lim : AxisArrays
-        Limits of ``path.axes``.
-    grid : Grid
-        Nodes (the ``acc`` oracle's final grid is a good one: refined where the speed
-        bounds change).
-    cell_time_rel : float
-        Largest cell time at the envelope's speed, as a fraction of the cell's period.
-    max_cells : int
-        Ceiling on the number of cells.
-    bounds : tuple of numpy.ndarray, optional
-        :func:`optimal.bounds.speed_envelope_bounds` on ``grid`` when the caller has it.
-
-    Returns
-    -------
-    Envelope
-    """
-    return _envelope(_tents(path, lim, grid, bounds), cell_time_rel, max_cells)
-
-
 def _envelope(t: _Tents, cell_time_rel: float, max_cells: int) -> Envelope:
+    """Cells of the relaxation's intervals, each at most ``cell_time_rel`` periods long
+    at speed ``hi`` (at most ``max_cells`` of them: longer cells only weaken the bound),
+    with their speed bounds (step 1)."""
     whole = _cells(t, np.arange(t.b0.size), t.s[:-1], t.s[1:])
     pieces = _pieces(whole, cell_time_rel)
     total = float(pieces.sum())

@@ -483,14 +483,7 @@ def circle_fillet_radius_for_deviation(e: np.ndarray, c1: np.ndarray, r1: np.nda
     Exact for the contour deviation; a start (checked by the full fillet) where the
     per-axis deviations decide.
     """
-    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
-    i = iota1 * iota2
-    c = row_dots(u1, u2)
-    x = _cross2(u1, u2)
-    plus = u2 + i[:, None] * u1
-    p2 = row_dots(plus, plus)
-    m = c / r1 - 1.0 / r2
-    kk = iota1 / r1 - 2.0 * iota2 * m / p2
+    x, p2, m, kk = _circle_pair_terms(c1, r1, s1, c2, r2, s2)
     with np.errstate(divide="ignore", invalid="ignore"):
         v2 = 1.0 / (r1 * r1) + (m / x) ** 2
         a = 2.0 * x / p2
@@ -533,6 +526,21 @@ class CircleFillet:
     heading: np.ndarray
     sweep: np.ndarray
     deviation: np.ndarray
+
+
+def _circle_pair_terms(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray, c2: np.ndarray,
+                       r2: np.ndarray, s2: np.ndarray):
+    """The terms of the fillet quadratic of :func:`_circle_fillet_centre` that both closed
+    forms (:func:`circle_fillet_radius_for_deviation`, :func:`circle_fillet_largest_radius`)
+    use, shape (k,) each: ``X = u_1 x u_2``, ``P = |u_2 + iota_1 iota_2 u_1|^2``,
+    ``m = c / R_1 - 1 / R_2`` (``c = u_1 . u_2``) and ``K = iota_1 / R_1 - 2 iota_2 m / P``.
+    """
+    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    x = _cross2(u1, u2)
+    plus = u2 + (iota1 * iota2)[:, None] * u1
+    p2 = row_dots(plus, plus)
+    m = row_dots(u1, u2) / r1 - 1.0 / r2
+    return x, p2, m, iota1 / r1 - 2.0 * iota2 * m / p2
 
 
 def _circle_pair_frame(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray, c2: np.ndarray,
@@ -717,14 +725,8 @@ def circle_fillet_largest_radius(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray,
     u_1|^2``) the ``X`` cancel: ``k = iota_1 / R_1 - 2 iota_2 (c / R_1 - 1 / R_2) / P``,
     ``|V| |a| = 2 sqrt(X^2 / R_1^2 + (c / R_1 - 1 / R_2)^2) / P``.
     """
-    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
-    i = iota1 * iota2
-    c = row_dots(u1, u2)
-    x = _cross2(u1, u2)
-    plus = u2 + i[:, None] * u1
-    p2 = row_dots(plus, plus)
-    m = c / r1 - 1.0 / r2
-    den = iota1 / r1 - 2.0 * iota2 * m / p2 + 2.0 * np.sqrt(x * x / (r1 * r1) + m * m) / p2
+    x, p2, m, k = _circle_pair_terms(c1, r1, s1, c2, r2, s2)
+    den = k + 2.0 * np.sqrt(x * x / (r1 * r1) + m * m) / p2
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(den > 0, 1.0 / den, np.inf)
 
