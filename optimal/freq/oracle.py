@@ -11,7 +11,10 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
 3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
    (the base optimum slowed down, the filtered acc optimum, the motion under the caps
    adapted to the rule: unfiltered for ``acc+freq``, and filtered with the windows of
-   :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each);
+   :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each; for
+   ``jerk+freq`` where these leave the bracket open, the jerk optimum re-solved under caps
+   adapted to its own short phases, :mod:`optimal.freq.jerk_adapted`), and the fastest
+   candidate per rest-to-rest piece, joined;
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -37,6 +40,7 @@ from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from ..grid import grid_on
 from .humps import humps_bound
+from .jerk_adapted import jerk_adapted
 from .lower import freq_lower_bound, segment_periods
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     line_pieces, pieced, scaled, verified)
@@ -149,6 +153,11 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             c = verified(label, path, limits, prof, name, u.rest_breaks)
             if c is not None:
                 cands.append(c)
+    if (base == "jerk" and base_sol.profile is not None and cands
+            and min(c.duration for c in cands) + hold_t - lb > tol * lb):
+        # the jerk optimum re-solved where it breaks the rule (optimal.freq.jerk_adapted)
+        cands += jerk_adapted(path, limits, base_sol.grid, base_sol.profile,
+                              progress=(lambda msg: progress(msg, 0.85)) if progress else None)
     # pieces start and end at rest: the fastest candidate on each, joined
     joined = pieced(path, cands, line_pieces(path, limits) if base == "acc" else None)
     if joined is not None:

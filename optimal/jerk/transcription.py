@@ -189,6 +189,10 @@ class JerkProblem:
         The constraint behind each speed cap (``optimal.problem.CAP_*``) and its axis.
     axes : tuple[str, ...]
         Axis names.
+    a_lo, a_hi : numpy.ndarray, shape (N + 1,), optional
+        Bounds on the path acceleration at the nodes (scaled; on leaving a break node);
+        ``None``: none. The transcription sets none; :mod:`optimal.freq.jerk_adapted`
+        sets them to lengthen phases the frequency rule finds short.
     """
 
     units: Units
@@ -205,6 +209,8 @@ class JerkProblem:
     cap_code: np.ndarray
     cap_axis: np.ndarray
     axes: tuple[str, ...]
+    a_lo: np.ndarray | None = None
+    a_hi: np.ndarray | None = None
 
     @property
     def n_intervals(self) -> int:
