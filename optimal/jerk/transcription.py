@@ -189,9 +189,9 @@ class JerkProblem:
         The constraint behind each speed cap (``optimal.problem.CAP_*``) and its axis.
     axes : tuple[str, ...]
         Axis names.
-    a_lo, a_hi : numpy.ndarray, shape (N + 1,), optional
-        Bounds on the path acceleration at the nodes (scaled; on leaving a break node);
-        ``None``: none. The transcription sets none; :mod:`optimal.freq.jerk_adapted`
+    a_lo, a_hi : numpy.ndarray, shape (N + 1 + n_extra,), optional
+        Bounds on the path accelerations ``[a, extra]`` (scaled: at the nodes, on leaving
+        a break node, then on arriving at each interior break node); ``None``: none. The transcription sets none; :mod:`optimal.freq.jerk_adapted`
         sets them to lengthen phases the frequency rule finds short.
     """
 

@@ -137,15 +137,14 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
         lo.append(-jr.limit)
         hi.append(jr.limit)
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
-    a_lo = problem.a_lo if problem.a_lo is not None else np.full(N + 1, -np.inf)
-    a_hi = problem.a_hi if problem.a_hi is not None else np.full(N + 1, np.inf)
-    lbx = np.concatenate((np.zeros(N + 1), a_lo,
-                          np.full(N, MIN_INTERVAL_TIME_REL), np.full(ne, -np.inf)))
-    ubx = np.concatenate((problem.c_max, a_hi, np.full(N, np.inf),
-                          np.full(ne, np.inf)))
-    x0 = np.concatenate((np.clip(c0, 0.0, problem.c_max), np.clip(a0, a_lo, a_hi),
-                         np.maximum(dt0, MIN_INTERVAL_TIME_REL),
-                         a0[problem.grid.break_node[1:-1]]))
+    a_lo = problem.a_lo if problem.a_lo is not None else np.full(N + 1 + ne, -np.inf)
+    a_hi = problem.a_hi if problem.a_hi is not None else np.full(N + 1 + ne, np.inf)
+    lbx = np.concatenate((np.zeros(N + 1), a_lo[:N + 1],
+                          np.full(N, MIN_INTERVAL_TIME_REL), a_lo[N + 1:]))
+    ubx = np.concatenate((problem.c_max, a_hi[:N + 1], np.full(N, np.inf), a_hi[N + 1:]))
+    a_start = np.clip(np.concatenate((a0, a0[problem.grid.break_node[1:-1]])), a_lo, a_hi)
+    x0 = np.concatenate((np.clip(c0, 0.0, problem.c_max), a_start[:N + 1],
+                         np.maximum(dt0, MIN_INTERVAL_TIME_REL), a_start[N + 1:]))
     build = time.perf_counter() - tb
     solve = 0.0
     iters = 0
