@@ -191,7 +191,9 @@ class JerkProblem:
         Axis names.
     a_lo, a_hi : numpy.ndarray, shape (N + 1 + n_extra,), optional
         Bounds on the path accelerations ``[a, extra]`` (scaled: at the nodes, on leaving
-        a break node, then on arriving at each interior break node); ``None``: none. The transcription sets none; :mod:`optimal.freq.jerk_adapted`
+        a break node, then on arriving at each interior break node); ``None``: none.
+        Only the IPOPT backend reads them (the SCP cross-check solves the problem as
+        transcribed). The transcription sets none; :mod:`optimal.freq.jerk_adapted`
         sets them to lengthen phases the frequency rule finds short.
     """
 
