@@ -56,16 +56,24 @@ from reference.core.profile import Profile
 
 from ..grid import grid_on
 from ..jerk.backends import get_nlp_backend
-from ..jerk.transcription import build_jerk_problem
+from ..jerk.transcription import JerkProblem, Rows, StepRows, build_jerk_problem
 from ..jerk.upper import exact_profile, warm_start
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
 
-__all__ = ["JERK_ADAPT_ROUNDS", "jerk_adapted"]
+__all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "JERK_ADAPT_ROUNDS",
+           "jerk_adapted"]
 
 #: NLP rounds of :func:`jerk_adapted` at most (each costs one jerk NLP on the base
 #: solve's final grid; the loop stops as soon as no phase is short). The corpus programs
 #: it helps settle in 2-3 rounds, lcnc_test_12mmflat in 8 (about 4 s each).
 JERK_ADAPT_ROUNDS = 8
+#: ``acc+freq``: target size and largest size of the NLP grid, intervals (the jerk
+#: oracle's first grid, :func:`optimal.jerk.oracle.jerk_grid`, graded toward the ends of
+#: segments where the acc optimum's speed changes, merged with the acc grid). The acc
+#: grid alone has 19 nodes on lcnc_corner_decel: the NLP's motion then took 9.0 s against
+#: 7.35 s on 425 nodes.
+ACC_ADAPT_INTERVALS = 400
+ACC_ADAPT_MAX_INTERVALS = 5_000
 
 
 def _short_phases(path: Path, lim, prof: Profile):
@@ -79,9 +87,20 @@ def _short_phases(path: Path, lim, prof: Profile):
     return ph, short, need
 
 
+def _without_jerk(problem: JerkProblem) -> JerkProblem:
+    """The NLP of the ``acc`` set: no jerk rows, no acceleration-step rows at breaks
+    (the acceleration is still linear in time inside each interval, so it is
+    continuous between the nodes of a segment, which only removes motions)."""
+    i0 = np.zeros(0, np.int64)
+    f0 = np.zeros(0)
+    return replace(problem, jerk=Rows(i0, i0, f0, f0, f0, f0, i0),
+                   step=StepRows(i0, i0, i0, f0, f0, f0, f0, f0, i0))
+
+
 def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Profile,
                  rounds: int = JERK_ADAPT_ROUNDS,
-                 progress: Callable[[str], object] | None = None) -> list[Candidate]:
+                 progress: Callable[[str], object] | None = None,
+                 bounds: str = "jerk+freq", widen: bool = False) -> list[Candidate]:
     """The jerk optimum adapted to the frequency rule (see the module docstring).
 
     Parameters
@@ -97,6 +116,17 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         NLP rounds at most.
     progress : callable, optional
         ``progress(message)`` after each round.
+    bounds : {"jerk+freq", "acc+freq"}
+        ``acc+freq``: the NLP without its jerk and acceleration-step rows
+        (:func:`_without_jerk`), started from the ``acc`` optimum.
+    widen : bool
+        Bound the acceleration also where the motion goes in ``1/f`` before and after
+        each short phase. Without jerk rows the NLP can move a bounded phase beside its
+        bounds, one phase length per round (a line-arc-line at F150: two phases of 6 ms
+        moved for 8 rounds); the wider bound stops that but also binds ramps that were
+        long enough. Neither is faster on every program (default machine, ``acc+freq``:
+        ``lcnc_corner_decel`` 7.35 s narrow against 7.26 s wide, ``lcnc_arc_arc_sawtooth``
+        5.59 against 5.79 s), so the oracle runs both.
 
     Returns
     -------
@@ -113,6 +143,9 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         return []
     grid = grid_on(path, grid_s)
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
+    jerk_rows = bounds != "acc+freq"
+    if not jerk_rows:
+        problem = _without_jerk(problem)
     a_unit = problem.units.accel
     # bounds on [a, extra]: the accelerations at the nodes (on leaving), then on arriving
     # at each interior break node (a phase ending at a break ends on that one)
@@ -124,6 +157,12 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     for r in range(rounds):
         for p in short:
             s0, s1 = prof.s[ph.first[p]], prof.s[ph.last[p] + 1]
+            if widen:
+                # without a jerk limit the NLP can move a bounded phase to the unbounded
+                # nodes beside it (it decelerates earlier at the full acceleration):
+                # the bound then reaches as far as the motion goes in 1/f on either side
+                reach = max(prof.v[ph.first[p]], prof.v[ph.last[p] + 1]) * need[p]
+                s0, s1 = s0 - reach, s1 + reach
             i0 = max(int(np.searchsorted(grid.s, s0, side="left")), 0)
             i1 = min(int(np.searchsorted(grid.s, s1, side="right")), grid.s.size)
             if i1 <= i0:
@@ -155,12 +194,13 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
             break
         prof = exact_profile(prob_r, nlp.c, nlp.a, nlp.a_end, nlp.dt,
                              path.block[grid.segment])
-        c = verified(f"jerk adapted, round {r + 1}", path, limits, prof, "jerk+freq")
+        c = verified(f"{bounds.split('+')[0]} NLP adapted{' (wide)' if widen else ''}, "
+                     f"round {r + 1}", path, limits, prof, bounds)
         if c is not None:
             out.append(c)
         ph, short, need = _short_phases(path, lim, prof)
         if progress:
-            progress(f"jerk motion adapted to the rule, round {r + 1}: "
+            progress(f"{bounds.split('+')[0]} NLP adapted to the rule, round {r + 1}: "
                      f"{short.size} short phases left")
         if short.size == 0:
             break

@@ -39,8 +39,9 @@ from reference.core.rows import block_motion, block_rows
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from ..grid import grid_on
+from ..jerk.oracle import jerk_grid
 from .humps import humps_bound
-from .jerk_adapted import jerk_adapted
+from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .lower import freq_lower_bound, segment_periods
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     line_pieces, pieced, scaled, verified)
@@ -153,11 +154,18 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             c = verified(label, path, limits, prof, name, u.rest_breaks)
             if c is not None:
                 cands.append(c)
-    if (base == "jerk" and base_sol.profile is not None and cands
+    if (base_sol.profile is not None and cands
             and min(c.duration for c in cands) + hold_t - lb > tol * lb):
-        # the jerk optimum re-solved where it breaks the rule (optimal.freq.jerk_adapted)
-        cands += jerk_adapted(path, limits, base_sol.grid, base_sol.profile,
-                              progress=(lambda msg: progress(msg, 0.85)) if progress else None)
+        # the base optimum re-solved by the NLP where it breaks the rule
+        # (optimal.freq.jerk_adapted); acc+freq on a grid graded as the jerk oracle's
+        # first one (the acc grid is as coarse as straight lines allow)
+        grid_s = base_sol.grid if base == "jerk" else np.unique(np.concatenate((
+            jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_sol.profile,
+                      ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid)))
+        for widen in ((False,) if base == "jerk" else (False, True)):
+            cands += jerk_adapted(path, limits, grid_s, base_sol.profile, bounds=name,
+                                  widen=widen, progress=(lambda msg: progress(msg, 0.85))
+                                  if progress else None)
     # pieces start and end at rest: the fastest candidate on each, joined
     joined = pieced(path, cands, line_pieces(path, limits) if base == "acc" else None)
     if joined is not None:

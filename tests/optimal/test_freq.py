@@ -22,7 +22,8 @@ from reference.core import AxisLimits, MachineLimits
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.holds import NO_HOLDS
 from reference.core.tolerances import RATIO_TOL
-from optimal.freq.jerk_adapted import jerk_adapted
+from optimal.freq.jerk_adapted import ACC_ADAPT_INTERVALS, jerk_adapted
+from optimal.jerk.oracle import jerk_grid
 
 ruckig = pytest.importorskip("ruckig")
 
@@ -136,14 +137,16 @@ def test_frequency_bound_decides_many_short_exact_stop_moves():
     assert check_profile(path, lim, frq.profile).ok(BOUND_SETS["jerk+freq"])
 
 
-def test_dip_at_a_curvature_jump_beats_the_hand_plateau():
+@pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
+def test_dip_at_a_curvature_jump_beats_the_hand_plateau(bounds):
     # line -> half circle R -> line at F150, f = 10 Hz. The jerk set caps the speed where
     # the curvature jumps (the centripetal step v^2/R over one IPO cycle within the jerk
     # limit: v <= sqrt(J T_ipo R), 63.2 mm/s at R = 10), so the jerk optimum dips there
-    # and its phases last far less than 1/f = 0.1 s. An independent motion the rule
-    # accepts, by hand: one plateau at v_c = 63.2 mm/s over the whole path (below every
-    # cap: sqrt(A R) = 141 mm/s and (J R^2)^(1/3) = 215 mm/s on the arc), reached and left
-    # by symmetric S-ramps of exactly 1/f (peak 2 v_c f = 1265 mm/s^2 <= A, jerk
+    # and its phases last far less than 1/f = 0.1 s; the acc optimum dips from the feed
+    # to the arc's sqrt(A R) = 141 mm/s, in 5-20 ms. An independent motion both rules
+    # accept, by hand: one plateau at v_c = 63.2 mm/s over the whole path (below every
+    # cap: sqrt(A R) and (J R^2)^(1/3) = 215 mm/s on the arc), reached and left by
+    # symmetric S-ramps of exactly 1/f (peak 2 v_c f = 1265 mm/s^2 <= A, jerk
     # 4 v_c f^2 = 25,300 mm/s^3 <= J), which lose 1/f in all: T = L / v_c + 1/f. The
     # oracle's verified motion must match or beat it, and its lower bound stay below it.
     R, L, f = 10.0, 30.0, 10.0
@@ -152,19 +155,24 @@ def test_dip_at_a_curvature_jump_beats_the_hand_plateau():
     v_c = float(np.sqrt(100_000.0 * T_IPO * R))
     assert v_c < min(np.sqrt(2000.0 * R), (100_000.0 * R * R) ** (1 / 3), 150.0)
     t_hand = (2 * L + np.pi * R) / v_c + 1.0 / f
-    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
     rep = check_profile(path, lim, sol.profile)
-    assert rep.ok(BOUND_SETS["jerk+freq"]), rep.violations(BOUND_SETS["jerk+freq"])
+    assert rep.ok(BOUND_SETS[bounds]), rep.violations(BOUND_SETS[bounds])
     assert sol.upper_bound_s <= t_hand * (1 + MATCH_SLACK)
     assert sol.lower_bound_s <= sol.upper_bound_s
-    # the jerk optimum alone breaks the rule at the dips (phases of 60-90 ms and a
+    # the base optimum alone breaks the rule at the dips (jerk: phases of 60-90 ms and a
     # wiggle of 4 ms at the arc's middle, against 100 ms)
-    jerk = optimal.solve(path, lim, bounds="jerk", holds=NO_HOLDS, initial_intervals=N0)
-    assert not check_profile(path, lim, jerk.profile).ok(BOUND_SETS["jerk+freq"])
-    # the jerk NLP re-solved with those phases' accelerations bounded keeps the rule by
+    base = optimal.solve(path, lim, bounds=bounds.split("+")[0], holds=NO_HOLDS,
+                         initial_intervals=N0)
+    assert not check_profile(path, lim, base.profile).ok(BOUND_SETS[bounds])
+    # the NLP re-solved with those phases' accelerations bounded keeps the rule by
     # itself (the checker's frequency ratio, before any slowing down, within 0.1 %): the
     # adaptation works on the motion, not through the time scaling that follows it
-    adapted = jerk_adapted(path, lim, jerk.grid, jerk.profile)
+    grid = base.grid if bounds == "jerk+freq" else np.unique(np.concatenate((
+        jerk_grid(path, ACC_ADAPT_INTERVALS, lim, base.profile).s, base.grid)))
+    # (acc+freq: with the bounds widened, or the NLP moves the bounded phases aside)
+    adapted = jerk_adapted(path, lim, grid, base.profile, bounds=bounds,
+                           widen=bounds == "acc+freq")
     assert adapted and min(c.report.worst("frequency").ratio for c in adapted) <= 1.001
-    assert min(c.duration for c in adapted) >= jerk.lower_bound_s
+    assert min(c.duration for c in adapted) >= base.lower_bound_s
     assert sol.upper_bound_s <= min(c.duration for c in adapted) * (1 + 1e-12)
