@@ -351,15 +351,22 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     sh = SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
                       trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
                       np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
-    if deviation and ok.any():
+    return samedir_measured(sh) if deviation else sh
+
+
+def samedir_measured(sh: SameDirShape) -> SameDirShape:
+    """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
+    :func:`samedir_shape` returns with ``deviation=True`` for the same radii and rates
+    (its landing is each transition's own, whatever the batch)."""
+    ok = np.isfinite(sh.theta)
+    dev = np.full_like(sh.rate, np.nan)
+    if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
-        dev = np.full_like(rate, np.nan)
         dev[i] = pieces_deviation(_canonical_pieces(part), part.r_in, part.r_out,
                                   part.r_out)
-        sh = SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
-                            for f in SameDirShape.__slots__))
-    return sh
+    return SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
+                          for f in SameDirShape.__slots__))
 
 
 def _canonical_pieces(sh: SameDirShape):
@@ -414,5 +421,5 @@ def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
     return pieces_rows(_canonical_pieces(sh), junction, along, inward, block, kind_code)
 
 
-__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_for_deviation", "samedir_rows",
-           "samedir_shape"]
+__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_for_deviation", "samedir_measured",
+           "samedir_rows", "samedir_shape"]
