@@ -303,21 +303,29 @@ def _halved(t1, p2, dt, dp):
     """The Newton step ``(dt, dp)`` halved while it would turn the pair backwards or
     past a quarter turn (``h <= 0`` or ``|theta1|``, ``|phi2| >= THETA_MAX``), at most
     :data:`STEP_HALVINGS` times: per transition, the first of the halvings ``dt 2^-m``,
-    ``m = 0 .. STEP_HALVINGS - 1``, that is allowed, else the last. All candidates are
-    tested at once, each made by halving the one before (the same numbers as halving in
-    a loop until allowed)."""
-    n = STEP_HALVINGS
-    half = np.full((dt.size, n + 1), 0.5)
-    half[:, 0] = dt
-    cand_t = np.multiply.accumulate(half, axis=1)
-    half[:, 0] = dp
-    cand_p = np.multiply.accumulate(half, axis=1)
-    a, b = t1[:, None] + cand_t, p2[:, None] + cand_p
+    ``m = 0 .. STEP_HALVINGS - 1``, that is allowed, else the last. The full steps are
+    tested first; where one is not allowed, all its halvings at once, each made by
+    halving the one before (the same numbers as halving in a loop until allowed)."""
+    a, b = t1 + dt, p2 + dp
     # h summed in the loop's order, ((theta1 + dt) + phi2) + dp
-    ok = (a + p2[:, None] + cand_p > 0) & (np.abs(a) < THETA_MAX) & (np.abs(b) < THETA_MAX)
+    bad = np.flatnonzero(~((a + p2 + dp > 0) & (np.abs(a) < THETA_MAX)
+                           & (np.abs(b) < THETA_MAX)))
+    if not bad.size:
+        return dt, dp
+    n = STEP_HALVINGS
+    half = np.full((bad.size, n + 1), 0.5)
+    half[:, 0] = dt[bad]
+    cand_t = np.multiply.accumulate(half, axis=1)
+    half[:, 0] = dp[bad]
+    cand_p = np.multiply.accumulate(half, axis=1)
+    t1b, p2b = t1[bad, None], p2[bad, None]
+    a, b = t1b + cand_t, p2b + cand_p
+    ok = (a + p2b + cand_p > 0) & (np.abs(a) < THETA_MAX) & (np.abs(b) < THETA_MAX)
     ok[:, n] = True
-    rows, m = np.arange(dt.size), ok.argmax(axis=1)
-    return cand_t[rows, m], cand_p[rows, m]
+    rows, m = np.arange(bad.size), ok.argmax(axis=1)
+    dt, dp = dt.copy(), dp.copy()
+    dt[bad], dp[bad] = cand_t[rows, m], cand_p[rows, m]
+    return dt, dp
 
 
 def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
