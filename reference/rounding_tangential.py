@@ -60,8 +60,8 @@ from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
                               transition_rows, transition_shape)
 from .core.transition_samedir import (SAMEDIR_PIECES, samedir_for_deviation,
                                       samedir_measured, samedir_rows, samedir_shape)
-from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_measured,
-                                    sbend_rows, sbend_shape, scatter, take)
+from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_rows,
+                                    sbend_shape, scatter, take)
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
@@ -293,7 +293,7 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
         for kind, sized, shape_of, measured, to_rows, n_p in (
-                (sbend, sbend_for_deviation, sbend_shape, sbend_measured, sbend_rows,
+                (sbend, sbend_for_deviation, sbend_shape, _sbend_again, sbend_rows,
                  SBEND_PIECES),
                 (samedir, samedir_for_deviation, samedir_shape, samedir_measured,
                  samedir_rows, SAMEDIR_PIECES)):
@@ -397,11 +397,12 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
                measured):
     """Transitions ``o`` between two arcs (an S-bend, :mod:`reference.core.
     transition_sbend`, or arcs curving the same way, :mod:`reference.core.
-    transition_samedir`: ``for_deviation``, ``shape_of`` and ``measured`` of that
-    module): the shape whose deviation is ``dev`` (mm, shape (j,)); where a trim exceeds
-    the block-length clamp ``c`` (5.3) the rate is raised (every length scales about
-    like ``1/rate``) until both fit; whether it was cut, and whether it is too small
-    (bool, shape (j,) each)."""
+    transition_samedir`: ``for_deviation`` and ``shape_of`` of that module, and
+    ``measured``, a shape built without its deviation -> the same with it): the shape
+    whose deviation is ``dev`` (mm, shape (j,)); where a trim exceeds the block-length
+    clamp ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``)
+    until both fit; whether it was cut, and whether it is too small (bool, shape (j,)
+    each)."""
     r1, r2 = R[o], R_b[o]
     sh = for_deviation(r1, r2, dev)
     rate = sh.rate.copy()
@@ -419,12 +420,21 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
         sh = scatter(sh, hit, shape_of(r1[hit], r2[hit], rate[hit], deviation=False))
     again = np.flatnonzero(cut)
     if again.size:
-        # each was last shaped at its final rate: only its deviation is left to measure
+        # each was last shaped at its final rate, without the deviation
         sh = scatter(sh, again, measured(take(sh, again)))
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
+
+
+def _sbend_again(sh):
+    """The S-bends of ``sh`` built again at their rates, with the deviation: unlike the
+    same-way landing (:func:`reference.core.transition_samedir.samedir_measured`), the
+    S-bend's heading root is not quite each transition's own (the fixed point of
+    :func:`reference.core.transition.s_shift` stops for the whole batch at once), so
+    the batch it was built in could move it by round-off."""
+    return sbend_shape(sh.r_in, sh.r_out, sh.rate)
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,

@@ -574,17 +574,11 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
                     theta * r_out + 0.5 * l2, np.full_like(rate, np.nan),
                     l1 + l2 + 4.0 * l_s,
                     np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_s)))
-    return sbend_measured(sh) if deviation else sh
-
-
-def sbend_measured(sh: SBendShape) -> SBendShape:
-    """``sh`` with its deviation measured where a heading lands (``nan`` elsewhere):
-    what :func:`sbend_shape` returns with ``deviation=True``."""
-    ok = np.isfinite(sh.theta)
-    dev = np.full_like(sh.rate, np.nan)
-    if ok.any():
+    if deviation and ok.any():
+        dev = np.full_like(rate, np.nan)
         dev[ok] = sbend_deviation(take(sh, np.flatnonzero(ok)))
-    return _replace(sh, deviation=dev)
+        sh = _replace(sh, deviation=dev)
+    return sh
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
@@ -729,5 +723,5 @@ def _replace(sh: SBendShape, **kw) -> SBendShape:
 
 
 __all__ = ["SBEND_PIECES", "SBendShape", "pieces_deviation", "pieces_rows", "sbend_deviation",
-           "sbend_for_deviation", "sbend_measured", "sbend_rows", "sbend_shape", "scatter",
-           "size_for_deviation", "take"]
+           "sbend_for_deviation", "sbend_rows", "sbend_shape", "scatter", "size_for_deviation",
+           "take"]

@@ -27,9 +27,8 @@ from scipy.optimize import brentq
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.core.transition_sbend import (_on_pieces, _packed, _canonical_pieces,
-                                             sbend_for_deviation, sbend_measured,
-                                             sbend_rows, sbend_shape)
+from reference.core.transition_sbend import (_canonical_pieces, _on_pieces, _packed,
+                                             sbend_for_deviation, sbend_rows, sbend_shape)
 from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
@@ -197,18 +196,6 @@ def test_vectorised_sizes_agree_with_one_at_a_time():
     for i in (0, 17, 39):
         one = sbend_for_deviation(r1[i:i + 1], r2[i:i + 1], tol[i:i + 1])
         assert float(one.rate[0]) == pytest.approx(float(sh.rate[i]), rel=1e-8)
-
-
-def test_measured_later_is_the_shape_with_its_deviation():
-    """sbend_measured (the block-length clamp measures the deviation of the shape it
-    built last) gives what sbend_shape gives with the deviation, for the same rates."""
-    rng = np.random.default_rng(4)
-    r1, r2 = rng.uniform(1, 50, 40), rng.uniform(1, 50, 40)
-    rate = rng.uniform(0.05, 3.0, 40) / np.minimum(r1, r2) ** 2
-    sh = sbend_shape(r1, r2, rate)
-    late = sbend_measured(sbend_shape(r1, r2, rate, deviation=False))
-    for f in sh.__slots__:
-        np.testing.assert_array_equal(getattr(late, f), getattr(sh, f))
 
 
 def test_points_on_the_pieces_are_the_clothoid_rows():
