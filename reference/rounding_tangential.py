@@ -59,7 +59,7 @@ from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
                               transition_rows, transition_shape)
 from .core.transition_samedir import (SAMEDIR_PIECES, samedir_for_deviation,
-                                      samedir_rows, samedir_shape)
+                                      samedir_measured, samedir_rows, samedir_shape)
 from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_rows,
                                     sbend_shape, scatter, take)
 from .machine import Machine
@@ -292,16 +292,17 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
-        for kind, sized, shape_of, to_rows, n_p in (
-                (sbend, sbend_for_deviation, sbend_shape, sbend_rows, SBEND_PIECES),
-                (samedir, samedir_for_deviation, samedir_shape, samedir_rows,
-                 SAMEDIR_PIECES)):
+        for kind, sized, shape_of, measured, to_rows, n_p in (
+                (sbend, sbend_for_deviation, sbend_shape, _sbend_again, sbend_rows,
+                 SBEND_PIECES),
+                (samedir, samedir_for_deviation, samedir_shape, samedir_measured,
+                 samedir_rows, SAMEDIR_PIECES)):
             sel = kind[o]
             at = o[sel]
             if not at.size:
                 continue
             sh, cut_aa, small_aa = _size_arcs(path, R, R_b, a, b, at, dev[sel], c, sized,
-                                              shape_of)
+                                              shape_of, measured)
             groups.append((at, sh, to_rows, n_p))
             cut_in[sel], cut_out[sel] = sh.trim_in, sh.trim_out
             rlen[sel], rmin[sel], rate[sel] = sh.length, sh.min_radius, sh.rate
@@ -392,10 +393,12 @@ def _size_line_arc(path: Path, R: np.ndarray, arc: np.ndarray, line: np.ndarray,
 
 
 def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.ndarray,
-               o: np.ndarray, dev: np.ndarray, c: float, for_deviation, shape_of):
+               o: np.ndarray, dev: np.ndarray, c: float, for_deviation, shape_of,
+               measured):
     """Transitions ``o`` between two arcs (an S-bend, :mod:`reference.core.
     transition_sbend`, or arcs curving the same way, :mod:`reference.core.
-    transition_samedir`: ``for_deviation`` and ``shape_of`` of that module): the shape
+    transition_samedir`: ``for_deviation`` and ``shape_of`` of that module, and
+    ``measured``, a shape built without its deviation -> the same with it): the shape
     whose deviation is ``dev`` (mm, shape (j,)); where a trim exceeds the block-length
     clamp ``c`` (5.3) the rate is raised (every length scales about like ``1/rate``)
     until both fit; whether it was cut, and whether it is too small (bool, shape (j,)
@@ -417,11 +420,21 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
         sh = scatter(sh, hit, shape_of(r1[hit], r2[hit], rate[hit], deviation=False))
     again = np.flatnonzero(cut)
     if again.size:
-        sh = scatter(sh, again, shape_of(r1[again], r2[again], rate[again]))
+        # each was last shaped at its final rate, without the deviation
+        sh = scatter(sh, again, measured(take(sh, again)))
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
+
+
+def _sbend_again(sh):
+    """The S-bends of ``sh`` built again at their rates, with the deviation: unlike the
+    same-way landing (:func:`reference.core.transition_samedir.samedir_measured`), the
+    S-bend's heading root is not quite each transition's own (the fixed point of
+    :func:`reference.core.transition.s_shift` stops for the whole batch at once), so
+    the batch it was built in could move it by round-off."""
+    return sbend_shape(sh.r_in, sh.r_out, sh.rate)
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,

@@ -166,7 +166,15 @@ def _unit(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangent ``u(b)`` and normal ``n(b)`` (``u`` turned a quarter left) of
     headings ``b``, shape (k, 2) each."""
     c, s = np.cos(b), np.sin(b)
-    return np.stack((c, s), axis=1), np.stack((-s, c), axis=1)
+    return _pairs(c, s), _pairs(-s, c)
+
+
+def _pairs(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``np.stack((x, y), axis=1)`` (the same numbers, without its overhead: the Newton
+    steps call this on a few transitions at a time)."""
+    out = np.empty(x.shape + (2,))
+    out[:, 0], out[:, 1] = x, y
+    return out
 
 
 def _pair_distance(h: np.ndarray, rate: np.ndarray) -> np.ndarray:
@@ -182,8 +190,8 @@ def _ends(t1, p2, r_in, r_out, off):
     ub, nb = _unit(p2)
     # the arcs' points of headings -theta1 and phi2 (2 sin^2(b/2) = 1 - cos b, without
     # cancellation at small b)
-    p1 = np.stack((-r_in * np.sin(t1), 2.0 * r_in * np.sin(0.5 * t1) ** 2), axis=1)
-    p2_ = np.stack((r_out * np.sin(p2), 2.0 * r_out * np.sin(0.5 * p2) ** 2), axis=1)
+    p1 = _pairs(-r_in * np.sin(t1), 2.0 * r_in * np.sin(0.5 * t1) ** 2)
+    p2_ = _pairs(r_out * np.sin(p2), 2.0 * r_out * np.sin(0.5 * p2) ** 2)
     # ramp A is the line-arc ramp traversed backwards (its x points back along line A)
     q1 = p1 - xq1[:, None] * ua + yq1[:, None] * na
     q2 = p2_ + xq2[:, None] * ub + yq2[:, None] * nb
@@ -211,8 +219,9 @@ def _landing(t1, p2, r_in, r_out, rate, off):
     x = d_1 - y * th
     dd1 = (ch - x) / (2.0 * h) + (sh - y) / (2.0 * h) * th + 0.5 * y / (ch * ch)
     dd = 0.5 * d_p / h + l_p * dd1
-    jac = np.stack((-dq1 - dd[:, None] * w + d_p[:, None] * na,
-                    dq2 - dd[:, None] * w - d_p[:, None] * nb), axis=2)
+    jac = np.empty(g.shape + (2,))
+    jac[:, :, 0] = -dq1 - dd[:, None] * w + d_p[:, None] * na
+    jac[:, :, 1] = dq2 - dd[:, None] * w - d_p[:, None] * nb
     return g, jac
 
 
@@ -248,38 +257,75 @@ def _solve(r_in, r_out, ramp, rate, off):
 def _newton(r_in, r_out, ramp, rate, off, flat_out):
     """Newton's method on the landing from the small-angle start with the pair on the
     second arc where ``flat_out`` (on the first elsewhere): ``theta1, phi2`` (nan where
-    it does not converge)."""
+    it does not converge).
+
+    Each transition's iterates are those it would have alone: the arrays of the ones
+    still iterating are compacted whenever some stop (the per-iteration cost is then
+    that of the few that wander, up to :data:`NEWTON_MAX_ITER` steps, where the pair on
+    the flatter arc has no landing), and a transition's verdict is the test of the
+    miss at its last iterate (the one it stopped at, or after the last step)."""
     t1, p2 = _start(r_in, r_out, ramp, rate, flat_out)
-    done = np.zeros(t1.shape, bool)
+    lands = np.zeros(t1.shape, bool)
+    act = np.arange(t1.size)
+    a1, a2 = t1, p2
+    r1, r2, c, o = r_in, r_out, rate, off
     for _ in range(NEWTON_MAX_ITER):
-        act = np.flatnonzero(~done)
         if not act.size:
             break
-        sel = (r_in[act], r_out[act], rate[act], tuple(o[act] for o in off))
         with np.errstate(invalid="ignore", divide="ignore"):
-            g, jac = _landing(t1[act], p2[act], *sel)
+            g, jac = _landing(a1, a2, r1, r2, c, o)
         ok = np.abs(g).max(axis=1) <= LANDING_TOL_MM
-        done[act[ok]] = True
-        det = jac[:, 0, 0] * jac[:, 1, 1] - jac[:, 0, 1] * jac[:, 1, 0]
+        j00, j01, j10, j11 = jac[:, 0, 0], jac[:, 0, 1], jac[:, 1, 0], jac[:, 1, 1]
+        g0, g1 = g[:, 0], g[:, 1]
+        det = j00 * j11 - j01 * j10
         with np.errstate(divide="ignore", invalid="ignore"):
-            dt = -(jac[:, 1, 1] * g[:, 0] - jac[:, 0, 1] * g[:, 1]) / det
-            dp = -(jac[:, 0, 0] * g[:, 1] - jac[:, 1, 0] * g[:, 0]) / det
-        # halve a step that would turn the pair backwards or past a quarter turn
-        for _ in range(STEP_HALVINGS):
-            h = t1[act] + dt + p2[act] + dp
-            bad = ~((h > 0) & (np.abs(t1[act] + dt) < THETA_MAX)
-                    & (np.abs(p2[act] + dp) < THETA_MAX))
-            if not bad.any():
-                break
-            dt, dp = np.where(bad, 0.5 * dt, dt), np.where(bad, 0.5 * dp, dp)
+            dt = -(j11 * g0 - j01 * g1) / det
+            dp = -(j00 * g1 - j10 * g0) / det
+        dt, dp = _halved(a1, a2, dt, dp)
         step = ~ok & np.isfinite(dt) & np.isfinite(dp)
-        t1[act] = np.where(step, t1[act] + dt, t1[act])
-        p2[act] = np.where(step, p2[act] + dp, p2[act])
-        done[act[~ok & ~step]] = True
-    with np.errstate(invalid="ignore", divide="ignore"):
-        g, _ = _landing(t1, p2, r_in, r_out, rate, off)
-    lands = (np.abs(g).max(axis=1) <= LANDING_TOL_MM) & (t1 + p2 > 0)
+        lands[act[ok]] = True
+        a1 = np.where(step, a1 + dt, a1)
+        a2 = np.where(step, a2 + dp, a2)
+        if not step.all():                    # some stop: write back, compact the rest
+            t1[act], p2[act] = a1, a2
+            act, a1, a2 = act[step], a1[step], a2[step]
+            r1, r2, c, o = r1[step], r2[step], c[step], tuple(x[step] for x in o)
+    if act.size:                              # still iterating: the miss after the last step
+        t1[act], p2[act] = a1, a2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            g, _ = _landing(a1, a2, r1, r2, c, o)
+        lands[act] = np.abs(g).max(axis=1) <= LANDING_TOL_MM
+    lands &= t1 + p2 > 0
     return np.where(lands, t1, np.nan), np.where(lands, p2, np.nan)
+
+
+def _halved(t1, p2, dt, dp):
+    """The Newton step ``(dt, dp)`` halved while it would turn the pair backwards or
+    past a quarter turn (``h <= 0`` or ``|theta1|``, ``|phi2| >= THETA_MAX``), at most
+    :data:`STEP_HALVINGS` times: per transition, the first of the halvings ``dt 2^-m``,
+    ``m = 0 .. STEP_HALVINGS - 1``, that is allowed, else the last. The full steps are
+    tested first; where one is not allowed, all its halvings at once, each made by
+    halving the one before (the same numbers as halving in a loop until allowed)."""
+    a, b = t1 + dt, p2 + dp
+    # h summed in the loop's order, ((theta1 + dt) + phi2) + dp
+    bad = np.flatnonzero(~((a + p2 + dp > 0) & (np.abs(a) < THETA_MAX)
+                           & (np.abs(b) < THETA_MAX)))
+    if not bad.size:
+        return dt, dp
+    n = STEP_HALVINGS
+    half = np.full((bad.size, n + 1), 0.5)
+    half[:, 0] = dt[bad]
+    cand_t = np.multiply.accumulate(half, axis=1)
+    half[:, 0] = dp[bad]
+    cand_p = np.multiply.accumulate(half, axis=1)
+    t1b, p2b = t1[bad, None], p2[bad, None]
+    a, b = t1b + cand_t, p2b + cand_p
+    ok = (a + p2b + cand_p > 0) & (np.abs(a) < THETA_MAX) & (np.abs(b) < THETA_MAX)
+    ok[:, n] = True
+    rows, m = np.arange(bad.size), ok.argmax(axis=1)
+    dt, dp = dt.copy(), dp.copy()
+    dt[bad], dp[bad] = cand_t[rows, m], cand_p[rows, m]
+    return dt, dp
 
 
 def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
@@ -313,15 +359,22 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     sh = SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
                       trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
                       np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
-    if deviation and ok.any():
+    return samedir_measured(sh) if deviation else sh
+
+
+def samedir_measured(sh: SameDirShape) -> SameDirShape:
+    """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
+    :func:`samedir_shape` returns with ``deviation=True`` for the same radii and rates
+    (its landing is each transition's own, whatever the batch)."""
+    ok = np.isfinite(sh.theta)
+    dev = np.full_like(sh.rate, np.nan)
+    if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
-        dev = np.full_like(rate, np.nan)
         dev[i] = pieces_deviation(_canonical_pieces(part), part.r_in, part.r_out,
                                   part.r_out)
-        sh = SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
-                            for f in SameDirShape.__slots__))
-    return sh
+    return SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
+                          for f in SameDirShape.__slots__))
 
 
 def _canonical_pieces(sh: SameDirShape):
@@ -376,5 +429,5 @@ def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
     return pieces_rows(_canonical_pieces(sh), junction, along, inward, block, kind_code)
 
 
-__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_for_deviation", "samedir_rows",
-           "samedir_shape"]
+__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_for_deviation", "samedir_measured",
+           "samedir_rows", "samedir_shape"]

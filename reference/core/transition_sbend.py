@@ -267,27 +267,46 @@ def _on_pieces(packed: np.ndarray, s: np.ndarray, derivatives: bool = True):
     heading ``c sigma^2 / 2`` from ``e1`` towards ``e2``, the tangent reversed on a
     piece whose zero-curvature end is its last point); the points alone unless
     ``derivatives``."""
-    k = s.shape[0]
+    k, p = packed.shape[:2]
     ends = packed[:, :, 7] + packed[:, :, 8]
-    rows = np.arange(k).reshape((k,) + (1,) * (s.ndim - 1))
-    p = packed.shape[1]
-    ends = ends.reshape((k,) + (1,) * (s.ndim - 1) + (p,))
-    idx = np.minimum((s[..., None] >= ends).sum(axis=-1), p - 1)
-    g = packed[rows, idx]                                       # s.shape + (9,)
-    e1, e2, rate, length = g[..., 2:4], g[..., 4:6], g[..., 6], g[..., 7]
+    col = (k,) + (1,) * (s.ndim - 1)
+    # the piece each point lies on: how many pieces end at or before it (the last
+    # piece at most), counted piece by piece, and one gather from the flattened rows
+    idx = np.zeros(s.shape, np.intp)
+    for j in range(p - 1):
+        idx += s >= ends[:, j].reshape(col)
+    flat = idx + (np.arange(k) * p).reshape(col)
+    g = packed.reshape(k * p, packed.shape[2]).take(flat, axis=0)   # s.shape + (9,)
+    # (the two components apart: the same numbers as on s.shape + (2,) rows, without
+    # broadcasting over strided views)
+    rate, length = g[..., 6], g[..., 7]
     s_local = s - g[..., 8]
     c = np.abs(rate)
-    sigma = np.clip(np.where(rate < 0, length - s_local, s_local), 0.0, length)
+    sigma = np.minimum(np.maximum(np.where(rate < 0, length - s_local, s_local), 0.0),
+                       length)
     scale = np.sqrt(np.pi / c)
     fs, fc = _fresnel(sigma / scale)
-    p = g[..., 0:2] + (scale * fc)[..., None] * e1 + (scale * fs)[..., None] * e2
+    a, b = scale * fc, scale * fs
+    p = _xy(g[..., 0] + a * g[..., 2] + b * g[..., 4],
+            g[..., 1] + a * g[..., 3] + b * g[..., 5])
     if not derivatives:
         return p
     phi = 0.5 * c * sigma * sigma
-    cos, sin = np.cos(phi)[..., None], np.sin(phi)[..., None]
-    tangent = np.where(rate[..., None] < 0, -1.0, 1.0) * (cos * e1 + sin * e2)
-    second = (c * sigma)[..., None] * (cos * e2 - sin * e1)
+    cos, sin = np.cos(phi), np.sin(phi)
+    sign = np.where(rate < 0, -1.0, 1.0)
+    tangent = _xy(sign * (cos * g[..., 2] + sin * g[..., 4]),
+                  sign * (cos * g[..., 3] + sin * g[..., 5]))
+    kappa = c * sigma
+    second = _xy(kappa * (cos * g[..., 4] - sin * g[..., 2]),
+                 kappa * (cos * g[..., 5] - sin * g[..., 3]))
     return p, tangent, second
+
+
+def _xy(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Components ``x``, ``y`` as one array, shape ``x.shape + (2,)``."""
+    out = np.empty(x.shape + (2,))
+    out[..., 0], out[..., 1] = x, y
+    return out
 
 
 def _circle(first: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,

@@ -30,7 +30,10 @@ from scipy.integrate import solve_ivp
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.core.transition_samedir import samedir_for_deviation, samedir_shape
+from reference.core.transition import ramp_offset
+from reference.core.transition_samedir import (STEP_HALVINGS, THETA_MAX, _halved,
+                                               _newton, samedir_for_deviation,
+                                               samedir_measured, samedir_shape)
 from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_text
 from reference.planner import plan
@@ -177,6 +180,65 @@ def test_vectorised_sizes_agree_with_one_at_a_time():
     for i in (0, 17, 39):
         one = samedir_for_deviation(r1[i:i + 1], r2[i:i + 1], tol[i:i + 1])
         assert float(one.rate[0]) == pytest.approx(float(sh.rate[i]), rel=1e-8)
+
+
+def _halved_by_loop(t1, p2, dt, dp):
+    """The step halving written as the loop it replaces: each transition's step halved
+    while the pair would turn backwards or past a quarter turn, at most STEP_HALVINGS
+    times, one transition at a time."""
+    out_t, out_p = dt.copy(), dp.copy()
+    for i in range(dt.size):
+        a, b = dt[i], dp[i]
+        for _ in range(STEP_HALVINGS):
+            if t1[i] + a + p2[i] + b > 0 and abs(t1[i] + a) < THETA_MAX \
+                    and abs(p2[i] + b) < THETA_MAX:
+                break
+            a, b = 0.5 * a, 0.5 * b
+        out_t[i], out_p[i] = a, b
+    return out_t, out_p
+
+
+def test_all_step_halvings_at_once_are_the_halving_loop():
+    """_halved tests every halving of a Newton step at once: per transition the same
+    numbers as halving in a loop until the step is allowed (steps needing 0 to 8
+    halvings, and some never allowed)."""
+    rng = np.random.default_rng(11)
+    t1 = rng.uniform(-1.4, 1.4, 400)
+    p2 = rng.uniform(-1.4, 1.4, 400)
+    dt = rng.normal(0.0, 1.0, 400) * 10.0 ** rng.uniform(-3, 3, 400)
+    dp = rng.normal(0.0, 1.0, 400) * 10.0 ** rng.uniform(-3, 3, 400)
+    got = _halved(t1, p2, dt, dp)
+    want = _halved_by_loop(t1, p2, dt, dp)
+    np.testing.assert_array_equal(got[0], want[0])
+    np.testing.assert_array_equal(got[1], want[1])
+    assert len({int(n) for n in np.round(np.log2(dt / got[0]))}) >= 5
+
+
+def test_each_landing_is_the_transitions_own_and_measured_later_alike():
+    """The landing's Newton steps give each transition what it gets alone, bit for bit,
+    also the ones that wander (radius ratios above 16, where the pair on the flatter arc
+    has no small-angle landing) -- which lets the block-length clamp measure the
+    deviation of a shape built earlier (samedir_measured) instead of building it again."""
+    rng = np.random.default_rng(7)
+    r1 = rng.uniform(2.0, 50.0, 60)
+    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, 60))
+    rate = rng.uniform(0.02, 2.0, 60) / np.minimum(r1, r2) ** 2
+    ramp = 1.0 / (np.minimum(r1, r2) * rate)
+    off = (*ramp_offset(r1, ramp)[:2], *ramp_offset(r2, ramp)[:2])
+    flat = r2 > r1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t_all, p_all = _newton(r1, r2, ramp, rate, off, flat)
+        for i in range(60):
+            one = slice(i, i + 1)
+            t1, p2 = _newton(r1[one], r2[one], ramp[one], rate[one],
+                             tuple(o[one] for o in off), flat[one])
+            np.testing.assert_array_equal(t1, t_all[one])
+            np.testing.assert_array_equal(p2, p_all[one])
+    assert np.isnan(t_all).any() and not np.isnan(t_all).all()
+    sh = samedir_shape(r1, r2, rate)
+    late = samedir_measured(samedir_shape(r1, r2, rate, deviation=False))
+    for f in sh.__slots__:
+        np.testing.assert_array_equal(getattr(late, f), getattr(sh, f))
 
 
 # ------------------------------------------------------------------ on a rounded path

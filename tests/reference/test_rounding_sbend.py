@@ -27,7 +27,8 @@ from scipy.optimize import brentq
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.core.transition_sbend import sbend_for_deviation, sbend_shape
+from reference.core.transition_sbend import (_canonical_pieces, _on_pieces, _packed,
+                                             sbend_for_deviation, sbend_rows, sbend_shape)
 from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
@@ -195,6 +196,33 @@ def test_vectorised_sizes_agree_with_one_at_a_time():
     for i in (0, 17, 39):
         one = sbend_for_deviation(r1[i:i + 1], r2[i:i + 1], tol[i:i + 1])
         assert float(one.rate[0]) == pytest.approx(float(sh.rate[i]), rel=1e-8)
+
+
+def test_points_on_the_pieces_are_the_clothoid_rows():
+    """The deviation search's points, tangents and curvature vectors (_on_pieces) are
+    those of the packed clothoid rows the path gets (reference.core.geometry), at
+    points spread over every piece."""
+    rng = np.random.default_rng(8)
+    r1, r2 = rng.uniform(2, 50, 12), rng.uniform(2, 50, 12)
+    sh = sbend_for_deviation(r1, r2, np.full(12, 0.02))
+    pieces = _canonical_pieces(sh)
+    lengths = pieces[4]
+    total = lengths.sum(axis=1)
+    s = rng.uniform(0.0, 1.0, (12, 30)) * total[:, None]
+    p, t, dd = _on_pieces(_packed(pieces), s)
+    # the canonical frame placed at the origin: x along, y inward
+    rows = sbend_rows(np.zeros((12, 2)), np.tile([1.0, 0.0], (12, 1)),
+                      np.tile([0.0, 1.0], (12, 1)), sh, np.arange(12), 0)
+    from reference.core.geometry import _eval_clothoid
+    starts = np.cumsum(lengths, axis=1) - lengths
+    piece = np.minimum((s[..., None] >= (starts + lengths)[:, None, :]).sum(axis=2), 5)
+    seg = (np.arange(12)[:, None] * 6 + piece).ravel()
+    local = (s - np.take_along_axis(starts, piece, axis=1)).ravel()
+    q, dq, ddq, _ = _eval_clothoid(rows["origin"][seg], rows["e1"][seg], rows["e2"][seg],
+                                   rows["sharpness"][seg], rows["length"][seg], local)
+    np.testing.assert_allclose(p.reshape(-1, 2), q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(t.reshape(-1, 2), dq, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(dd.reshape(-1, 2), ddq, rtol=0, atol=1e-9)
 
 
 # ------------------------------------------------------------------ on a rounded path
