@@ -58,6 +58,7 @@ from typing import Callable
 
 import numpy as np
 
+from reference.core.errors import ProfileError
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.core.phases import acceleration_phases, min_phase_duration, phase_frequencies
@@ -65,6 +66,7 @@ from reference.core.profile import Profile
 
 from ..grid import grid_on
 from ..jerk.backends import get_nlp_backend
+from ..jerk.tolerances import DEFAULT_JERK_MAX_GRID
 from ..jerk.transcription import JerkProblem, Rows, StepRows, build_jerk_problem
 from ..jerk.upper import exact_profile, warm_start
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
@@ -122,7 +124,8 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     start : Profile
         The jerk optimum on that grid (holds excluded).
     rounds : int
-        NLP rounds at most.
+        NLP rounds at most. None runs on a grid of more than ``DEFAULT_JERK_MAX_GRID``
+        intervals (the jerk oracle's largest NLP).
     progress : callable, optional
         ``progress(message)`` after each round.
     bounds : {"jerk+freq", "acc+freq"}
@@ -151,6 +154,10 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     if short.size == 0:
         return []
     grid = grid_on(path, grid_s)
+    if grid.n_intervals > DEFAULT_JERK_MAX_GRID:
+        # the jerk oracle's own largest NLP: beyond it a round would cost more than the
+        # base solve, and the other candidates stand
+        return []
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
     jerk_rows = bounds != "acc+freq"
     if not jerk_rows:
@@ -201,8 +208,11 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         nlp = nlp_solve(prob_r, c0, a0, dt0)
         if not nlp.success:
             break
-        prof = exact_profile(prob_r, nlp.c, nlp.a, nlp.a_end, nlp.dt,
-                             path.block[grid.segment])
+        try:
+            prof = exact_profile(prob_r, nlp.c, nlp.a, nlp.a_end, nlp.dt,
+                                 path.block[grid.segment])
+        except ProfileError:
+            break      # an NLP answer that is no motion: the rounds so far stand
         c = verified(f"{bounds.split('+')[0]} NLP adapted{' (wide)' if widen else ''}, "
                      f"round {r + 1}", path, limits, prof, bounds)
         if c is not None:
