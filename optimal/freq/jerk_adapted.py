@@ -37,15 +37,15 @@ bounded phase beside its bounds, so it also runs with the bounds widened (``wide
 The bounds only remove motions, and the motion at rest keeps all of them, so each
 round's NLP is feasible; every result is verified: nothing here is assumed, and a round
 that does not help costs time only. Measured (default machine, ``jerk+freq``, bracket
-before -> after): ``lcnc_arc_arc_sawtooth`` [7.50, 11.75] -> [7.50, 7.68] s (the jerk
+before -> after): ``lcnc_arc_arc_sawtooth`` [7.50, 11.75] -> [7.50, 7.66] s (the jerk
 optimum, 7.64 s, had two phases of a dip near the start at 41 and 49 ms against 50 ms),
-``lcnc_tangent_helix`` 14.4 -> 0.96 %, ``lcnc_corner_decel`` 5.7 -> 2.8 %,
+``lcnc_tangent_helix`` 14.4 -> 0.96 %, ``lcnc_corner_decel`` 5.7 -> 1.99 %,
 ``lcnc_test_12mmflat`` 23 -> 13 % (174 short phases -> 139, 130, 99, 81, 30, 5, 2, 0 over
 8 rounds of about 4 s). On ``lcnc_sam_tolerance_issue`` (tiny segments at low speed) the
 rounds settle only once the doubling wiggle share flattens nearly everything (12 rounds,
 5.5 s against the filtered candidates' 3.6 s): they decide there. ``acc+freq`` (against
 the adapted caps of :func:`optimal.freq.upper.eroded_plans`): ``lcnc_corner_decel``
-10.4 -> 3.8 %, ``lcnc_arc_arc_sawtooth`` 20.7 -> 10.7 %, ``lcnc_tangent_helix``
+10.4 -> 3.8 %, ``lcnc_arc_arc_sawtooth`` 20.7 -> 5.2 %, ``lcnc_tangent_helix``
 3.2 -> 0.92 %; no change on 12mmflat and sam.
 
 Units: mm, s.
@@ -71,13 +71,19 @@ from ..jerk.transcription import JerkProblem, Rows, StepRows, build_jerk_problem
 from ..jerk.upper import exact_profile, warm_start
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
 
-__all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "JERK_ADAPT_ROUNDS",
-           "jerk_adapted"]
+__all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "JERK_ADAPT_DONE_REL",
+           "JERK_ADAPT_ROUNDS", "jerk_adapted"]
 
 #: NLP rounds of :func:`jerk_adapted` at most (each costs one jerk NLP on the base
 #: solve's final grid; the loop stops as soon as no phase is short). The corpus programs
 #: it helps settle in 2-3 rounds, lcnc_test_12mmflat in 8 (about 4 s each).
 JERK_ADAPT_ROUNDS = 8
+#: The rounds stop once a verified round was slowed down by at most this share: what
+#: the phases still short cost is then a tenth of the default 2 % bracket, and the next
+#: rounds, which tighten bounds that are nearly met, were the slow ones (on
+#: lcnc_arc_arc_sawtooth under acc+freq an eighth round took IPOPT 32 s to fail, after
+#: seven of about 1 s).
+JERK_ADAPT_DONE_REL = 2e-3
 #: ``acc+freq``: target size and largest size of the NLP grid, intervals (the jerk
 #: oracle's first grid, :func:`optimal.jerk.oracle.jerk_grid`, graded toward the ends of
 #: segments where the acc optimum's speed changes, merged with the acc grid). The acc
@@ -111,7 +117,8 @@ def _without_jerk(problem: JerkProblem) -> JerkProblem:
 def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Profile,
                  rounds: int = JERK_ADAPT_ROUNDS,
                  progress: Callable[[str], object] | None = None,
-                 bounds: str = "jerk+freq", widen: bool = False) -> list[Candidate]:
+                 bounds: str = "jerk+freq", widen: bool = False,
+                 asymmetric: bool = True) -> list[Candidate]:
     """The jerk optimum adapted to the frequency rule (see the module docstring).
 
     Parameters
@@ -138,7 +145,17 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         moved for 8 rounds); the wider bound stops that but also binds ramps that were
         long enough. Neither is faster on every program (default machine, ``acc+freq``:
         ``lcnc_corner_decel`` 7.35 s narrow against 7.26 s wide, ``lcnc_arc_arc_sawtooth``
-        5.59 against 5.79 s), so the oracle runs both.
+        5.59 against 5.79 s), so the oracle runs both (``acc+freq`` only).
+    asymmetric : bool
+        Scale each bound by the phase's ``D_eff / D``: an asymmetric ramp (an S-ramp whose
+        jerk differs at its two ends, an acceleration limited by a curvature term that
+        changes with the speed) is slowed by what its effective duration lacks, where a
+        bound that makes it symmetric would need less. Neither is faster on every program
+        (default machine, ``jerk+freq``: ``lcnc_test_12mmflat`` 40.4 s with the factor
+        against 41.6 s without, ``lcnc_corner_decel`` 7.35 against 7.29 s; ``acc+freq``
+        on ``lcnc_arc_arc_sawtooth`` 5.59 against 5.31 s, but on the line-arc-line of the
+        tests 0.742 against 0.750 s), so the oracle runs both, under ``acc+freq`` with and
+        without ``widen``.
 
     Returns
     -------
@@ -194,7 +211,8 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
             aim = need[p] * (1.0 + ADAPT_MARGIN)
             # the mean acceleration that makes the phase last its 1/f, less what an
             # asymmetric ramp's effective duration lacks against its plain one
-            a_new = ph.dv[p] / aim * min(1.0, ph.effective_duration[p] / ph.duration[p])
+            a_new = ph.dv[p] / aim * (min(1.0, ph.effective_duration[p] / ph.duration[p])
+                                      if asymmetric else 1.0)
             if ph.sign[p] > 0:
                 now = a_hi[nodes]
                 shrink = float(np.clip(ph.effective_duration[p] / aim, 0.5, 1.0))
@@ -213,10 +231,13 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
                                  path.block[grid.segment])
         except ProfileError:
             break      # an NLP answer that is no motion: the rounds so far stand
-        c = verified(f"{bounds.split('+')[0]} NLP adapted{' (wide)' if widen else ''}, "
+        tags = ", ".join(t for t, on in (("wide", widen), ("D_eff/D", asymmetric)) if on)
+        c = verified(f"{bounds.split('+')[0]} NLP adapted{f' ({tags})' if tags else ''}, "
                      f"round {r + 1}", path, limits, prof, bounds)
         if c is not None:
             out.append(c)
+            if c.time_scale <= 1.0 + JERK_ADAPT_DONE_REL:
+                break      # what the short phases left still cost is below the mark
         ph, short, need = _short_phases(path, lim, prof)
         if progress:
             progress(f"{bounds.split('+')[0]} NLP adapted to the rule, round {r + 1}: "

@@ -162,9 +162,14 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         grid_s = base_sol.grid if base == "jerk" else np.unique(np.concatenate((
             jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_sol.profile,
                       ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid)))
-        for widen in ((False,) if base == "jerk" else (False, True)):
+        # (widen, asymmetric): the variants of optimal.freq.jerk_adapted, none always
+        # faster; without a jerk limit the NLP also needs the widened bounds
+        variants = ((False, True), (False, False)) if base == "jerk" else (
+            (False, True), (False, False), (True, True), (True, False))
+        for widen, asym in variants:
             cands += jerk_adapted(path, limits, grid_s, base_sol.profile, bounds=name,
-                                  widen=widen, progress=(lambda msg: progress(msg, 0.85))
+                                  widen=widen, asymmetric=asym,
+                                  progress=(lambda msg: progress(msg, 0.85))
                                   if progress else None)
     # pieces start and end at rest: the fastest candidate on each, joined
     joined = pieced(path, cands, line_pieces(path, limits) if base == "acc" else None)
