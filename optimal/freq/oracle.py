@@ -167,6 +167,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         variants = ((False, True), (False, False)) if base == "jerk" else (
             (False, True), (False, False), (True, True), (True, False))
         for widen, asym in variants:
+            if min(c.duration for c in cands) + hold_t - lb <= tol * lb:
+                break      # the bracket is met: the next variants cannot matter
             cands += jerk_adapted(path, limits, grid_s, base_sol.profile, bounds=name,
                                   widen=widen, asymmetric=asym,
                                   progress=(lambda msg: progress(msg, 0.85))
