@@ -33,6 +33,7 @@ from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
 from seeded_programs import line_arc_chain
+from two_arc_refs import planned_under_g64_and_g645
 
 ROUNDING = KIND_CODES.index("rounding")
 ARC = KIND_CODES.index("arc")
@@ -290,14 +291,7 @@ def test_g645_is_not_slower_than_g64_and_keeps_its_limits(mfile, accel):
     faster and the planned speed through each transition stays above that cap."""
     mach = load_machine(mfile)
     body = "G1 X0 Y0\nG1 X20\nG3 X30 Y10 I0 J10\nG1 Y30\nG2 X40 Y40 I10 J0\nG1 X60\nM30\n"
-    out = {}
-    for mode in ("G64", "G645"):
-        prog = parse_text(f"G17 G90 {mode} {accel} F6000\n" + body)
-        path = build_path(prog, mach)
-        res = plan(prog, mach, path=path)
-        rep = check_profile(path, mach.limits, res.profile)
-        assert rep.ok(BOUND_SETS[res.bound_set]), rep
-        out[mode] = (path, res)
+    out = planned_under_g64_and_g645(mach, "G17 G90 {mode} " + accel + " F6000\n", body)
     t64 = out["G64"][1].profile.duration
     path, res = out["G645"]
     assert res.profile.duration <= t64 * (1 + 1e-9)

@@ -22,18 +22,18 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
 from reference.core.transition_sbend import (_canonical_pieces, _on_pieces, _packed,
                                              sbend_for_deviation, sbend_rows, sbend_shape)
-from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
 from seeded_programs import s_bend_chain
+from two_arc_refs import contour_distance as arc_distance
+from two_arc_refs import g645_keeps_limits_and_passes_faster_than_the_cap, integrate_curvature
 from test_rounding_g645 import machine, reasons
 
 ROUNDING = KIND_CODES.index("rounding")
@@ -55,43 +55,19 @@ def integrate(sh, i: int):
     """The rounding by an ODE solver from its curvature profile alone (hand model:
     ``1/R1 -> 0`` over ``L1``, ``0 -> +c L_s -> 0 -> -c L_s -> 0`` over ``4 L_s``,
     ``0 -> -1/R2`` over ``L2``, all linear in the arc length), started on the first arc
-    ``trim_in`` before the junction with its tangent (frame: junction at the origin,
-    tangent +x, first centre (0, R1), second centre (0, -R2)). Returns the dense
-    solution and the length."""
+    ``trim_in`` before the junction with its tangent (frame of :mod:`two_arc_refs`).
+    Returns the dense solution and the length."""
     r1, r2 = float(sh.r_in[i]), float(sh.r_out[i])
     c, ls = float(sh.rate[i]), float(sh.piece[i])
     l1, l2 = float(sh.ramp_in[i]), float(sh.ramp_out[i])
-    b = np.cumsum([0.0, l1, ls, ls, ls, ls, l2])
-
-    def kappa(s):
-        if s < b[1]:
-            return (1.0 / r1) * (1.0 - s / l1)
-        if s < b[2]:
-            return c * (s - b[1])
-        if s < b[3]:
-            return c * (b[3] - s)
-        if s < b[4]:
-            return -c * (s - b[3])
-        if s < b[5]:
-            return -c * (b[5] - s)
-        return -(1.0 / r2) * (s - b[5]) / l2
-
-    a0 = -float(sh.trim_in[i]) / r1
-    start = [r1 * math.sin(a0), r1 * (1 - math.cos(a0)), a0]
-    sol = solve_ivp(lambda s, z: [math.cos(z[2]), math.sin(z[2]), kappa(s)], (0, b[-1]),
-                    start, rtol=1e-12, atol=1e-14, dense_output=True,
-                    max_step=min(ls, l1, l2) / 20)
-    return sol, b[-1]
+    return integrate_curvature(np.cumsum([0.0, l1, ls, ls, ls, ls, l2]),
+                               [1.0 / r1, 0.0, c * ls, 0.0, -c * ls, 0.0, -1.0 / r2], r1,
+                               float(sh.trim_in[i]), min(ls, l1, l2) / 20)
 
 
 def contour_distance(x, y, r1, r2):
-    """Hand geometry: distance from the two programmed arcs near the junction (the first
-    for x <= 0, the second for x >= 0; beyond an arc's end its nearest point is the
-    junction)."""
-    j = np.hypot(x, y)
-    d1 = np.where(x <= 0, np.abs(np.hypot(x, y - r1) - r1), j)
-    d2 = np.where(x >= 0, np.abs(np.hypot(x, y + r2) - r2), j)
-    return np.minimum(d1, d2)
+    """Hand geometry: distance from the two programmed arcs, curving opposite ways."""
+    return arc_distance(x, y, r1, r2, -1)
 
 
 CASES = [(10.0, 10.0, 0.005), (10.0, 20.0, 0.005), (5.0, 50.0, 0.01), (100.0, 3.0, 0.005),
@@ -343,26 +319,7 @@ def test_g645_keeps_its_limits_and_passes_faster_than_the_cap(mfile):
     (check_profile) on both bundled machines; where the S-bend is rounded (default
     machine: the jump caps G64 at sqrt(J T R / 2)) the planned speed inside the rounding
     stays above that cap and the program is not slower than under G64."""
-    mach = load_machine(mfile)
-    out = {}
-    for mode in ("G64", "G645"):
-        prog = parse_text(f"G17 G90 {mode} SOFT F5000\n" + s_bend(60.0, 60.0))
-        path = build_path(prog, mach)
-        res = plan(prog, mach, path=path)
-        rep = check_profile(path, mach.limits, res.profile)
-        assert rep.ok(BOUND_SETS[res.bound_set]), rep
-        out[mode] = (path, res)
-    path, res = out["G645"]
-    t = path.rounding
-    if mfile == "default":
-        assert t.inserted.all()
-        k = np.flatnonzero(path.kind == ROUNDING)
-        s = np.linspace(path.s_breaks[k[0]], path.s_breaks[k[-1] + 1], 200)
-        v = res.profile.state(res.profile.time_at(s))[1]
-        assert v.min() > t.v_g64[0]
-        assert res.profile.duration < out["G64"][1].profile.duration
-    else:       # the jump there is allowed at the programmed speed: named
-        assert reasons(path) == ["G64 passes the curvature jump without reduction"]
+    g645_keeps_limits_and_passes_faster_than_the_cap(mfile, s_bend(60.0, 60.0))
 
 
 def test_a_seeded_chain_of_s_bends_is_rounded_where_it_pays_and_keeps_its_limits():
