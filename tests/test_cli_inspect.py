@@ -9,12 +9,11 @@ from pathlib import Path
 import pytest
 
 from compare.cli import main
+from shared_inputs import NO_CORPUS, corpus_listing
 
 ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT.parent / "shared" / "corpus"
-CORPUS_FILES = sorted(p for p in CORPUS.glob("*") if p.suffix.lower() in
-                      (".mpf", ".spf", ".ngc", ".nc", ".tap")) if CORPUS.is_dir() else []
-NO_CORPUS = "shared corpus folder ../shared/corpus not present (it lives beside the repository, not in it)"
+CORPUS_FILES = sorted(p for p in corpus_listing("*") if p.suffix.lower() in
+                      (".mpf", ".spf", ".ngc", ".nc", ".tap"))
 
 
 @pytest.mark.skipif(not CORPUS_FILES, reason=NO_CORPUS)

@@ -13,7 +13,9 @@ segment array of the built path, its rounding table and block spans, and of the 
 (with its own check) the profile, total time, block rows, corner
 rows and trace (less its wall time). ``compare`` prints the largest relative difference
 ``|a - b| / max(1, |a|)`` of the float columns and every mismatch; a speed-up that only
-reorders work must show 0 (bit-identical), and at most round-off otherwise.
+reorders work must show 0 (bit-identical), and at most round-off otherwise. Where
+``../shared`` is absent the corpus cases are left out (saying so on stderr); ``compare``
+then reports "different cases" against a dump that has them.
 """
 
 from __future__ import annotations
@@ -29,8 +31,11 @@ import numpy as np
 HERE = FsPath(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 sys.path.insert(0, str(HERE.parent / "reference"))
+# tests/: shared_inputs, the one place that says where ../shared is
+sys.path.insert(0, str(HERE.parent))
 
-from corpus_sinumerik import CORPUS, corpus_in_mode, short_segments_g642  # noqa: E402
+from corpus_sinumerik import corpus_in_mode, short_segments_g642  # noqa: E402
+from shared_inputs import CORPUS_PRESENT, NO_CORPUS, corpus_listing  # noqa: E402
 from reference.machine import load_machine  # noqa: E402
 from reference.nc import parse_text  # noqa: E402
 from reference.planner import plan  # noqa: E402
@@ -51,7 +56,9 @@ ROUNDOFF_REL = 1e-9
 def programs(n: int = 1500) -> dict[str, str]:
     """Name -> program text of every case."""
     progs = {}
-    for f in sorted(CORPUS.iterdir()):
+    if not CORPUS_PRESENT:
+        print(f"corpus cases left out: {NO_CORPUS}", file=sys.stderr)
+    for f in corpus_listing():
         if f.suffix not in (".ngc", ".mpf"):
             continue
         if f.suffix == ".mpf":
@@ -59,7 +66,8 @@ def programs(n: int = 1500) -> dict[str, str]:
         for mode in MODES:
             for acc in ("BRISK", "SOFT"):
                 progs[f"{f.name}|{mode} {acc}"] = corpus_in_mode(f.name, f"{mode} {acc}")
-    progs["short_segments_g642"] = short_segments_g642()
+    if CORPUS_PRESENT:
+        progs["short_segments_g642"] = short_segments_g642()
     body = polyline(n, 13)
     for acc in ("BRISK", "SOFT"):
         for mode in MODES + ("G641 ADIS=0.2 ADISPOS=0.1",):

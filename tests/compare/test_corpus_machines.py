@@ -23,16 +23,14 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT
-
 from compare import cli
+from shared_inputs import NO_CORPUS, corpus_file, corpus_listing
 
-CORPUS = ROOT.parent / "shared" / "corpus"
-PROGRAMS = sorted(CORPUS.glob("*.ngc")) + sorted(CORPUS.glob("*.mpf")) if CORPUS.is_dir() else []
+PROGRAMS = corpus_listing("*.ngc") + corpus_listing("*.mpf")
 #: Axes a program moves beyond X, Y, Z (the parser test's extruder and extra axis).
 EXTRA_AXES = {"sin_cead_edge_cases.mpf": ("A", "B", "C", "E", "ELX")}
 
-pytestmark = pytest.mark.skipif(not PROGRAMS, reason="../shared/corpus not present")
+pytestmark = pytest.mark.skipif(not PROGRAMS, reason=NO_CORPUS)
 
 
 def _bundled(name: str) -> dict:
@@ -107,7 +105,7 @@ def test_corpus_program_compares_with_a_certificate(program: Path, machine: str,
 
 
 def test_a_machine_without_a_programmed_axis_is_bad_input(tmp_path: Path, capsys) -> None:
-    prog = CORPUS / "sin_cead_edge_cases.mpf"
+    prog = corpus_file("sin_cead_edge_cases.mpf")
     mfile = tmp_path / "default.toml"
     mfile.write_text(_toml(_bundled("default")))
     rc = cli.main(["compare", str(prog), "--machine", str(mfile), "--no-report", "--quiet"])

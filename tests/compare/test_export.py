@@ -13,24 +13,23 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from conftest import ROOT, SMALL, path_of
+from conftest import SMALL, path_of
 from fakes import fake_plan, fake_solution
 
 from compare.comparison import OracleResult, Side, compare, compare_profiles
 from compare.export import (CSV_COLUMNS, JSON_INF, blocks_csv, comparison_dict, dumps,
                             profile_samples, schema)
 from reference.core.limits import MachineLimits
+from shared_inputs import SCHEMA, absent
 
-SHARED_SCHEMA = ROOT.parent / "shared" / "schema" / "result.schema.json"
 
-
-@pytest.mark.skipif(not SHARED_SCHEMA.is_file(),
-                    reason="../shared/schema/result.schema.json not present (it lives "
-                           "beside the repository)")
+@pytest.mark.skipif(not SCHEMA.is_file(),
+                    reason=absent(SCHEMA, "DESIGN's result schema, which the packaged one "
+                                          "copies (it lives beside the repository)"))
 def test_packaged_schema_is_the_shared_one():
     """The packaged schema is DESIGN's, with one difference issue 12 (newer than DESIGN)
     makes: the bound set ``acc+freq`` (BRISK with the dynamic response adaptation)."""
-    shared = json.loads(SHARED_SCHEMA.read_text())
+    shared = json.loads(SCHEMA.read_text())
     ours = schema()
     enum = ours["properties"]["bounds"]["enum"]
     assert "acc+freq" in enum and "acc+freq" not in shared["properties"]["bounds"]["enum"]

@@ -14,25 +14,24 @@ from __future__ import annotations
 import pytest
 
 import optimal
-from conftest import ROOT
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.holds import imposed_holds
 from reference.machine import load_machine
 from reference.nc import parse_file
 from reference.prepare import build_path
+from shared_inputs import corpus_file, needs_corpus
 
-CORPUS = ROOT.parent / "shared" / "corpus"
 # (lcnc_full_xz.ngc and sin_cead_arc.mpf take 30-50 s on the default machine: too slow here)
 PROGRAMS = ["lcnc_square.ngc", "lcnc_corner_decel.ngc"]
 MACHINES = [None, "linuxcnc_xyz"]
-pytestmark = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus not present")
+pytestmark = needs_corpus
 
 
 @pytest.mark.parametrize("machine", MACHINES)
 @pytest.mark.parametrize("program", PROGRAMS)
 def test_relaxation_chain(program, machine):
     m = load_machine(machine)
-    prog = parse_file(CORPUS / program)
+    prog = parse_file(corpus_file(program))
     path = build_path(prog, m)
     holds = imposed_holds(prog, path, m)
     lim = m.limits

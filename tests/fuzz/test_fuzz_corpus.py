@@ -25,10 +25,10 @@ from pathlib import Path
 import pytest
 
 from fuzz_harness import COMPARE_ARGS, assert_clean, run_cli
+from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS, corpus_cases, corpus_listing
 
 pytestmark = pytest.mark.fuzz
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 #: Longest mutant, lines: a few dozen blocks, like the generated programs.
 MAX_LINES = 40
 CI_SEEDS = 5
@@ -52,9 +52,7 @@ KNOWN_FAILURES: dict[tuple[str, int], str] = {}
 
 
 def _corpus_files() -> list[Path]:
-    if not CORPUS.is_dir():
-        return []
-    return sorted(p for p in CORPUS.glob("*") if p.suffix in (".mpf", ".ngc"))
+    return sorted(p for p in corpus_listing("*") if p.suffix in (".mpf", ".ngc"))
 
 
 def mutant(original: bytes, seed: int) -> bytes:
@@ -118,13 +116,12 @@ def _cases():
 
 
 def test_corpus_is_there():
-    if not CORPUS.is_dir():
-        pytest.skip(f"no corpus at {CORPUS} (../shared/corpus beside the repository): "
-                    "no mutants to run")
+    if not CORPUS_PRESENT:
+        pytest.skip(f"{NO_CORPUS}: no mutants to run")
     assert len(_corpus_files()) >= 10, f"corpus at {CORPUS} has lost its programs"
 
 
-@pytest.mark.parametrize("original, seed", list(_cases()))
+@pytest.mark.parametrize("original, seed", corpus_cases(list(_cases()), nargs=2))
 def test_corpus_mutant(original, seed):
     data = mutant(original.read_bytes(), seed)
     with tempfile.TemporaryDirectory() as tmp:

@@ -27,16 +27,16 @@ from optimal.jerk.upper import profile_times_at
 from reference.core import AxisLimits, MachineLimits, Profile
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.machine import load_machine
+from shared_inputs import CORPUS, corpus_param
 
 ROOT = Path(__file__).resolve().parents[2]
-CORPUS = "../shared/corpus/"
-PROGRAMS = ["examples/demo.mpf", "examples/slot.ngc", CORPUS + "lcnc_square.ngc",
-            CORPUS + "sin_cead_arc.mpf", CORPUS + "lcnc_arc_arc_sawtooth.ngc",
-            CORPUS + "lcnc_tangent_helix.ngc",
-            # arcs whose end radius differs from the start: spirals (step 6 on them)
-            CORPUS + "lcnc_sam_tolerance_issue.ngc"]
-# the corpus lives beside the repository: without it those cases are not collected
-PROGRAMS = [str(ROOT / p) for p in PROGRAMS if (ROOT / p).is_file()]
+# the corpus lives beside the repository: without it those cases are skipped, saying so
+PROGRAMS = [str(ROOT / p) for p in ("examples/demo.mpf", "examples/slot.ngc")] + [
+    corpus_param(n, str(CORPUS / n))
+    for n in ("lcnc_square.ngc", "sin_cead_arc.mpf", "lcnc_arc_arc_sawtooth.ngc",
+              "lcnc_tangent_helix.ngc",
+              # arcs whose end radius differs from the start: spirals (step 6 on them)
+              "lcnc_sam_tolerance_issue.ngc")]
 
 #: The time offset at which a motion's acceleration is read on each side of a node:
 #: far below any interval, far above float resolution of the knot times.

@@ -3,15 +3,15 @@
 ``../shared/corpus/SOURCES.md`` asks that its programs are used from there and not copied
 into this repository (the ``lcnc_*`` files are GPL-2.0 data). Tests and benchmarks that
 need a LinuxCNC program in the other dialect convert it here, from the corpus file, on
-every run.
+every run; where the corpus is absent the calling test skips, naming the file
+(:func:`shared_inputs.corpus_file`).
 """
 
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
+from shared_inputs import corpus_file
 
 
 def short_segments_g642() -> str:
@@ -24,10 +24,11 @@ def short_segments_g642() -> str:
 
     Raises
     ------
-    FileNotFoundError
-        The corpus is not beside the project.
+    pytest.skip.Exception
+        The corpus file is not beside the project (the calling test skips, saying so;
+        a benchmark checks :data:`shared_inputs.CORPUS_PRESENT` first).
     """
-    src = (CORPUS / "lcnc_short_segments_0.001.ngc").read_text()
+    src = corpus_file("lcnc_short_segments_0.001.ngc").read_text()
     out = []
     for line in src.splitlines():
         line = line.replace("\t", " ").strip()
@@ -56,10 +57,11 @@ def corpus_in_mode(name: str, mode: str) -> str:
 
     Raises
     ------
-    FileNotFoundError
-        The corpus is not beside the project.
+    pytest.skip.Exception
+        The corpus file is not beside the project (the calling test skips, saying so;
+        a benchmark checks :data:`shared_inputs.CORPUS_PRESENT` first).
     """
-    src = (CORPUS / name).read_text()
+    src = corpus_file(name).read_text()
     if name.endswith(".mpf"):
         return f"{mode}\n" + re.sub(r"\bG64\b", mode, src)
     out = []

@@ -20,13 +20,13 @@ from reference.core.errors import FeedOracleError, MachineDataError
 from reference.machine import load_machine
 from reference.nc import parse_file, parse_text
 from reference.planner import plan
+from shared_inputs import corpus_cases, corpus_listing
 
 ROOT = FsPath(__file__).resolve().parents[2]
-CORPUS = ROOT.parent / "shared" / "corpus"
 SUFFIXES = (".mpf", ".spf", ".ngc", ".nc", ".tap")
-PROGRAMS = [ROOT / "examples" / "demo.mpf", ROOT / "examples" / "slot.ngc"] + (
-    sorted(p for p in CORPUS.iterdir() if p.suffix.lower() in SUFFIXES)
-    if CORPUS.is_dir() else [])
+# without ../shared the corpus cases are one skipped case that says so
+PROGRAMS = [ROOT / "examples" / "demo.mpf", ROOT / "examples" / "slot.ngc"] + corpus_cases(
+    sorted(p for p in corpus_listing() if p.suffix.lower() in SUFFIXES))
 
 SQUARE_ARC = "N10 G90 G64 F6000\nN20 G1 X30 Y0\nN30 G1 Y40\nN40 G3 X0 Y70 CR=30\nM30\n"
 

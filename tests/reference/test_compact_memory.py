@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import sys
 import tracemalloc
-from pathlib import Path as FsPath
 
 import numpy as np
 import pytest
@@ -29,8 +28,8 @@ from reference.nc import parse_file, parse_text
 from reference.nc.lines import FullStmt, Stmt, fast_pairs, parse_ngc, parse_sinumerik
 from reference.planner import plan, to_json_dict
 from reference.prepare import build_path
+from shared_inputs import corpus_file
 
-CORPUS = FsPath(__file__).resolve().parents[2].parent / "shared" / "corpus"
 PROGRAMS = ["sin_cead_arc.mpf", "sin_cead_loop.mpf", "lcnc_tangent_helix.ngc",
             "lcnc_arc_arc_sawtooth.ngc", "lcnc_test_12mmflat.ngc"]
 
@@ -92,7 +91,7 @@ def _report_numbers(rep):
 @pytest.mark.parametrize("name", PROGRAMS)
 def test_results_do_not_depend_on_chunk_sizes(name, monkeypatch):
     m = load_machine("linuxcnc_xyz" if name.endswith(".ngc") else None)
-    prog = parse_file(CORPUS / name)
+    prog = parse_file(corpus_file(name))
     p = plan(prog, m)
     doc = to_json_dict(p)
     rep = _report_numbers(check_profile(p.path, m.limits, p.profile))
@@ -109,7 +108,7 @@ def test_results_do_not_depend_on_chunk_sizes(name, monkeypatch):
 @pytest.mark.parametrize("name", PROGRAMS)
 def test_block_times_equal_their_definition(name):
     m = load_machine("linuxcnc_xyz" if name.endswith(".ngc") else None)
-    p = plan(parse_file(CORPUS / name), m)
+    p = plan(parse_file(corpus_file(name)), m)
     path, prof = p.path, p.profile
     # the definition: split at every block end, label every interval, sum its durations
     split = prof.split_at([b.s_end for b in path.blocks if b.s_end > b.s_start])

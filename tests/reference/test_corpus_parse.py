@@ -13,24 +13,18 @@ from pathlib import Path
 import pytest
 
 from reference.nc import parse_file
+from shared_inputs import CORPUS_PRESENT, NO_CORPUS, corpus_cases, corpus_file, corpus_listing
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
-NO_CORPUS = ("shared corpus folder ../shared/corpus not present (it lives beside the "
-             "repository, not in it)")
 SUFFIXES = (".mpf", ".spf", ".ngc", ".nc", ".tap")
 IN = 25.4
 
 
 def _files() -> list[Path]:
-    if not CORPUS.is_dir():
-        return []
-    return sorted(p for p in CORPUS.iterdir() if p.suffix.lower() in SUFFIXES)
+    return sorted(p for p in corpus_listing() if p.suffix.lower() in SUFFIXES)
 
 
 def _load(name: str):
-    if not CORPUS.is_dir():
-        pytest.skip(NO_CORPUS)
-    return parse_file(CORPUS / name)
+    return parse_file(corpus_file(name))
 
 
 def _moving(prog):
@@ -38,12 +32,12 @@ def _moving(prog):
 
 
 def test_corpus_folder_is_there_or_skip():
-    if not CORPUS.is_dir():
+    if not CORPUS_PRESENT:
         pytest.skip(NO_CORPUS)
     assert len(_files()) >= 12
 
 
-@pytest.mark.parametrize("path", _files(), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", corpus_cases(_files()), ids=lambda p: p.name)
 def test_every_corpus_program_parses(path: Path):
     prog = parse_file(path)
     assert prog.blocks, path.name

@@ -2,16 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from reference.core.errors import NCSyntaxError
 from reference.nc import parse_file, parse_text
-
-ROOT = Path(__file__).resolve().parents[2]
-CORPUS = ROOT.parent / "shared" / "corpus"
+from shared_inputs import NO_CORPUS, corpus_listing
 
 
 def sin(text):
@@ -247,11 +243,10 @@ def test_unknown_extension(tmp_path):
 
 
 # ------------------------------------------------------------------------ corpus
-CORPUS_FILES = sorted(CORPUS.glob("*.*")) if CORPUS.is_dir() else []
+CORPUS_FILES = corpus_listing("*.*")
 
 
-@pytest.mark.skipif(not CORPUS_FILES, reason="shared corpus folder ../shared/corpus not present "
-                    "(it lives beside the repository, not in it)")
+@pytest.mark.skipif(not CORPUS_FILES, reason=NO_CORPUS)
 def test_corpus_counts():
     progs = {f.name: parse_file(f) for f in CORPUS_FILES if f.suffix != ".md"}
     assert len(moves(progs["lcnc_short_segments_0.001.ngc"])) >= 3000

@@ -15,9 +15,9 @@ import pytest
 from reference.core.errors import NCSyntaxError
 from reference.nc import parse_file, parse_text
 from reference.prepare import prepare
+from shared_inputs import CORPUS_PRESENT, NO_CORPUS, corpus_cases, corpus_listing
 
 ROOT = Path(__file__).resolve().parents[2]
-CORPUS = ROOT.parent / "shared" / "corpus"
 SUFFIXES = (".mpf", ".spf", ".ngc", ".nc", ".tap")
 
 #: Consecutive segments must meet to this, mm (issue 8, item 3).
@@ -28,9 +28,7 @@ REPRO = "G90 G1 X0 Y0 F6000\nX100\nG3 X0 Y100.09 I-100 J0\nG1 X-100\n"
 
 
 def _corpus() -> list[Path]:
-    if not CORPUS.is_dir():
-        return []
-    return sorted(p for p in CORPUS.iterdir() if p.suffix.lower() in SUFFIXES)
+    return sorted(p for p in corpus_listing() if p.suffix.lower() in SUFFIXES)
 
 
 def assert_continuous(program, path) -> None:
@@ -51,7 +49,7 @@ def assert_continuous(program, path) -> None:
         assert np.abs(got - want).max() <= MEET_MM, (program.file, span.line, got, want)
 
 
-@pytest.mark.parametrize("file", _corpus(), ids=lambda p: p.name)
+@pytest.mark.parametrize("file", corpus_cases(_corpus()), ids=lambda p: p.name)
 def test_every_corpus_path_is_continuous(file: Path):
     # the path is machine-independent (prepare needs no machine), so every program
     # qualifies, also those with axes the default machine lacks
@@ -60,8 +58,8 @@ def test_every_corpus_path_is_continuous(file: Path):
 
 
 def test_corpus_has_spiral_arcs_or_skip():
-    if not CORPUS.is_dir():
-        pytest.skip("shared corpus folder ../shared/corpus not present")
+    if not CORPUS_PRESENT:
+        pytest.skip(NO_CORPUS)
     spirals = sum(int(np.count_nonzero(prepare(parse_file(f)).dradius)) for f in _corpus())
     assert spirals > 0          # real programs round their end points: the case is real
 

@@ -23,8 +23,8 @@ from reference.core.constraints import BOUND_SETS
 from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_file, parse_text
 from reference.planner import plan
+from shared_inputs import corpus_listing, needs_corpus
 
-CORPUS = FsPath(__file__).resolve().parents[2].parent / "shared" / "corpus"
 N_RANDOM = int(os.environ.get("FEEDORACLE_RANDOM_CASES", "12"))
 DEFAULT_DICT = tomllib.loads(resources.files("reference.machines").joinpath(
     "default.toml").read_text())
@@ -144,13 +144,10 @@ def test_random_drive_programs_keep_the_declared_bounds(seed: int):
 
 
 def _corpus_files() -> list[FsPath]:
-    if not CORPUS.is_dir():
-        return []
-    return sorted(f for f in CORPUS.iterdir() if f.suffix.lower() in (".ngc", ".mpf"))
+    return sorted(f for f in corpus_listing() if f.suffix.lower() in (".ngc", ".mpf"))
 
 
-@pytest.mark.skipif(not CORPUS.is_dir(), reason=f"corpus not found at {CORPUS} "
-                    "(programs written by others live in ../shared/corpus)")
+@needs_corpus
 @pytest.mark.parametrize("file", _corpus_files(), ids=lambda f: f.name)
 def test_corpus_programs_keep_the_declared_bounds(file: FsPath):
     prog = parse_file(file)
