@@ -44,10 +44,15 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    * ``LT``, from lost time: each phase ``P`` of the stretch loses
      ``int_P (V - v) dt >= dv_P g / 2`` against the stretch's largest speed ``V``
      (integration by parts, :mod:`reference.core.phases`), the phases carry the whole
-     change of ``w``, at least ``V - u`` with ``u = hi_i`` (step 2), and ``V - v >= 0``
-     elsewhere. The distance ``d >= sum_k ds_k`` is ``V D - int (V - v) dt``, so
-     ``D >= (d + (V - u) g / 2) / V``; minimised over ``V <= hi_c``:
-     ``LT = min(d / u, (d - u g / 2) / hi_c + g / 2)``.
+     change of ``w``, at least ``V - u`` with ``u`` the valley's speed, and
+     ``V - v >= 0`` elsewhere. The distance ``d >= sum_k ds_k`` is
+     ``V D - int (V - v) dt``, so ``D >= (d + (V - u) g / 2) / V``; minimised over
+     ``V <= hi_c``: ``LT = min(d / u, (d - u g / 2) / hi_c + g / 2)``, which falls as
+     ``u`` grows, so any upper bound on ``u`` may stand in for it. The valley lies in
+     cell ``i``: the fall into it passes the cell's start and the rise out of it its end,
+     and ``w`` is at least ``u`` on both stretches, so ``u <= lo_i`` (``lo`` is the
+     envelope at one of the cell's ends, step 1), ``u <= lo_k`` for every cell ``k``
+     strictly inside the rise and ``u <= hi_c``.
 
    Falling stretches alike, mirrored.
 4. *The programme.* Any motion is a chain of stretches, valley (rest at the start) to
@@ -68,6 +73,31 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    path: a cut at that point already splits them at no more cost (the pieces' ``R`` add
    to at most the whole's, and the whole's cost is at least its ``R``).
 
+4b. *Turn cells.* The time spent in a turn cell ``k`` is split between the stretch into
+   the turn (``tau_out``) and the one out of it (``tau_in``), ``tau_out + tau_in >= E_k =
+   ds_k / hi_k``. A stretch ``s`` lasts ``T_s >= G_s`` (the ``g`` and ``LT`` terms) and
+   ``T_s >= R_s + tau_in + tau_out``. Charge the stretch out of a turn ``ch_s <= (E_k -
+   sigma)^+``, ``sigma = (G - R - ch)^+`` the slack of the stretch into it, and let
+   ``A_s = max(G_s, R_s + ch_s)``. By induction over the stretches,
+   ``sum_{s <= n} T_s >= sum_{s <= n} A_s + (tau_out(n) - sigma_n)^+``: adding ``T_n`` to
+   the hypothesis, ``ch_n <= (tau_out(n-1) - sigma_{n-1})^+ + tau_in(n)`` and
+   ``T_n >= max(G_n, R_n + tau_in(n) + tau_out(n))`` give ``T_n + (tau_out(n-1) -
+   sigma_{n-1})^+ >= max(G_n, R_n + ch_n + tau_out(n)) = A_n + (tau_out(n) -
+   sigma_n)^+``. So ``sum A_s`` bounds the time: a stretch whose bound leaves no slack
+   passes the whole next turn cell on, one with slack absorbs that much of it. The
+   programme keeps the slack in levels (:data:`HUMP_SLACK_LEVELS`, shares of the next
+   turn cell's time), rounded up, which only charges less. A cut piece is ``R`` alone
+   (slack 0); the piece's start, at rest, passes nothing on.
+4c. *Valley speeds.* Each side of a valley bounds its speed ``u`` (step 3) and each uses
+   ``u`` in its ``LT``; the true ``u`` satisfies both. The programme carries ``u`` from
+   the fall to the rise in levels ``(lo_i r^(k+1), lo_i r^k]`` (the last down to 0,
+   :data:`HUMP_SPEED_RATIO`, :data:`HUMP_SPEED_LEVELS`): a valley state per level, a
+   fall or a rise admits a level whose lower end is at or below its own bound and takes
+   ``u = min(lo_i r^k, bound)``. The motion's own levels give a path of the programme,
+   so its shortest path is still at most every motion's time. Where the corner is in
+   the valley's fall, say, the rise then loses the lost time of a dip to the corner's
+   cap, not to the envelope beside it.
+
 5. *Per piece.* At a stop the speed is (within the checker's tolerances) zero and cannot
    fall further, so no phase runs through it: every rest-to-rest piece is such a chain on
    its own, and the programme bounds the time spent between the piece's ends. So does the
@@ -75,10 +105,12 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    pointwise bounds of ``b``, so each holds on its own). The bound is the sum over the
    pieces of the larger of the two.
 
-What it does not know: the acceleration inside a stretch beyond the envelope, and the
-time in the cells left out, which :data:`HUMP_CELL_TIME_REL` keeps to a few per cent of a
-period per turn (:func:`hump_lower_bound` on a flat envelope shows it; the tests measure
-it). Where corners are a period or more apart it therefore adds little to ``acc``.
+What it does not know: the acceleration inside a stretch beyond the envelope, the
+time a phase adds where its lost time and the envelope's overlap, and a quarter of a
+turn cell's time at most per turn (step 4b's rounding; :data:`HUMP_CELL_TIME_REL` keeps a
+cell a few per cent of a period). Measured on single corners (two lines at F1200 on the
+default machine) it comes within 0.7 % of the verified motion; on paths of many short
+segments at low speed (lcnc_sam_tolerance_issue) it is still some 20 % below it.
 
 Units: mm, s, mm/s.
 """
@@ -97,10 +129,13 @@ from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
 
 from ..bounds import speed_envelope_bounds
 from ..grid import Grid
+from ..tolerances import LB_ROUNDOFF_REL
 from .lower import rest_pieces, segment_periods
 
 __all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_REL",
-           "HUMP_MAX_CELLS", "HUMP_MERGE_SHARE", "HUMP_REFINE_MARGIN", "Envelope",
+           "HUMP_MAX_CELLS", "HUMP_MERGE_SHARE", "HUMP_REFINE_MARGIN", "HUMP_SPREAD_REL",
+           "HUMP_SLACK_LEVELS", "HUMP_SPEED_LEVELS", "HUMP_SPEED_RATIO",
+           "HUMP_SPREAD_ROUNDS", "Envelope",
            "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound"]
 
 #: Cells are cut so that each takes at most this fraction of its period at the fastest
@@ -131,12 +166,40 @@ HUMP_MERGE_SHARE = 0.5
 #: weakens the bound.
 HUMP_MAX_CELLS = 20_000
 
+#: Cells whose speed bounds differ by more than this share (``hi > (1 + x) lo``) are cut
+#: further in the programme's last run (:func:`_spread`): near corners the envelope climbs
+#: steeply, and ``ds / hi`` falls short of the time there. 1 % keeps that shortfall at
+#: the level of the bracket's own 2 % while adding cells only near corners and ends
+#: (lcnc_sam_tolerance_issue: 1.98 -> 2.07 s of bound).
+HUMP_SPREAD_REL = 0.01
+
+#: Rounds of four-way cuts of :func:`_spread` (each quarters the spread of a cell on a
+#: tent's straight side).
+HUMP_SPREAD_ROUNDS = 6
+
+#: Levels of the slack a stretch leaves (step 4b), in shares of the next turn cell's
+#: time: a stretch whose bound is set by ``g`` or the lost time with room to spare may
+#: absorb that much of the turn cell, and the next stretch is charged the rest, rounded
+#: down to a level. Quarters: at most a quarter of a cell per turn goes uncharged.
+HUMP_SLACK_LEVELS = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+
+#: Valley speed levels (step 4c): a valley's speed is carried from the fall into it to
+#: the rise out of it in levels of ``lo ratio^k`` of the valley cell's ``lo``, so that
+#: both stretches' lost time use the lower of their two bounds on it. Ratio 0.7 over 13
+#: levels reaches 1.4 % of ``lo``; a level's width costs at most ``(1 - ratio) u g / (2 V)``
+#: of lost time per stretch.
+HUMP_SPEED_RATIO = 0.7
+
+#: See HUMP_SPEED_RATIO.
+HUMP_SPEED_LEVELS = 13
+
 #: A stretch may be cut into pieces of at least this many periods (step 4). A cut forgets
-#: that the speed before it stays below the speeds after it, so a chain of pieces could
-#: dip where a motion would need a whole hump; this many periods between such dips keeps
-#: that slack small against the two periods a hump costs, while edges need only reach
-#: ``HUMP_CHAIN_PERIODS + 1`` periods (the work grows with the reach).
-HUMP_CHAIN_PERIODS = 8.0
+#: that the speed before it stays below the speeds after it, and a cut stretch carries
+#: no lost time (``LT``, up to half a period per stretch: the whole of the rule's cost
+#: at an isolated corner); edges need only reach ``HUMP_CHAIN_PERIODS + 1`` periods (the
+#: work grows with the reach). 24 periods keep whole the stretches of corners a second
+#: apart at 20 Hz (lcnc_corner_decel: 8 periods gave 6.99 s of bound, 24 give 7.10 s).
+HUMP_CHAIN_PERIODS = 24.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -257,6 +320,25 @@ def _envelope(t: _Tents, cell_time_rel: float, max_cells: int) -> Envelope:
     return _split(t, whole.interval, whole.s[:-1], whole.s[1:], pieces)
 
 
+def _spread(t: _Tents, env: Envelope, spread: float, max_cells: int) -> Envelope:
+    """``env`` with every cell whose speed bounds differ by more than ``spread``
+    (``hi > (1 + spread) lo``) cut into four, repeatedly, up to ``max_cells`` cells.
+
+    Near a corner the envelope climbs from the corner's cap within a fraction of a
+    millimetre, and a cell's time ``ds / hi`` there is far below the time at the speeds
+    the cell actually allows; these cuts make it the envelope's own time to within
+    ``spread``. Valid for any cut (step 1 holds on every cell).
+    """
+    for _ in range(HUMP_SPREAD_ROUNDS):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            wide = env.hi > (1.0 + spread) * env.lo
+        n_new = env.hi.size + 3 * int(np.count_nonzero(wide))
+        if not np.any(wide) or n_new > max_cells or env.interval is None:
+            break
+        env = _split(t, env.interval, env.s[:-1], env.s[1:], np.where(wide, 4, 1))
+    return env
+
+
 def _merged(env: Envelope, cell_time_rel: float) -> Envelope:
     """Runs of cells shorter together than ``HUMP_MERGE_SHARE * cell_time_rel`` periods at
     speed ``hi``, each made one cell (short segments make many tiny cells, and the programme's work grows
@@ -340,6 +422,8 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     g = env.period
     with np.errstate(divide="ignore"):
         fast = ds / hi
+    # a turn cell's own time (step 4b): at least its length at the cell's top speed
+    turn_t = fast
     # reach of the edges: from every start, chain + 1 of the largest period at speed hi
     cum = np.concatenate(([0.0], np.cumsum(fast)))
     need = (chain + 1.0) * float(np.max(g))
@@ -347,72 +431,19 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     # edges reach c start at first[c]
     last = np.minimum(np.searchsorted(cum, cum[:-1] + need, side="left") + 2, N - 1)
     first = np.searchsorted(last, np.arange(N), side="left")
-    inf = math.inf
-    # cost of the best path to each state, and its predecessor (kind, cell) for the way
-    # back: rows valley, peak, rising cut, falling cut
-    cost = np.full((4, N), inf)
-    pred_kind = np.full((4, N), -1, np.int8)
-    pred_cell = np.full((4, N), -1, np.int64)
-    V, P, U, Dn = cost
-    V[0] = 0.0
-
-    def pull(row: int, c: int, a: np.ndarray, b: np.ndarray, i: np.ndarray) -> None:
-        """cost[row, c] = min over i of (a, from a valley; b, from a rising cut)."""
-        ka, kb = int(np.argmin(a)), int(np.argmin(b))
-        if a[ka] <= b[kb]:
-            cost[row, c], pred_kind[row, c], pred_cell[row, c] = a[ka], _VALLEY, i[ka]
-        else:
-            cost[row, c], pred_kind[row, c], pred_cell[row, c] = b[kb], _RISE_CUT, i[kb]
-
-    def push(row: int, tail: slice, new: np.ndarray, kind: int, c: int) -> None:
-        """cost[row, tail] = min(itself, new), remembering (kind, c) where it improves."""
-        better = new < cost[row, tail]
-        cost[row, tail] = np.where(better, new, cost[row, tail])
-        pred_kind[row, tail] = np.where(better, kind, pred_kind[row, tail])
-        pred_cell[row, tail] = np.where(better, c, pred_cell[row, tail])
-
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for c in range(N):
-            if c > 0:
-                # rises ending in cell c, pulled from valleys and cuts in cells i = c-1 .. first[c];
-                # a valley's cell is left out, a cut (at its cell's start) leaves nothing out
-                lo_i = min(int(first[c]), c - 1)
-                kk = np.arange(c - 1, lo_i - 1, -1)      # cells c-1 .. lo_i, nearest first
-                suf = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                Rx = _sums(ds[kk], np.minimum(hi[kk], suf))
-                R, Rc = Rx[:-1], Rx[1:]                  # valley i = kk: cells i+1 .. c-1
-                i = kk
-                d = s[c] - s[i + 1]
-                gm = np.minimum(np.minimum.accumulate(g[i]), g[c])
-                full = np.maximum(np.maximum(gm, R), _lost(d, hi[i], hi[c], gm))
-                pull(_PEAK, c, V[i] + full, U[i] + Rc, i)
-                # a cut at the start of cell c: cells i+1 .. c-1 from a valley, cells
-                # i .. c-1 from a cut, once they hold `chain` periods
-                pull(_RISE_CUT, c, np.where(R >= chain * gm, V[i] + R, inf),
-                     np.where(Rc >= chain * gm, U[i] + Rc, inf), i)
-            if c + 1 < N and (P[c] < inf or Dn[c] < inf):
-                # falls starting in cell c, pushed to valleys and cuts j = c+1 .. last[c]
-                hi_j = max(int(last[c]), c + 1)
-                j = np.arange(c + 1, hi_j + 1)
-                tail = slice(c + 1, hi_j + 1)
-                if P[c] < inf:
-                    kk = np.arange(c + 1, hi_j)          # peak in cell c: cells c+1 .. j-1
-                    pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                    F = _sums(ds[kk], np.minimum(hi[kk], pre))
-                    d = s[j] - s[c + 1]
-                    gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
-                    full = np.maximum(np.maximum(gm, F), _lost(d, hi[j], hi[c], gm))
-                    push(_VALLEY, tail, P[c] + full, _PEAK, c)
-                    # a cut at the start of cell j: cells c+1 .. j-1
-                    push(_FALL_CUT, tail, np.where(F >= chain * gm, P[c] + F, inf), _PEAK, c)
-                if Dn[c] < inf:
-                    kk = np.arange(c, hi_j)              # cut at cell c's start: c .. j-1
-                    pre = np.minimum.accumulate(np.concatenate(([hi[c]], lo[kk])))[:-1]
-                    F = _sums(ds[kk], np.minimum(hi[kk], pre))[1:]
-                    gm = np.minimum(np.minimum.accumulate(g[j]), g[c])
-                    push(_VALLEY, tail, Dn[c] + F, _FALL_CUT, c)
-                    push(_FALL_CUT, tail, np.where(F >= chain * gm, Dn[c] + F, inf), _FALL_CUT, c)
-    T = float(V[N - 1])
+    # the cost of the best path to each state, turns (valley, peak) per slack level of
+    # step 4b and cuts (which leave no cell out), and for the way back each state's
+    # predecessor (kind, level, cell): compiled (optimal.freq.humps_kernel), the states
+    # and costs of steps 3, 4 and 4b as plain loops
+    from .humps_kernel import programme, unpack
+    valley, _, _, pv, pp, pc = programme(np.ascontiguousarray(s, np.float64), hi, lo,
+                                   np.ascontiguousarray(g, np.float64), turn_t,
+                                   first.astype(np.int64), last.astype(np.int64),
+                                   float(chain), HUMP_SLACK_LEVELS, HUMP_SPEED_RATIO,
+                                   HUMP_SPEED_LEVELS)
+    last_v = valley[:, :, N - 1]
+    q, k = np.unravel_index(int(np.argmin(last_v)), last_v.shape)
+    T = float(last_v[q, k])
     if not math.isfinite(T):
         return HumpPlan(T, none, none)
     valleys, peaks = [], []
@@ -422,7 +453,9 @@ def hump_plan(env: Envelope, drift: float = 0.0,
             valleys.append(cell)
         elif kind == _PEAK:
             peaks.append(cell)
-        kind, cell = int(pred_kind[kind, cell]), int(pred_cell[kind, cell])
+        x = (pv[q, k, cell] if kind == _VALLEY else pp[q, cell] if kind == _PEAK
+             else pc[kind - _RISE_CUT, cell])
+        kind, q, k, cell = unpack(x, HUMP_SLACK_LEVELS.size, HUMP_SPEED_LEVELS)
     return HumpPlan(T, np.array(valleys[::-1], np.int64), np.array(peaks[::-1], np.int64))
 
 
@@ -472,9 +505,10 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
         A verified upper bound of the minimum motion time (holds excluded), s.
     beat : float
         The best lower bound known so far, s. The programme runs on coarse cells
-        (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones only on the pieces
-        where that comes within :data:`HUMP_REFINE_MARGIN` of their ``acc`` time, and only
-        while the sum comes that near ``beat``. Effort only: every run gives a bound.
+        (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones, cut further where the
+        envelope climbs (:data:`HUMP_SPREAD_REL`), only on the pieces where that comes
+        within :data:`HUMP_REFINE_MARGIN` of their ``acc`` time, and only while the sum
+        comes that near ``beat``. Effort only: every run gives a bound.
     segment_floor : numpy.ndarray, shape (m,), optional
         Certified time per segment of the base bound set
         (:attr:`optimal.solution.OptimalSolution.segment_lower_bounds_s`, the ``jerk``
@@ -500,8 +534,11 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     acc = np.add.reduceat(seg_t, pieces[:, 0]) if pieces.size else np.zeros(0)
     dp = np.zeros(pieces.shape[0])
     todo = np.ones(pieces.shape[0], bool)
-    for rel in (HUMP_COARSE_CELL_TIME_REL, HUMP_CELL_TIME_REL):
+    runs = ((HUMP_COARSE_CELL_TIME_REL, False), (HUMP_CELL_TIME_REL, True))
+    for rel, spread in runs:
         env = _envelope(t, rel, HUMP_MAX_CELLS)
+        if spread:
+            env = _spread(t, env, HUMP_SPREAD_REL, HUMP_MAX_CELLS)
         # cells of each piece: those of its intervals (cells never straddle intervals)
         lo = np.searchsorted(env.interval, ends[:, 0], side="left")
         hi = np.searchsorted(env.interval, ends[:, 1], side="left")
@@ -509,7 +546,8 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
             a, b = lo[k], hi[k]
             sub = _merged(Envelope(s=env.s[a:b + 1], hi=env.hi[a:b], lo=env.lo[a:b],
                                    period=env.period[a:b], accel=env.accel), rel)
-            x = hump_lower_bound(sub, drift)
+            # less the round-off of the programme's sums (as the relaxation's own times)
+            x = hump_lower_bound(sub, drift) * (1.0 - LB_ROUNDOFF_REL)
             if math.isfinite(x):              # no path cannot happen with the cuts
                 dp[k] = max(dp[k], x)
         T = float(np.sum(np.maximum(acc, dp)))

@@ -39,10 +39,19 @@ that hole without touching the profiles the rule is meant for:
   ``L/v + 1/f`` exact and what the lower bound of :mod:`optimal.freq.lower` uses.
 
 What it still accepts: a speed change concentrated in the *middle* of a long phase whose
-ends creep (the centroid stays central). Such a phase loses exactly as much time as the
-linear ramp of its effective duration, so no motion gains time by it and the bounds of
-every bound set stay what they claim; but the rule is a rule on time, not a guarantee of a
-smooth acceleration spectrum.
+ends creep (the centroid stays central), in the limit a jump with ``1/(2f)`` of creep on
+either side. Such a phase loses exactly as much time as the linear ramp of its effective
+duration, and the bounds of every bound set hold for it (they are proven for the rule as
+written). But where speed caps change inside the phase it can be *faster* than any ramp:
+it holds a corner's low speed up to the corner and jumps right after it. On the tail of
+lcnc_sam_tolerance_issue (corners 0.1-0.4 mm apart, caps of 1-8 mm/s, 15 Hz) an
+exploratory lattice search found such jump motions about 9 % faster than the best with
+linear ramps of ``1/f`` (1.25 s against 1.37 s). So on paths like that the optimum under
+this rule is a motion no adaptation produces, and the oracle's verified motions, built
+from ramps, stay above it; the rule is a rule on time, not a guarantee of a smooth
+acceleration spectrum. A rule that also bounds the acceleration within a phase by its
+change (``|s''| <= 2 f dv``, which linear ramps and S-curves of ``1/f`` meet) would close
+this; it is not adopted (issue 12 defines the rule by the phases' durations).
 
 Units: s, mm, Hz. numpy only.
 """
