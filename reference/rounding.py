@@ -66,8 +66,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
    and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
    TRUE skips it, G643 and G644 never make it); every mode but RND/RNDM rounds only
    when the rounding is estimated to pass the corner in less time than G64
-   (:func:`corner_time_loss`: ramps on each line to its own programmed speed, BRISK or
-   jerk-limited, a stop costing its ramps), with ``v_round``
+   (:func:`corner_time_loss`: ramps on each line to the speed it runs at, its
+   programmed speed and one IPO cycle per block (:func:`_line_speeds`), BRISK or
+   jerk-limited, a stop costing its ramps; the part a window leaves of a block it cuts
+   is counted with the rounding where its own IPO cycle caps it), with ``v_round``
    (:func:`_rounding_speed`) = min of the centripetal limit at the largest curvature,
    the one-IPO-cycle limit per inserted block (5.3: "about ADIS/T_ipo"), under SOFT the
    in-rounding jerk limit and, on the arc only, the curvature-jump limit of the shared
@@ -350,24 +352,34 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         soft = accel_id[ka[o]] == soft_id
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
         a1, a2 = np.abs(t1[o]), np.abs(t2[o])
-        v_in, v_out = _programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o])
+        # the rounding runs at most at the programmed speed; beside it each line at
+        # most at its own one-IPO-cycle cap too (:func:`_line_speeds`)
+        v_prog = np.minimum(*_programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o]))
+        v_in, v_out = _line_speeds(path, lim, a[o], b[o], t1[o], t2[o],
+                                   machine.limits.t_ipo_s)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / a1)
             acc_out = row_min(lim.a_max[None, :] / a2)
             j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
             j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
-        v_prog = np.minimum(v_in, v_out)
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = _is_in(mode_id[o], names, _OVERLOAD_CHECKED) & \
             (not ch.ignore_ovl_factor_for_adis)
         radius_mode = _is_in(mode_id[o], names, _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
-        sub[o] = ovl & (v64[o] >= v_prog)
+        sub[o] = ovl & (v64[o] >= np.minimum(v_in, v_out))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         sub[:] = False
+        # what the window leaves of the blocks it cuts (the corner's own two, or the
+        # first and last block it touches across short blocks)
+        sb = path.s_breaks
+        s_c = sb[a[o] + 1]
+        left_in = (s_c - d[o]) - sb[first[o]]
+        left_out = sb[last[o] + 1] - (s_c + d[o])
         sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
-                                    shape.length[o], d[o])
+                                    shape.length[o], d[o], None, left_in, left_out,
+                                    machine.limits.t_ipo_s)
                    < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
                                       0.0, 0.0)
                    ) & ~radius_mode
@@ -521,6 +533,31 @@ def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray
         v_in = np.minimum(path.feed[a], row_min(lim.v_max[None, :] / np.abs(t1)))
         v_out = np.minimum(path.feed[b], row_min(lim.v_max[None, :] / np.abs(t2)))
     return v_in, v_out
+
+
+def _line_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
+                 t1: np.ndarray, t2: np.ndarray, t_ipo: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Speed the segments before and after corners can run at beside the corner, mm/s,
+    shape (k,) each: the programmed speed (:func:`_programmed_speeds`) and at most one
+    segment per IPO cycle, ``L / T_ipo`` (5.3: "every block ... needs at least one
+    interpolation point"; the heuristic caps every segment so,
+    :func:`reference.planner.limit_curves.segment_limits`).
+
+    The decision's estimate (:func:`corner_time_loss`) ramps each side between the
+    corner speed and this speed and counts the length a rounding replaces at it. With
+    the programmed speed alone, a corner between blocks shorter than ``v T_ipo`` (CAM
+    chains of short blocks; ``lcnc_short_segments_0.001.ngc``: 0.0254 mm blocks, whose
+    cap at 1 ms is 25.4 mm/s, not the 203 mm/s of the axis velocity) was estimated with
+    ramps from a speed the lines never reach and with the replaced stretch passed at it:
+    on the LinuxCNC machine 0.4 ms slower per corner than G64, where the plan is 1.1 ms
+    faster. The overload-factor check compares with the same speed: G64 passes a corner
+    "without a reduction" (4.3) where its corner speed is at least what the blocks run
+    at.
+    """
+    v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
+    return (np.minimum(v_in, path.length[a] / t_ipo),
+            np.minimum(v_out, path.length[b] / t_ipo))
 
 
 def _plane_weights(t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -733,29 +770,44 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
                      a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
                      j_out: np.ndarray, inserted: np.ndarray | float,
                      replaced: np.ndarray | float,
-                     replaced_out: np.ndarray | float | None = None) -> np.ndarray:
+                     replaced_out: np.ndarray | float | None = None,
+                     left_in: np.ndarray | None = None, left_out: np.ndarray | None = None,
+                     t_ipo: float = 0.0) -> np.ndarray:
     """Time a corner passed at ``v_corner`` costs against passing it at the programmed
     speeds, s: the decision's estimate of "rounding would slow the program down"
     (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
     the heuristic then plans whichever contour results exactly.
 
-    Each side ``i`` (the line before, with programmed speed ``v_in``, and the one after,
-    ``v_out``) ramps between the corner speed ``v = min(v_corner, v_in, v_out)`` and its
-    programmed speed ``v_i``: the ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
+    Each side ``i`` (the line before, with speed ``v_in``, and the one after,
+    ``v_out``) ramps between the corner speed ``v`` and its own speed ``v_i``: ``v =
+    min(v_corner, v_in, v_out)`` at a G64 corner (one point), ``min(v_corner, v_i)``
+    beside a rounding (which may be faster than a side that its IPO cycle caps: it
+    replaces such blocks by one of its own). The ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
     a_i / j_i`` (SOFT, where it reaches ``a_i``: ``dv_i >= a_i^2 / j_i``) or ``2 sqrt(dv_i
     / j_i)``, and is symmetric in time, so it covers ``(v + v_i) T_i / 2`` and costs
     ``T_i dv_i / (2 v_i)`` more than that distance at ``v_i``. A rounding of length ``l``
-    adds ``l / v`` (it is passed at about ``v``: a SOFT profile crosses its ends at zero
-    path acceleration) and removes ``replaced`` of each line, which would have been
+    adds ``l / v_x`` (it is passed at about its own speed: a SOFT profile crosses its
+    ends at zero path acceleration; ``v_x = min(v_corner, sqrt(v^2 + a l))``, what a
+    BRISK ramp from the slower side reaches by its middle) and removes ``replaced`` of each line, which would have been
     passed at ``v_i``. Per side because the two lines may have other programmed speeds
     (a G0 into a G1 at a low feed: the rounding runs at the lower, the replaced stretch
     of the G0 at rapid speed).
 
+    The part of a shortened block left beside the rounding (``left_in``, ``left_out``)
+    is still one block and needs one IPO cycle (5.3): its cap ``r / T_ipo`` may bind
+    where the block itself did not (a 0.0254 mm block cut to half, at 4 ms: 3.2 mm/s,
+    below a rounding passed at 4.4 mm/s). Where that cap is below the side's speed and
+    below the speed a ramp from the rounding reaches at the far end of the piece
+    (``sqrt(v^2 + 2 a_i r)``, the BRISK ramp: under SOFT the ramp reaches less, so the
+    test errs toward the cap binding), the piece is counted with the rounding: passed at
+    ``v = min(v_corner, r / T_ipo)``, its length added to ``l`` and to the side's
+    ``replaced``.
+
     Parameters
     ----------
     v_in, v_out : numpy.ndarray, shape (k,)
-        Programmed path speed of the line before and after (feed, axis velocities),
-        mm/s.
+        Speed of the line before and after (programmed: feed, axis velocities; and one
+        IPO cycle per block), mm/s.
     v_corner : numpy.ndarray, shape (k,)
         Speed at the corner (G64: the corner rule; rounding: the rounding's speed), mm/s.
     a_in, a_out : numpy.ndarray, shape (k,)
@@ -770,27 +822,55 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
         Length cut from the segment after, where it differs from ``replaced`` (then cut
         from the segment before only): G645's tangential transitions replace more of
         the line than of the arc.
+    left_in, left_out : numpy.ndarray, shape (k,), optional
+        Length left of the shortened block before and after the rounding, mm (none
+        given: not counted).
+    t_ipo : float
+        IPO cycle, s (used with ``left_in``, ``left_out``).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
         s; ``inf`` for a rounding that would be passed at no speed.
     """
-    v = np.minimum(v_corner, np.minimum(v_in, v_out))
     inserted = np.asarray(inserted, dtype=np.float64)
-    total = np.zeros(np.shape(v))
+    cut_in = np.asarray(replaced, dtype=np.float64)
+    cut_out = cut_in if replaced_out is None else np.asarray(replaced_out, dtype=np.float64)
+    # the speed each side's ramp ends at: a G64 corner is one point, passed at most at
+    # the slower side's speed; a rounding may be faster than a side capped by its IPO
+    # cycle (it replaces such blocks by one block of its own, 5.3), so each side ramps
+    # to the rounding's speed or its own, whichever is lower
+    point = np.minimum(v_corner, np.minimum(v_in, v_out))
+    curve = inserted > 0
+    v_s = [np.where(curve, np.minimum(v_corner, v_p), point) for v_p in (v_in, v_out)]
+    left = [np.zeros(np.shape(point)), np.zeros(np.shape(point))]
+    if left_in is not None and t_ipo > 0:
+        for i, (r, v_p, a) in enumerate(((left_in, v_in, a_in), (left_out, v_out, a_out))):
+            with np.errstate(invalid="ignore"):
+                cap = r / t_ipo
+                binds = ((r > MIN_SEGMENT_LENGTH_MM) & (cap < v_p)
+                         & (cap < np.sqrt(v_s[i] * v_s[i] + 2.0 * a * r)))
+            left[i] = np.where(binds, r, 0.0)
+            v_s[i] = np.where(binds, np.minimum(v_s[i], cap), v_s[i])
+        cut_in, cut_out = cut_in + left[0], cut_out + left[1]
+    # the rounding itself: at its own speed, as far as a ramp from the slower side
+    # reaches by its middle (BRISK)
+    v_lo = np.minimum(v_s[0], v_s[1])
+    v_x = np.minimum(v_corner, np.sqrt(v_lo * v_lo + np.minimum(a_in, a_out) * inserted))
+    total = np.zeros(np.shape(point))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        cut_out = replaced if replaced_out is None else replaced_out
-        for v_p, a, j, cut in ((v_in, a_in, j_in, replaced), (v_out, a_out, j_out, cut_out)):
+        for v_p, v, a, j, cut, r in ((v_in, v_s[0], a_in, j_in, cut_in, left[0]),
+                                     (v_out, v_s[1], a_out, j_out, cut_out, left[1])):
             dv = np.maximum(v_p - v, 0.0)
             reach = dv * j >= a * a
             T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
             T = np.where(dv > 0, T, 0.0)
             total = total + np.where(np.isfinite(v_p) & (v_p > 0),
-                                     T * dv / (2.0 * v_p) - np.asarray(cut) / v_p, 0.0)
-        total = total + np.where(inserted > 0, inserted / v, 0.0)
+                                     T * dv / (2.0 * v_p) - cut / v_p, 0.0)
+            total = total + np.where(r > 0, r / v, 0.0)
+        total = total + np.where(curve, inserted / v_x, 0.0)
     # a stop costs its ramps; only a rounding passed at no speed would never end
-    return np.where((v > 0) | ~(inserted > 0), total, np.inf)
+    return np.where((v_x > 0) | ~curve, total, np.inf)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -285,6 +285,10 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             v_axis = np.minimum(row_min(lim.v_max[None, :] / np.abs(t1[o2])),
                                 row_min(lim.v_max[None, :] / np.abs(t2[o2])))
             v_prog = np.minimum(np.minimum(path.feed[a[o2]], path.feed[b[o2]]), v_axis)
+            # at most one segment per IPO cycle on either side (5.3), as the heuristic
+            # caps them: the speed each side runs at beside the corner
+            # (reference.rounding._line_speeds)
+            ipo_in, ipo_out = path.length[a[o2]] / t_ipo, path.length[b[o2]] / t_ipo
             v_c = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
                                                    * ro[:, None] / wr), np.inf))
             v_j = row_min(np.where(moving, np.cbrt(jerk_share * lim.j_max[None, :]
@@ -320,7 +324,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         sub = np.zeros(k, bool)
         ovl = np.isin(mode[o2], ("G641", "G642", "G645")) & (
             not machine.channel.ignore_ovl_factor_for_adis)
-        sub[o2] = ovl & (v_g64[o2] >= v_prog)
+        sub[o2] = ovl & (v_g64[o2] >= np.minimum(v_prog, np.minimum(ipo_in, ipo_out)))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         # the time estimate of the line-line corners, each side ramping to its own
         # speed (an arc side to its own limit), the fillet passed at v_round
@@ -328,8 +332,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         v_line = v_prog
         v_first = np.minimum(v_line, v_arc_first)
         v_second = np.minimum(v_line, v_arc)
-        v_in = np.where(forward, v_first, v_second)
-        v_out = np.where(forward, v_second, v_first)
+        v_in = np.minimum(np.where(forward, v_first, v_second), ipo_in)
+        v_out = np.minimum(np.where(forward, v_second, v_first), ipo_out)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / np.abs(t1[o2]))
             acc_out = row_min(lim.a_max[None, :] / np.abs(t2[o2]))
@@ -339,8 +343,11 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         cut_out = np.where(forward, f.trim_second, f.trim_first)
         radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
         sub[:] = False
+        # what the fillet leaves of the two elements (one IPO cycle each, 5.3)
+        left_in = path.length[a[o2]] - cut_in
+        left_out = path.length[b[o2]] - cut_out
         sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
-                              cut_in, cut_out)
+                              cut_in, cut_out, left_in, left_out, t_ipo)
                     < time_loss(v_in, v_out, v_g64[o2], acc_in, acc_out, j_in, j_out,
                                 0.0, 0.0)) & ~radius_mode
         decide(sub, "rounding would be slower than G64")
