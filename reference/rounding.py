@@ -62,9 +62,13 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      straight line, ``L1``, ``L2`` then being those straight chains
      (:func:`_across_blocks`; the blocks it covers whole are no longer interpolated);
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
-   junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
-   and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
-   TRUE skips it, G643 and G644 never make it); every mode but RND/RNDM rounds only
+   junction rule); G641/G642/G645 round only when ``v_g64`` is below the speed of the
+   lines (the overload-factor check; G643 and G644 never make it); G641/G642/G645 with
+   MD20490 IGNORE_OVL_FACTOR_FOR_ADIS = TRUE and G643 "always round" (4.3, 5.5, 5.8,
+   :func:`reference.core.rounding.always_rounds`): neither check is made, only the
+   documented short-block case keeps an inserted block out ("between two very short
+   blocks", 5.2 group 2; :func:`reference.core.rounding.very_short_blocks`; G643
+   inserts none); every other mode but RND/RNDM rounds only
    when the rounding is estimated to pass the corner in less time than G64
    (:func:`corner_time_loss`: ramps on each line to the speed it runs at, its
    programmed speed and one IPO cycle per block (:func:`_line_speeds`), BRISK or
@@ -101,8 +105,10 @@ import numpy as np
 from .core.arrays import row_dots, row_max, row_min, row_norms
 from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_pieces
 from .core.limits import AxisArrays
-from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
-                            deflection_angle, distance_for_deviation, fillet_pieces)
+from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
+                            RoundingTable, always_rounds, axis_deviation_limit,
+                            deflection_angle, distance_for_deviation, fillet_pieces,
+                            very_short_blocks)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
@@ -113,7 +119,8 @@ from .rounding_tangential import tangential_transitions
 #: Group-10 modes that round corners.
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
 #: Modes that round only where G64 would have to reduce the speed (4.3).
-_OVERLOAD_CHECKED = ("G641", "G642", "G645")
+_OVERLOAD_CHECKED = OVERLOAD_CHECKED_MODES
+_INTERNAL = INTERNAL_MODES
 
 #: Modes whose tolerance-based rounding window may reach across several short blocks
 #: (:func:`_across_blocks`). G641 and the ADIS digit (4) are limited by the block lengths
@@ -366,10 +373,20 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = _is_in(mode_id[o], names, _OVERLOAD_CHECKED) & \
             (not ch.ignore_ovl_factor_for_adis)
+        always = always_rounds(np.array(names, dtype=_MODE_DTYPE)[mode_id[o]],
+                               ch.ignore_ovl_factor_for_adis)
         radius_mode = _is_in(mode_id[o], names, _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
         sub[o] = ovl & (v64[o] >= np.minimum(v_in, v_out))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
+        # where the overload check is waived, the documented short-block case still
+        # holds: an inserted block between two blocks of one IPO cycle each (G643
+        # inserts none, a window across short blocks replaces several by one)
+        sub[:] = False
+        sub[o] = always & ~_is_in(mode_id[o], names, _INTERNAL) & (first[o] == a[o]) & (
+            last[o] == b[o]) & very_short_blocks(path.length[a[o]], path.length[b[o]],
+                                                  v_prog, machine.limits.t_ipo_s)
+        decide(sub, "rounding would slow the program down (between two very short blocks)")
         sub[:] = False
         # what the window leaves of the blocks it cuts (the corner's own two, or the
         # first and last block it touches across short blocks)
@@ -382,7 +399,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
                                     machine.limits.t_ipo_s)
                    < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
                                       0.0, 0.0)
-                   ) & ~radius_mode
+                   ) & ~radius_mode & ~always
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
     ins = reason == 0                     # corners rounded (transitions are still pending)

@@ -63,11 +63,13 @@ from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
-from .core.rounding import (REASON_CODE, axis_deviation_limit, circle_circle_fillet,
+from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
+                            always_rounds, axis_deviation_limit, circle_circle_fillet,
                             circle_fillet_deviation, circle_fillet_radius_for_deviation,
                             circle_fillet_radius_within, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_deviation,
-                            fillet_radius_for_line_trim, line_circle_fillet)
+                            fillet_radius_for_line_trim, line_circle_fillet,
+                            very_short_blocks)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM
 from .machine import Machine
@@ -322,10 +324,17 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             vr = np.where(soft, np.minimum(vr, v_k), vr)
         v_round[o2] = vr
         sub = np.zeros(k, bool)
-        ovl = np.isin(mode[o2], ("G641", "G642", "G645")) & (
-            not machine.channel.ignore_ovl_factor_for_adis)
+        ignore = machine.channel.ignore_ovl_factor_for_adis
+        ovl = np.isin(mode[o2], OVERLOAD_CHECKED_MODES) & (not ignore)
         sub[o2] = ovl & (v_g64[o2] >= np.minimum(v_prog, np.minimum(ipo_in, ipo_out)))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
+        # G643, and G641/G642/G645 with MD20490 = TRUE, round whatever G64 costs
+        # (always_rounds), but not with an inserted block between two very short ones
+        always = always_rounds(mode[o2], ignore)
+        sub[:] = False
+        sub[o2] = always & ~np.isin(mode[o2], INTERNAL_MODES) & very_short_blocks(
+            path.length[a[o2]], path.length[b[o2]], v_prog, t_ipo)
+        decide(sub, "rounding would slow the program down (between two very short blocks)")
         # the time estimate of the line-line corners, each side ramping to its own
         # speed (an arc side to its own limit), the fillet passed at v_round
         forward = line_arc[o2] | aa
@@ -349,7 +358,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
                               cut_in, cut_out, left_in, left_out, t_ipo)
                     < time_loss(v_in, v_out, v_g64[o2], acc_in, acc_out, j_in, j_out,
-                                0.0, 0.0)) & ~radius_mode
+                                0.0, 0.0)) & ~radius_mode & ~always
         decide(sub, "rounding would be slower than G64")
 
     reason[reason < 0] = REASON_CODE["rounded"]

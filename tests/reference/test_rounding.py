@@ -610,11 +610,72 @@ def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
     prog = parse_text(square("G642"))
     path = build_path(prog, mach)
     assert reasons(path) == ["rounding would be slower than G64"] * 3
-    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
-    assert not forced.rounding.inserted.any()          # the time check is not the ovl one
     # the same roundings, inserted (as on a machine where G64 must stop) and planned on
     # this machine: slower than the sharp corners
     t_sharp = plan(prog, mach, path=path).time_s
     rounded_path = build_path(prog, machine(ovl=1.0))
     assert rounded_path.rounding.inserted.all()
     assert plan(prog, mach, path=rounded_path).time_s > t_sharp
+
+
+@pytest.mark.parametrize("mode", ["G641 ADIS=0.05", "G642", "G645"])
+def test_ignore_ovl_factor_for_adis_rounds_where_rounding_loses_time(mode):
+    """spec 4.3: "A transition is rounded only if it cannot be passed at G64 speed
+    without a reduction. Rounding would otherwise lengthen the program. ... This check
+    applies to G641/G642 only. G643 ignores the overload factor. Setting MD20490
+    IGNORE_OVL_FACTOR_FOR_ADIS = TRUE makes G641/G642 behave like G643 here (always
+    round)"; 5.8: "Insert the rounding only if v_corner_G64 < min(F, v_round), unless
+    MD20490 = TRUE or the mode is G643" (G645 "at corners rounds like G642", 5.7). The
+    corners of the previous test (not worth rounding on this machine) are rounded with
+    MD20490 = TRUE, and the program is then longer in time, as 4.3 says it would be:
+    the 90 degree arcs deviate by MD33100 per axis (|C - M| = 0.01 sqrt(2)) or, G641,
+    start ADIS = 0.05 mm before the corner."""
+    prog = parse_text(square(mode))
+    sharp = build_path(prog, machine())
+    assert not sharp.rounding.inserted.any()
+    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    assert reasons(forced) == ["rounded"] * 3
+    t = forced.rounding
+    if mode.startswith("G641"):
+        np.testing.assert_allclose(t.distance_mm, 0.05, rtol=1e-12)
+    else:
+        np.testing.assert_allclose(t.deviation_mm, 0.01 * math.sqrt(2), rtol=1e-12)
+    mach = machine(IGNORE_OVL_FACTOR_FOR_ADIS=True)
+    assert plan(prog, mach, path=forced).time_s > plan(prog, mach, path=sharp).time_s
+
+
+def test_g643_rounds_where_rounding_loses_time():
+    """spec 5.5 (G643): "The overload factor is never taken into account"; 5.8: "...
+    unless MD20490 = TRUE or the mode is G643": the corners G642 leaves sharp on this
+    machine (previous tests) are rounded by G643 with the same tolerance (MD33100, the
+    units digit 0: |C - M| = 0.01 sqrt(2) on the 90 degree corners)."""
+    _, _, path = rounded(square("G643"), machine())
+    assert reasons(path) == ["rounded"] * 3
+    np.testing.assert_allclose(path.rounding.deviation_mm, 0.01 * math.sqrt(2), rtol=1e-12)
+
+
+@pytest.mark.parametrize("mode, spanned", [("G641 ADIS=0.5", None), ("G642", 8)])
+def test_ignore_ovl_keeps_no_rounding_block_between_two_very_short_blocks(mode, spanned):
+    """spec 5.2 group 2: "Rounding would slow the program down: between two very short
+    blocks (each block costs at least one IPO cycle, so an extra block could double the
+    time)"; 5.8 "If the blocks are too short (... less than one IPO cycle per block),
+    fall back to G64 [S1]" -- not waived by MD20490, which waives the overload check
+    only. By hand: 0.01 mm blocks at F3000 (50 mm/s) take 0.2 ms, less than one 4 ms
+    IPO cycle, so both blocks beside the corner are very short: G641 (one-block clamp,
+    d = 0.005 mm) keeps the corner sharp and names it. G642's window reaches across
+    the short blocks (d = 0.0341 mm, 8 blocks: spanned ones are not interpolated, one
+    rounding block replaces six), so no block is added and it is rounded."""
+    steps = ("G17 G90 {} F3000\nG1 X0 Y0\n" + "\n".join(
+        [f"X{0.01 * i:.2f}" for i in range(1, 11)] + [f"Y{0.01 * i:.2f}" for i in range(1, 11)])
+        + "\n")
+    _, _, path = rounded(steps.format(mode), machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    t = path.rounding
+    corner = [i for i in range(t.n) if t.reason_text(i) != "tangential transition"]
+    assert len(corner) == 1
+    i = corner[0]
+    assert 0.01 <= 50.0 * 0.004
+    if spanned is None:
+        assert t.reason_text(i) == (
+            "rounding would slow the program down (between two very short blocks)")
+    else:
+        assert t.reason_text(i) == "rounded" and t.blocks_spanned[i] == spanned
