@@ -46,8 +46,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      or the contour within SD42465 SMOOTH_CONTUR_TOL (digit 1, 3); a programmed CTOL
      replaces both for the geometry axes (5.7); digit 4: ``d`` as G641. Both blocks G0:
      tolerances times MD20560 G0_TOLERANCE_FACTOR (5.7);
-   * G644 (thousands digit): 0xxx/4xxx MD33100 per axis, 1xxx/5xxx ADIS/ADISPOS
-     (CTOL ignored, 5.6); 2xxx the rounding lasts one period of the lowest
+   * G644 (thousands digit, 5.6): 4xxx MD33100 per axis and 5xxx ADIS/ADISPOS "fully
+     used"; 0xxx and 1xxx the same as a maximum, "not fully used" where the rounding of
+     3xxx at the path velocity is smaller (``d = min(d_tol, d_3xxx)``, ``min(ADIS,
+     d_3xxx)``; CTOL ignored); 2xxx the rounding lasts one period of the lowest
      LOOKAH_FREQUENCY at the programmed speed, 3xxx the smallest rounding the axes pass
      at the programmed speed (:func:`_dynamic_distance`); other digits named;
    * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
@@ -465,7 +467,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
     (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), ``dyn_radius``
-    and ``dyn_length`` (G644 2xxx/3xxx, :func:`_dynamic_distance`), mm. ``mode``:
+    and ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap,
+    :func:`_dynamic_distance`), mm, ``dyn_cap`` (bool: G644 0xxx/1xxx). ``mode``:
     each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
@@ -483,7 +486,13 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     how[_is_in(mode, names, _RADIUS_MODES)] = RADIUS
     how[_is_in(mode, names, ("G641",))] = ADIS
     dig644 = _digit(sm, 3)
-    how[_is_in(mode, names, ("G644",))] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
+    is644 = _is_in(mode, names, ("G644",))
+    how[is644] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
+    # G644 0xxx/1xxx (spec 5.6): the tolerance or the distance is a maximum that the
+    # rounding "if the dynamics allow" does not fully use: the rounding of 3xxx (the
+    # axes' maximum dynamics at the path velocity) where it is smaller; 4xxx/5xxx use
+    # them fully ("where possible": the block-length clamp)
+    dyn_cap = is644 & (dig644 in (0, 1))
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
         sel = _is_in(mode, names, (md,))
         dig = _digit(sm, place)
@@ -522,16 +531,19 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
     # G644 2xxx (frequency) and 3xxx (maximum dynamics): sized by the path velocity
-    dyn = np.flatnonzero((how == FREQ) | (how == DYN))
+    dyn = np.flatnonzero((how == FREQ) | (how == DYN) | dyn_cap)
     dyn_radius, dyn_length = np.zeros(k), np.zeros(k)
     if dyn.size:
-        d[dyn], dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
+        d_dyn, dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
             path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn], theta[dyn], g2[dyn],
             how[dyn] == FREQ)
+        # 0xxx/1xxx: the smaller of the mode's distance and the dynamic one
+        d[dyn] = np.where(dyn_cap[dyn], np.minimum(d[dyn], d_dyn), d_dyn)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length}
+               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length,
+               "dyn_cap": dyn_cap}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 

@@ -170,7 +170,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         ``dist`` (ADIS/ADISPOS, mm), ``contour`` (contour tolerance, mm, ``inf``: none),
         ``axis_tol`` (per-axis tolerance, shape (k, n), mm, ``inf``: none), ``g0``
         (tolerance factor), ``radius`` (programmed radius, mm), ``dyn_radius``,
-        ``dyn_length`` (G644 2xxx/3xxx: smallest radius and length, mm).
+        ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap: smallest radius
+        and length, mm), ``dyn_cap`` (bool: G644 0xxx/1xxx).
     accel : numpy.ndarray of str, shape (k,)
     centripetal_share, jerk_share : float
         The corner rounding's shares of the axis acceleration and jerk.
@@ -249,7 +250,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
-            targets["dyn_length"][i], t1[i], t2[i])
+            targets["dyn_length"][i], t1[i], t2[i], targets["dyn_cap"][i])
         clamped[i] = ro >= r_cap
         f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
         r[i] = ro
@@ -507,15 +508,16 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                     rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
                     cap_second: np.ndarray, dyn_radius: np.ndarray,
-                    dyn_length: np.ndarray, t1: np.ndarray,
-                    t2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    dyn_length: np.ndarray, t1: np.ndarray, t2: np.ndarray,
+                    dyn_cap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
     dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
     and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
     the tolerance holds at the radius found (True where no tolerance applies).
     ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
-    start)."""
+    start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
+    but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
@@ -561,7 +563,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
     # about like r: the same search, the largest r not longer), at least dyn_radius,
     # then clamped
-    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN))
+    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN) | dyn_cap)
     if dy.size:
         n_geo = len(cols)
         dc = (*(col[dy] for col in cols), dyn_length[dy])
@@ -570,7 +572,8 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
             return _log_length_ratio(x, *c, n_geo=n_geo, fillet=fam.fillet)
 
         r_len = _tolerance_radius(too_long, dc, r_cap[dy])[0]
-        ro[dy] = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
+        r_dyn = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
+        ro[dy] = np.where(dyn_cap[dy], np.fmin(ro[dy], r_dyn), r_dyn)
     ro = np.where(np.isfinite(ro), ro, 0.0)
     return ro, r_cap, tol_ok
 

@@ -436,11 +436,16 @@ def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
 
 
 @pytest.mark.parametrize("mode, smoothing, expect", [
-    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given"
+    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given", "5xxx: like
+    # 1xxx, but the distance is fully used where possible": at F3000 the 3xxx rounding
+    # (d = 1.667 mm, test_g644_digits_0_1_use_the_limit_only_where_the_dynamics_need_it)
+    # is larger than ADIS, so both use it
     ("G644 ADIS=0.4", 1000, ("distance", 0.4)),
     ("G644 ADIS=0.4", 5000, ("distance", 0.4)),
-    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL"
+    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL", "4xxx: like 0xxx, but the
+    # tolerance is fully used": the same reason
     ("G644 ADIS=0.4", 0, ("deviation", 0.01 * math.sqrt(2))),
+    ("G644 ADIS=0.4", 4000, ("deviation", 0.01 * math.sqrt(2))),
     # 6xxx..9xxx are not documented: named
     ("G644 ADIS=0.4", 6000, ("reason", "G644 SMOOTHING_MODE digit not documented")),
     # spec 5.4 table, value 4 [M]: "rounding distance from ADIS/ADISPOS, as for G641"
@@ -461,6 +466,39 @@ def test_smoothing_mode_digits(mode, smoothing, expect):
         np.testing.assert_allclose(t.distance_mm, value, rtol=1e-12)
     else:
         np.testing.assert_allclose(t.deviation_mm, value, rtol=1e-12)
+
+
+@pytest.mark.parametrize("digit, expect_d", [
+    (0, "dyn"), (4, "tol"), (1, "dyn"), (5, "adis"), (3, "dyn")])
+def test_g644_digits_0_1_use_the_limit_only_where_the_dynamics_need_it(digit, expect_d):
+    """spec 5.6 (MD20480 thousands digit): "0xxx: Keep each axis within MD33100
+    COMPRESS_POS_TOL; if the dynamics allow, the tolerance is not fully used"; "4xxx:
+    Like 0xxx, but the tolerance is fully used where possible (the axis then stays
+    below its maximum dynamics)"; "1xxx: The rounding distance (ADIS/ADISPOS) is
+    given"; "5xxx: Like 1xxx, but the distance is fully used where possible"; 5.8:
+    "0xxx: same T_i [as 3xxx, the minimum dynamic time], but reduce v until e_i(T_i) <=
+    tol_i. The tolerance is then usually not fully used ... 4xxx: ... use the full
+    tolerance, with lower acceleration ... 1xxx / 5xxx: as 0xxx/4xxx, but the
+    constraint is the rounding distance". So 0xxx/1xxx round as 3xxx where that is
+    within the tolerance / ADIS, 4xxx/5xxx always use it.
+
+    By hand, BRISK, the 90 degree corners of the square at F60 (v = 1 mm/s, T_ipo =
+    4 ms, A = 2000 mm/s^2): the 3xxx arc is R = max(v^2 / (0.75 A), v T_ipo / theta) =
+    max(6.7e-4, 0.004 / (pi/2)) = 2.546e-3 mm (its one IPO cycle binds), d = R
+    tan(45 deg) = R, deviating by d tan(22.5 deg) = 1.05e-3 mm per corner, below the
+    tolerance (|C - M| = 0.01 sqrt(2), d = 0.0341 mm) and ADIS = 0.4 mm. 0xxx, 1xxx and
+    3xxx give the dynamic rounding, 4xxx the tolerance's, 5xxx ADIS."""
+    text = square("G644 ADIS=0.4").replace("F3000", "F60")
+    _, _, path = rounded(text, machine(1.0, SMOOTHING_MODE=1000 * digit))
+    t = path.rounding
+    assert t.inserted.all()
+    r_dyn = max(1.0 / (0.75 * 2000.0), 0.004 / (math.pi / 2))
+    assert r_dyn == pytest.approx(2.546e-3, rel=1e-3)
+    d = {"dyn": r_dyn, "tol": 0.01 * math.sqrt(2) / math.tan(math.pi / 8),
+         "adis": 0.4}[expect_d]
+    np.testing.assert_allclose(t.distance_mm, d, rtol=1e-12)
+    if expect_d == "dyn":
+        assert (t.deviation_mm < 0.01 * math.sqrt(2) / 10).all()    # not fully used
 
 
 # the hand numbers of the G644 2xxx/3xxx tests: the test machine at F3000 round a 90
