@@ -28,6 +28,7 @@ from reference.core.geometry import KIND_CODES
 from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
+from reference.prepare import build_path
 from reference.rounding import corner_time_loss
 
 MACHINES = ("default", "linuxcnc_xyz")
@@ -335,3 +336,62 @@ def test_units_cut_at_their_cruise_are_planned_as_a_full_replan(monkeypatch):
     for name in ("t", "s", "v", "a", "j"):
         np.testing.assert_array_equal(getattr(r.profile, name), getattr(full.profile, name))
     assert r.time_s == full.time_s
+
+
+def test_small_soft_roundings_cost_time_on_the_default_machine_by_hand(monkeypatch):
+    """Issue 13 item 5: on the default SOFT machine (A = 2 m/s^2, J = 40 m/s^3, overload
+    factor 1.2, T_ipo = 4 ms) the seeded polyline under G641 ADIS=0.2 gets no rounding.
+    Spec 5.8's "G642 is much faster than G64 at sharp corners" is its BRISK example
+    (``v <= sqrt(8 tol A) / |dt_i|``); with this jerk every ramp at F6000 is jerk-limited
+    (A^2 / J = 100 mm/s = the feed), lasting about 2 sqrt(v / J) = 0.1 s whatever the
+    corner speed, so the corner speed buys little and the rounding's crawl costs much.
+
+    By hand, in the spec's own SOFT model (5.8, "each axis changes velocity by dv_i = v
+    |dt_i| with jerk J_i ... T_i = 2 sqrt(dv_i / J_i)", one common T, d = v T / 2), a 90
+    degree corner at F6000 (v_p = 100 mm/s, |dt_i| = 1), the full axis jerk: a ramp by
+    dv costs T dv / (2 v_p) = sqrt(dv^3 / J) / v_p against the programmed speed.
+
+    * G64: v = A (1.2 - 1) T_ipo = 1.6 mm/s, two ramps by 98.4 mm/s: 97.6 ms;
+    * rounding of distance d: entry speed v_r = (d^2 J)^(1/3) (T = 2 sqrt(v_r / J) =
+      2 d / v_r), two ramps by 100 - v_r, the rounding in 2 d / v_r instead of 2 d /
+      v_p: ADIS = 0.2 mm gives v_r = 11.7 mm/s and 113.2 ms, 15.6 ms slower; it pays
+      only from d = 0.80 mm on (ADIS = 2 mm: 64.6 ms).
+
+    The model agrees at ADIS = 0.2 ("rounding would be slower than G64"; its clothoid
+    pair, crossed at its jerk limit, 5.8 mm/s, slower than the axis-wise model's entry
+    speed), and so does its plan of the rounded corner. (The oracle's time-optimal
+    motion on the same paths: G64 0.5827 s, rounded at most 0.5987 s.)"""
+    from reference import rounding as rounding_stage
+    J, v_p = 40000.0, 100.0
+
+    def ramp(dv):
+        return math.sqrt(dv ** 3 / J) / v_p
+
+    def rounded(d):
+        v_r = (d * d * J) ** (1.0 / 3.0)
+        assert 2 * math.sqrt(v_r / J) == pytest.approx(2 * d / v_r, rel=1e-12)
+        return 2 * ramp(v_p - v_r) + 2 * d / v_r - 2 * d / v_p
+
+    g64 = 2 * ramp(v_p - 1.6)
+    assert g64 == pytest.approx(0.0976, abs=1e-4)
+    assert (0.2 * 0.2 * J) ** (1 / 3) == pytest.approx(11.70, abs=0.01)
+    assert rounded(0.2) - g64 == pytest.approx(0.0156, abs=1e-4)
+    assert rounded(2.0) == pytest.approx(0.0646, abs=1e-4)
+    lo, hi = 0.2, 2.0                               # the break-even distance
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if rounded(mid) > g64 else (lo, mid)
+    assert lo == pytest.approx(0.80, abs=0.005)
+    m = load_machine()
+    prog = parse_text("G90 G641 ADIS=0.2 SOFT F6000\nG1 X0 Y0\nG1 X20\nY20\n")
+    path = build_path(prog, m)
+    t = path.rounding
+    assert t.reason_text(0) == "rounding would be slower than G64"
+    assert t.v_g64[0] == pytest.approx(1.6, rel=1e-9)
+    assert t.v_round[0] < (0.2 * 0.2 * J) ** (1 / 3)
+    loss = rounding_stage.corner_time_loss
+    monkeypatch.setattr(rounding_stage, "corner_time_loss", lambda *a, **k: np.where(
+        np.asarray(a[7]) > 0, -np.inf, loss(*a, **k)))
+    forced = build_path(prog, m)
+    assert forced.rounding.inserted.all()
+    assert plan(prog, m, path=forced).time_s > plan(prog, m, path=path).time_s
