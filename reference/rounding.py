@@ -84,7 +84,14 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
-G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
+G643 rounds inside the original blocks (5.5, documented: "no separate rounding block
+is inserted"; :func:`_inside_the_blocks`): the rounding's halves belong to the blocks on
+either side, it has no row and no one-IPO-cycle cap of its own (its block's,
+:func:`reference.core.rows.interpolation_lengths`); its shape is G642's, the per-axis
+windows of the model note (5.5 "Model [I]", 5.8 "per-axis T_i") are not modelled (no
+segment kind of the shared path traces an axis-wise blend; the common shape keeps every
+axis within its tolerance, the documented limit); G644 inserts G642's segments (its
+per-axis T_i not modelled either);
 G645's rounding of tangential transitions is modelled between a line and a circle and
 between two circles in one plane (curving opposite ways, S-bends, or the same way with
 another radius), the rounding of corners next to arcs between a line and a circle and
@@ -434,13 +441,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         v64[arcc], v_round[arcc] = ac.v_g64, ac.v_round
     tangential = np.zeros(a.size, bool)
     tangential[trans] = True
+    # G643 rounds inside the original blocks (5.5): between two blocks the rounding's
+    # halves go to the blocks on either side (:func:`_inside_the_blocks`); a corner
+    # between two segments of one block is inside that block anyway
+    internal = (reason == 0) & _is_in(mode_id, names, _INTERNAL) & (ka != kb) & ~tangential
     table = RoundingTable(
         block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
         distance_mm=dist, length_mm=length, deviation_mm=dev, radius_mm=rad,
         clamped=clamped, v_g64=v64, v_round=v_round, g2=g2_out,
         first_block=np.where(ins, path.block[first], ka).astype(np.int64),
         last_block=np.where(ins, path.block[last], kb).astype(np.int64),
-        tangential=tangential)
+        tangential=tangential, internal=internal)
     if not (reason == 0).any():           # nothing to insert: same path, with the table
         keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
@@ -452,9 +463,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
             done = part.reason == 0
             n_rows = part.n_rows if part is tr else 1
             extras.append((a[at[done]], part.trim_in[done],
-                           part.trim_out[done], part.rows, n_rows))
+                           part.trim_out[done], part.rows, n_rows, internal[at[done]]))
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],
-                     table, extras)
+                     table, extras, internal[ins])
 
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
@@ -1029,6 +1040,55 @@ def _inserted_rows(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.nda
     return out
 
 
+def _inside_the_blocks(path: Path, a: np.ndarray, cnt: np.ndarray, inside: np.ndarray,
+                       rows: dict[str, np.ndarray]
+                       ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Roundings carried out inside the original blocks (G643, spec 5.5: "No separate
+    rounding block is inserted; the rounding is carried out inside the original
+    blocks"): the part up to the middle of the rounding stays with the block before the
+    corner, the rest goes to the block after it, so the block boundary moves from the
+    corner to the rounding's middle (the point nearest to it; both shapes are
+    symmetric). A clothoid pair splits there already (its second piece is attributed to
+    the next block); a tangent arc (at line corners; the fillet at an arc corner) is cut
+    into two arcs of half its length (the second's start angle moved by ``omega L / 2``).
+
+    Parameters
+    ----------
+    a : numpy.ndarray of int, shape (r,)
+        Segment before each insertion, ascending.
+    cnt : numpy.ndarray of int, shape (r,)
+        Rows of each insertion (in ``rows``, in that order).
+    inside : numpy.ndarray of bool, shape (r,)
+        The insertion is block-internal (one arc row or a clothoid pair).
+    rows : dict
+        Packed rows of all insertions.
+
+    Returns
+    -------
+    rows : dict
+        The rows with every block-internal arc in two halves.
+    cnt : numpy.ndarray of int, shape (r,)
+        Rows per insertion.
+    """
+    split = inside & (cnt == 1)
+    reps = np.repeat(np.where(split, 2, 1), cnt)            # per row: 1, or 2 (split)
+    src = np.repeat(np.arange(reps.size), reps)
+    out = {key: val[src] for key, val in rows.items()}
+    cnt = cnt + split
+    last = np.cumsum(cnt) - 1                                # each insertion's last row
+    half = np.zeros(src.size, bool)
+    half[np.repeat(split, cnt)] = True
+    second = np.zeros(src.size, bool)
+    second[last[split]] = True
+    out["length"] = np.where(half, 0.5 * out["length"], out["length"])
+    out["theta0"] = np.where(second, out["theta0"] + out["omega"] * out["length"],
+                             out["theta0"])
+    nxt = np.zeros(src.size, bool)
+    nxt[last[inside]] = True
+    out["block"] = np.where(nxt, np.repeat(path.block[a + 1], cnt), out["block"])
+    return out, cnt
+
+
 def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Length cut from the start and from the end of every segment by the windows
     ``[S_c - d, S_c + d]`` around the corners at the ends of segments ``a``, mm, shape (m,)
@@ -1071,7 +1131,7 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
 
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
               g2: np.ndarray, piece: np.ndarray, table: RoundingTable,
-              extras: list | None = None) -> Path:
+              extras: list | None = None, internal: np.ndarray | None = None) -> Path:
     """The rounded path: lines shortened, roundings inserted after segments ``a``
     (a tangent arc, or the two pieces of a clothoid pair), spans moved.
 
@@ -1093,7 +1153,11 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         at its start by ``trim_out`` (an arc's start angle moves, so it stays the exact
         arc), ``n_rows`` packed ``rows`` each (G645's tangential transitions,
         :mod:`reference.rounding_tangential`; fillets at corners next to arcs,
-        :mod:`reference.rounding_arcs`).
+        :mod:`reference.rounding_arcs`), and a 6th item: which of them are inside the
+        blocks (bool, shape of ``a_x``; as ``internal``).
+    internal : numpy.ndarray of bool, shape (r,), optional
+        The rounding is carried out inside the original blocks (G643, between two
+        blocks): :func:`_inside_the_blocks`.
     """
     m = path.n_segments
     trim_start, trim_end = _window_trims(path, a, d)
@@ -1101,22 +1165,33 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     n_ins[a] = np.where(g2, 2, 1)
     corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
+    inside = np.zeros(a.size, bool) if internal is None else internal
+    cnt = np.where(g2, 2, 1)
     if extras:
-        a_all, cnt = [a], [np.where(g2, 2, 1)]
-        for at, t_in, t_out, rows, n_rows in extras:
+        a_all, cnt, inside = [a], [cnt], [inside]
+        for at, t_in, t_out, rows, n_rows, x_inside in extras:
             trim_end[at] += t_in
             trim_start[at + 1] += t_out
             n_ins[at] = n_rows
             a_all.append(at)
             cnt.append(np.full(at.size, n_rows))
+            inside.append(x_inside)
             arcs = {key: np.concatenate((val, rows[key])) for key, val in arcs.items()}
         # rows in path order: every insertion's rows sorted by its segment
-        a_all, cnt = np.concatenate(a_all), np.concatenate(cnt)
+        a_all, cnt, inside = np.concatenate(a_all), np.concatenate(cnt), \
+            np.concatenate(inside)
         rank = np.empty(a_all.size, dtype=np.int64)
         rank[np.argsort(a_all, kind="stable")] = np.arange(a_all.size)
         order = np.argsort(np.repeat(rank, cnt), kind="stable")
         arcs = {key: val[order] for key, val in arcs.items()}
-        a = np.sort(a_all)
+        srt = np.argsort(a_all, kind="stable")
+        a, cnt, inside = a_all[srt], cnt[srt], inside[srt]
+    span_shift = np.zeros(m + 1, dtype=np.int64)
+    if inside.any():
+        arcs, cnt = _inside_the_blocks(path, a, cnt, inside, arcs)
+        n_ins[a] = cnt
+        # the last row of each such rounding starts the next block's span
+        span_shift[a[inside] + 1] = 1
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
     # meet tangentially and the line is dropped; a line inside a window that reaches
@@ -1172,7 +1247,8 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
     spans = path.blocks
     j0 = spans.first_segment
-    f, e = first[j0], first[j0 + spans.n_segments]
+    at = first - span_shift               # a block-internal rounding's second half
+    f, e = at[j0], at[j0 + spans.n_segments]
     spans = spans.moved(sb[f], sb[e], f, e - f)
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
                 rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=spans,

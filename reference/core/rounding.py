@@ -156,6 +156,13 @@ class RoundingTable:
         length replaced of the line, ``deviation_mm`` the largest distance from the
         programmed contour, ``radius_mm`` the arc's radius (the rounding's smallest),
         ``v_g64`` the curvature-jump limit (6.3). Rounded ones have ``g2`` set.
+    internal : numpy.ndarray of bool, shape (k,), optional
+        The rounding is carried out inside the original blocks (G643, 5.5: "No separate
+        rounding block is inserted"): its half up to the corner's bisector belongs to
+        ``block`` (the last segment of its span), the other half to ``next_block`` (the
+        first of its span), it is no interpolation block of its own (no one-IPO-cycle
+        cap of its own, no row of its own; :func:`reference.core.rows.
+        internal_rounding_segments`). False where inserted as a block, or not rounded.
     """
 
     block: np.ndarray
@@ -173,6 +180,11 @@ class RoundingTable:
     first_block: np.ndarray
     last_block: np.ndarray
     tangential: np.ndarray
+    internal: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.internal is None:
+            object.__setattr__(self, "internal", np.zeros(self.block.size, bool))
 
     @property
     def n(self) -> int:
