@@ -548,8 +548,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         d_dyn, dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
             path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn], theta[dyn], g2[dyn],
             how[dyn] == FREQ)
-        # 0xxx/1xxx: the smaller of the mode's distance and the dynamic one
-        d[dyn] = np.where(dyn_cap[dyn], np.minimum(d[dyn], d_dyn), d_dyn)
+        # 0xxx/1xxx: the smaller of the mode's distance and the dynamic one (fmin: a
+        # reversal has no plane, and no dynamic size, but its tolerance distance)
+        d[dyn] = np.where(dyn_cap[dyn], np.fmin(d[dyn], d_dyn), d_dyn)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
@@ -650,7 +651,8 @@ def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray
     t_ipo = machine.limits.t_ipo_s
     v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
     v = np.minimum(v_in, v_out)
-    _, rho = _plane_weights(t1, t2)
+    with np.errstate(divide="ignore", invalid="ignore"):    # a reversal: no plane
+        _, rho = _plane_weights(t1, t2)
     moving = rho > 0
     w = np.where(moving, rho, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
