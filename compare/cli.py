@@ -164,6 +164,8 @@ def _write_rounding(out, program, table) -> None:
         if table.inserted[i]:
             what = "rounded (" + ("G2 transition" if table.tangential[i] else
                                   "G2" if table.g2[i] else "arc") + ")"
+            if table.internal[i]:
+                what += " inside the blocks (G643: no block of its own)"
             if table.blocks_spanned[i] > 2:
                 what += (f" across lines {lines[int(table.first_block[i])]}.."
                          f"{lines[int(table.last_block[i])]} (short blocks)")

@@ -46,8 +46,10 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      or the contour within SD42465 SMOOTH_CONTUR_TOL (digit 1, 3); a programmed CTOL
      replaces both for the geometry axes (5.7); digit 4: ``d`` as G641. Both blocks G0:
      tolerances times MD20560 G0_TOLERANCE_FACTOR (5.7);
-   * G644 (thousands digit): 0xxx/4xxx MD33100 per axis, 1xxx/5xxx ADIS/ADISPOS
-     (CTOL ignored, 5.6); 2xxx the rounding lasts one period of the lowest
+   * G644 (thousands digit, 5.6): 4xxx MD33100 per axis and 5xxx ADIS/ADISPOS "fully
+     used"; 0xxx and 1xxx the same as a maximum, "not fully used" where the rounding of
+     3xxx at the path velocity is smaller (``d = min(d_tol, d_3xxx)``, ``min(ADIS,
+     d_3xxx)``; CTOL ignored); 2xxx the rounding lasts one period of the lowest
      LOOKAH_FREQUENCY at the programmed speed, 3xxx the smallest rounding the axes pass
      at the programmed speed (:func:`_dynamic_distance`); other digits named;
    * RND/RNDM: the programmed radius ``R``, ``d = R tan(theta/2)`` (a tangent arc of
@@ -62,12 +64,18 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
      straight line, ``L1``, ``L2`` then being those straight chains
      (:func:`_across_blocks`; the blocks it covers whole are no longer interpolated);
 5. speeds (4.3, 5.2 group 2, 5.8): ``v_g64`` is the G64 corner speed (the shared
-   junction rule); G641/G642/G645 round only when ``v_g64`` is below the programmed feed
-   and axis velocity (the overload-factor check; MD20490 IGNORE_OVL_FACTOR_FOR_ADIS =
-   TRUE skips it, G643 and G644 never make it); every mode but RND/RNDM rounds only
+   junction rule); G641/G642/G645 round only when ``v_g64`` is below the speed of the
+   lines (the overload-factor check; G643 and G644 never make it); G641/G642/G645 with
+   MD20490 IGNORE_OVL_FACTOR_FOR_ADIS = TRUE and G643 "always round" (4.3, 5.5, 5.8,
+   :func:`reference.core.rounding.always_rounds`): neither check is made, only the
+   documented short-block case keeps an inserted block out ("between two very short
+   blocks", 5.2 group 2; :func:`reference.core.rounding.very_short_blocks`; G643
+   inserts none); every other mode but RND/RNDM rounds only
    when the rounding is estimated to pass the corner in less time than G64
-   (:func:`corner_time_loss`: ramps on each line to its own programmed speed, BRISK or
-   jerk-limited, a stop costing its ramps), with ``v_round``
+   (:func:`corner_time_loss`: ramps on each line to the speed it runs at, its
+   programmed speed and one IPO cycle per block (:func:`_line_speeds`), BRISK or
+   jerk-limited, a stop costing its ramps; the part a window leaves of a block it cuts
+   is counted with the rounding where its own IPO cycle caps it), with ``v_round``
    (:func:`_rounding_speed`) = min of the centripetal limit at the largest curvature,
    the one-IPO-cycle limit per inserted block (5.3: "about ADIS/T_ipo"), under SOFT the
    in-rounding jerk limit and, on the arc only, the curvature-jump limit of the shared
@@ -76,7 +84,14 @@ Per corner (break between two consecutive segments), in this order (5.2, 8):
 Model limits, stated: under BRISK the rounding is a tangent arc (G1 continuous,
 curvature jump ``1/R`` at both ends: BRISK allows the acceleration step), under SOFT a
 clothoid pair (G2), where the control inserts a polynomial of its own;
-G643/G644 insert the same segments (the control rounds axis-wise inside the blocks);
+G643 rounds inside the original blocks (5.5, documented: "no separate rounding block
+is inserted"; :func:`_inside_the_blocks`): the rounding's halves belong to the blocks on
+either side, it has no row and no one-IPO-cycle cap of its own (its block's,
+:func:`reference.core.rows.interpolation_lengths`); its shape is G642's, the per-axis
+windows of the model note (5.5 "Model [I]", 5.8 "per-axis T_i") are not modelled (no
+segment kind of the shared path traces an axis-wise blend; the common shape keeps every
+axis within its tolerance, the documented limit); G644 inserts G642's segments (its
+per-axis T_i not modelled either);
 G645's rounding of tangential transitions is modelled between a line and a circle and
 between two circles in one plane (curving opposite ways, S-bends, or the same way with
 another radius), the rounding of corners next to arcs between a line and a circle and
@@ -99,8 +114,10 @@ import numpy as np
 from .core.arrays import row_dots, row_max, row_min, row_norms
 from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_pieces
 from .core.limits import AxisArrays
-from .core.rounding import (REASON_CODE, RoundingTable, axis_deviation_limit,
-                            deflection_angle, distance_for_deviation, fillet_pieces)
+from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
+                            RoundingTable, always_rounds, axis_deviation_limit,
+                            deflection_angle, distance_for_deviation, fillet_pieces,
+                            very_short_blocks)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
@@ -111,7 +128,8 @@ from .rounding_tangential import tangential_transitions
 #: Group-10 modes that round corners.
 ROUNDING_MODES = ("G641", "G642", "G643", "G644", "G645")
 #: Modes that round only where G64 would have to reduce the speed (4.3).
-_OVERLOAD_CHECKED = ("G641", "G642", "G645")
+_OVERLOAD_CHECKED = OVERLOAD_CHECKED_MODES
+_INTERNAL = INTERNAL_MODES
 
 #: Modes whose tolerance-based rounding window may reach across several short blocks
 #: (:func:`_across_blocks`). G641 and the ADIS digit (4) are limited by the block lengths
@@ -350,27 +368,47 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         soft = accel_id[ka[o]] == soft_id
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
         a1, a2 = np.abs(t1[o]), np.abs(t2[o])
-        v_in, v_out = _programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o])
+        # the rounding runs at most at the programmed speed; beside it each line at
+        # most at its own one-IPO-cycle cap too (:func:`_line_speeds`)
+        v_prog = np.minimum(*_programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o]))
+        v_in, v_out = _line_speeds(path, lim, a[o], b[o], t1[o], t2[o],
+                                   machine.limits.t_ipo_s)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / a1)
             acc_out = row_min(lim.a_max[None, :] / a2)
             j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
             j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
-        v_prog = np.minimum(v_in, v_out)
         v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
         ovl = _is_in(mode_id[o], names, _OVERLOAD_CHECKED) & \
             (not ch.ignore_ovl_factor_for_adis)
+        always = always_rounds(np.array(names, dtype=_MODE_DTYPE)[mode_id[o]],
+                               ch.ignore_ovl_factor_for_adis)
         radius_mode = _is_in(mode_id[o], names, _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
-        sub[o] = ovl & (v64[o] >= v_prog)
+        sub[o] = ovl & (v64[o] >= np.minimum(v_in, v_out))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
+        # where the overload check is waived, the documented short-block case still
+        # holds: an inserted block between two blocks of one IPO cycle each (G643
+        # inserts none, a window across short blocks replaces several by one)
         sub[:] = False
+        sub[o] = always & ~_is_in(mode_id[o], names, _INTERNAL) & (first[o] == a[o]) & (
+            last[o] == b[o]) & very_short_blocks(path.length[a[o]], path.length[b[o]],
+                                                  v_prog, machine.limits.t_ipo_s)
+        decide(sub, "rounding would slow the program down (between two very short blocks)")
+        sub[:] = False
+        # what the window leaves of the blocks it cuts (the corner's own two, or the
+        # first and last block it touches across short blocks)
+        sb = path.s_breaks
+        s_c = sb[a[o] + 1]
+        left_in = (s_c - d[o]) - sb[first[o]]
+        left_out = sb[last[o] + 1] - (s_c + d[o])
         sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
-                                    shape.length[o], d[o])
+                                    shape.length[o], d[o], None, left_in, left_out,
+                                    machine.limits.t_ipo_s)
                    < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
                                       0.0, 0.0)
-                   ) & ~radius_mode
+                   ) & ~radius_mode & ~always
         decide(sub, "rounding would be slower than G64")
     reason[reason < 0] = REASON_CODE["rounded"]
     ins = reason == 0                     # corners rounded (transitions are still pending)
@@ -403,13 +441,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         v64[arcc], v_round[arcc] = ac.v_g64, ac.v_round
     tangential = np.zeros(a.size, bool)
     tangential[trans] = True
+    # G643 rounds inside the original blocks (5.5): between two blocks the rounding's
+    # halves go to the blocks on either side (:func:`_inside_the_blocks`); a corner
+    # between two segments of one block is inside that block anyway
+    internal = (reason == 0) & _is_in(mode_id, names, _INTERNAL) & (ka != kb) & ~tangential
     table = RoundingTable(
         block=ka.astype(np.int64), next_block=kb.astype(np.int64), mode=mode, reason=reason,
         distance_mm=dist, length_mm=length, deviation_mm=dev, radius_mm=rad,
         clamped=clamped, v_g64=v64, v_round=v_round, g2=g2_out,
         first_block=np.where(ins, path.block[first], ka).astype(np.int64),
         last_block=np.where(ins, path.block[last], kb).astype(np.int64),
-        tangential=tangential)
+        tangential=tangential, internal=internal)
     if not (reason == 0).any():           # nothing to insert: same path, with the table
         keep = ("axes", "geometry", "rotary", "origin", "e1", "e2", "d", "radius", "omega",
                 "theta0", "length", "block", "kind", "feed", "rapid", "stop", "stop_reason",
@@ -421,9 +463,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
             done = part.reason == 0
             n_rows = part.n_rows if part is tr else 1
             extras.append((a[at[done]], part.trim_in[done],
-                           part.trim_out[done], part.rows, n_rows))
+                           part.trim_out[done], part.rows, n_rows, internal[at[done]]))
     return _assemble(path, a[ins], d[ins], t1[ins], t2[ins], g2[ins], shape.piece[ins],
-                     table, extras)
+                     table, extras, internal[ins])
 
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
@@ -436,7 +478,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
     (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), ``dyn_radius``
-    and ``dyn_length`` (G644 2xxx/3xxx, :func:`_dynamic_distance`), mm. ``mode``:
+    and ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap,
+    :func:`_dynamic_distance`), mm, ``dyn_cap`` (bool: G644 0xxx/1xxx). ``mode``:
     each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
     ch = machine.channel
     sm = ch.smoothing_mode
@@ -454,7 +497,13 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     how[_is_in(mode, names, _RADIUS_MODES)] = RADIUS
     how[_is_in(mode, names, ("G641",))] = ADIS
     dig644 = _digit(sm, 3)
-    how[_is_in(mode, names, ("G644",))] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
+    is644 = _is_in(mode, names, ("G644",))
+    how[is644] = {0: TOL, 1: ADIS, 2: FREQ, 3: DYN, 4: TOL, 5: ADIS}.get(dig644, NONE)
+    # G644 0xxx/1xxx (spec 5.6): the tolerance or the distance is a maximum that the
+    # rounding "if the dynamics allow" does not fully use: the rounding of 3xxx (the
+    # axes' maximum dynamics at the path velocity) where it is smaller; 4xxx/5xxx use
+    # them fully ("where possible": the block-length clamp)
+    dyn_cap = is644 & (dig644 in (0, 1))
     for md, place in (("G642", 1), ("G645", 1), ("G643", 0)):
         sel = _is_in(mode, names, (md,))
         dig = _digit(sm, place)
@@ -493,16 +542,20 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
     # G644 2xxx (frequency) and 3xxx (maximum dynamics): sized by the path velocity
-    dyn = np.flatnonzero((how == FREQ) | (how == DYN))
+    dyn = np.flatnonzero((how == FREQ) | (how == DYN) | dyn_cap)
     dyn_radius, dyn_length = np.zeros(k), np.zeros(k)
     if dyn.size:
-        d[dyn], dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
+        d_dyn, dyn_radius[dyn], dyn_length[dyn] = _dynamic_distance(
             path, machine, a[dyn], b[dyn], t1[dyn], t2[dyn], theta[dyn], g2[dyn],
             how[dyn] == FREQ)
+        # 0xxx/1xxx: the smaller of the mode's distance and the dynamic one (fmin: a
+        # reversal has no plane, and no dynamic size, but its tolerance distance)
+        d[dyn] = np.where(dyn_cap[dyn], np.fmin(d[dyn], d_dyn), d_dyn)
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length}
+               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length,
+               "dyn_cap": dyn_cap}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 
@@ -521,6 +574,31 @@ def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray
         v_in = np.minimum(path.feed[a], row_min(lim.v_max[None, :] / np.abs(t1)))
         v_out = np.minimum(path.feed[b], row_min(lim.v_max[None, :] / np.abs(t2)))
     return v_in, v_out
+
+
+def _line_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
+                 t1: np.ndarray, t2: np.ndarray, t_ipo: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Speed the segments before and after corners can run at beside the corner, mm/s,
+    shape (k,) each: the programmed speed (:func:`_programmed_speeds`) and at most one
+    segment per IPO cycle, ``L / T_ipo`` (5.3: "every block ... needs at least one
+    interpolation point"; the heuristic caps every segment so,
+    :func:`reference.planner.limit_curves.segment_limits`).
+
+    The decision's estimate (:func:`corner_time_loss`) ramps each side between the
+    corner speed and this speed and counts the length a rounding replaces at it. With
+    the programmed speed alone, a corner between blocks shorter than ``v T_ipo`` (CAM
+    chains of short blocks; ``lcnc_short_segments_0.001.ngc``: 0.0254 mm blocks, whose
+    cap at 1 ms is 25.4 mm/s, not the 203 mm/s of the axis velocity) was estimated with
+    ramps from a speed the lines never reach and with the replaced stretch passed at it:
+    on the LinuxCNC machine 0.4 ms slower per corner than G64, where the plan is 1.1 ms
+    faster. The overload-factor check compares with the same speed: G64 passes a corner
+    "without a reduction" (4.3) where its corner speed is at least what the blocks run
+    at.
+    """
+    v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
+    return (np.minimum(v_in, path.length[a] / t_ipo),
+            np.minimum(v_out, path.length[b] / t_ipo))
 
 
 def _plane_weights(t1: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -573,7 +651,8 @@ def _dynamic_distance(path: Path, machine: Machine, a: np.ndarray, b: np.ndarray
     t_ipo = machine.limits.t_ipo_s
     v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
     v = np.minimum(v_in, v_out)
-    _, rho = _plane_weights(t1, t2)
+    with np.errstate(divide="ignore", invalid="ignore"):    # a reversal: no plane
+        _, rho = _plane_weights(t1, t2)
     moving = rho > 0
     w = np.where(moving, rho, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -733,29 +812,44 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
                      a_in: np.ndarray, a_out: np.ndarray, j_in: np.ndarray,
                      j_out: np.ndarray, inserted: np.ndarray | float,
                      replaced: np.ndarray | float,
-                     replaced_out: np.ndarray | float | None = None) -> np.ndarray:
+                     replaced_out: np.ndarray | float | None = None,
+                     left_in: np.ndarray | None = None, left_out: np.ndarray | None = None,
+                     t_ipo: float = 0.0) -> np.ndarray:
     """Time a corner passed at ``v_corner`` costs against passing it at the programmed
     speeds, s: the decision's estimate of "rounding would slow the program down"
     (5.2 group 2, 4.3). Only the comparison of two such numbers (rounding, G64) is used;
     the heuristic then plans whichever contour results exactly.
 
-    Each side ``i`` (the line before, with programmed speed ``v_in``, and the one after,
-    ``v_out``) ramps between the corner speed ``v = min(v_corner, v_in, v_out)`` and its
-    programmed speed ``v_i``: the ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
+    Each side ``i`` (the line before, with speed ``v_in``, and the one after,
+    ``v_out``) ramps between the corner speed ``v`` and its own speed ``v_i``: ``v =
+    min(v_corner, v_in, v_out)`` at a G64 corner (one point), ``min(v_corner, v_i)``
+    beside a rounding (which may be faster than a side that its IPO cycle caps: it
+    replaces such blocks by one of its own). The ramp lasts ``T_i = dv_i / a_i`` (BRISK), ``dv_i / a_i +
     a_i / j_i`` (SOFT, where it reaches ``a_i``: ``dv_i >= a_i^2 / j_i``) or ``2 sqrt(dv_i
     / j_i)``, and is symmetric in time, so it covers ``(v + v_i) T_i / 2`` and costs
     ``T_i dv_i / (2 v_i)`` more than that distance at ``v_i``. A rounding of length ``l``
-    adds ``l / v`` (it is passed at about ``v``: a SOFT profile crosses its ends at zero
-    path acceleration) and removes ``replaced`` of each line, which would have been
+    adds ``l / v_x`` (it is passed at about its own speed: a SOFT profile crosses its
+    ends at zero path acceleration; ``v_x = min(v_corner, sqrt(v^2 + a l))``, what a
+    BRISK ramp from the slower side reaches by its middle) and removes ``replaced`` of each line, which would have been
     passed at ``v_i``. Per side because the two lines may have other programmed speeds
     (a G0 into a G1 at a low feed: the rounding runs at the lower, the replaced stretch
     of the G0 at rapid speed).
 
+    The part of a shortened block left beside the rounding (``left_in``, ``left_out``)
+    is still one block and needs one IPO cycle (5.3): its cap ``r / T_ipo`` may bind
+    where the block itself did not (a 0.0254 mm block cut to half, at 4 ms: 3.2 mm/s,
+    below a rounding passed at 4.4 mm/s). Where that cap is below the side's speed and
+    below the speed a ramp from the rounding reaches at the far end of the piece
+    (``sqrt(v^2 + 2 a_i r)``, the BRISK ramp: under SOFT the ramp reaches less, so the
+    test errs toward the cap binding), the piece is counted with the rounding: passed at
+    ``v = min(v_corner, r / T_ipo)``, its length added to ``l`` and to the side's
+    ``replaced``.
+
     Parameters
     ----------
     v_in, v_out : numpy.ndarray, shape (k,)
-        Programmed path speed of the line before and after (feed, axis velocities),
-        mm/s.
+        Speed of the line before and after (programmed: feed, axis velocities; and one
+        IPO cycle per block), mm/s.
     v_corner : numpy.ndarray, shape (k,)
         Speed at the corner (G64: the corner rule; rounding: the rounding's speed), mm/s.
     a_in, a_out : numpy.ndarray, shape (k,)
@@ -770,27 +864,55 @@ def corner_time_loss(v_in: np.ndarray, v_out: np.ndarray, v_corner: np.ndarray,
         Length cut from the segment after, where it differs from ``replaced`` (then cut
         from the segment before only): G645's tangential transitions replace more of
         the line than of the arc.
+    left_in, left_out : numpy.ndarray, shape (k,), optional
+        Length left of the shortened block before and after the rounding, mm (none
+        given: not counted).
+    t_ipo : float
+        IPO cycle, s (used with ``left_in``, ``left_out``).
 
     Returns
     -------
     numpy.ndarray, shape (k,)
         s; ``inf`` for a rounding that would be passed at no speed.
     """
-    v = np.minimum(v_corner, np.minimum(v_in, v_out))
     inserted = np.asarray(inserted, dtype=np.float64)
-    total = np.zeros(np.shape(v))
+    cut_in = np.asarray(replaced, dtype=np.float64)
+    cut_out = cut_in if replaced_out is None else np.asarray(replaced_out, dtype=np.float64)
+    # the speed each side's ramp ends at: a G64 corner is one point, passed at most at
+    # the slower side's speed; a rounding may be faster than a side capped by its IPO
+    # cycle (it replaces such blocks by one block of its own, 5.3), so each side ramps
+    # to the rounding's speed or its own, whichever is lower
+    point = np.minimum(v_corner, np.minimum(v_in, v_out))
+    curve = inserted > 0
+    v_s = [np.where(curve, np.minimum(v_corner, v_p), point) for v_p in (v_in, v_out)]
+    left = [np.zeros(np.shape(point)), np.zeros(np.shape(point))]
+    if left_in is not None and t_ipo > 0:
+        for i, (r, v_p, a) in enumerate(((left_in, v_in, a_in), (left_out, v_out, a_out))):
+            with np.errstate(invalid="ignore"):
+                cap = r / t_ipo
+                binds = ((r > MIN_SEGMENT_LENGTH_MM) & (cap < v_p)
+                         & (cap < np.sqrt(v_s[i] * v_s[i] + 2.0 * a * r)))
+            left[i] = np.where(binds, r, 0.0)
+            v_s[i] = np.where(binds, np.minimum(v_s[i], cap), v_s[i])
+        cut_in, cut_out = cut_in + left[0], cut_out + left[1]
+    # the rounding itself: at its own speed, as far as a ramp from the slower side
+    # reaches by its middle (BRISK)
+    v_lo = np.minimum(v_s[0], v_s[1])
+    v_x = np.minimum(v_corner, np.sqrt(v_lo * v_lo + np.minimum(a_in, a_out) * inserted))
+    total = np.zeros(np.shape(point))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        cut_out = replaced if replaced_out is None else replaced_out
-        for v_p, a, j, cut in ((v_in, a_in, j_in, replaced), (v_out, a_out, j_out, cut_out)):
+        for v_p, v, a, j, cut, r in ((v_in, v_s[0], a_in, j_in, cut_in, left[0]),
+                                     (v_out, v_s[1], a_out, j_out, cut_out, left[1])):
             dv = np.maximum(v_p - v, 0.0)
             reach = dv * j >= a * a
             T = np.where(reach, dv / a + a / j, 2.0 * np.sqrt(dv / j))
             T = np.where(dv > 0, T, 0.0)
             total = total + np.where(np.isfinite(v_p) & (v_p > 0),
-                                     T * dv / (2.0 * v_p) - np.asarray(cut) / v_p, 0.0)
-        total = total + np.where(inserted > 0, inserted / v, 0.0)
+                                     T * dv / (2.0 * v_p) - cut / v_p, 0.0)
+            total = total + np.where(r > 0, r / v, 0.0)
+        total = total + np.where(curve, inserted / v_x, 0.0)
     # a stop costs its ramps; only a rounding passed at no speed would never end
-    return np.where((v > 0) | ~(inserted > 0), total, np.inf)
+    return np.where((v_x > 0) | ~curve, total, np.inf)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -920,6 +1042,55 @@ def _inserted_rows(corner: np.ndarray, t1: np.ndarray, t2: np.ndarray, d: np.nda
     return out
 
 
+def _inside_the_blocks(path: Path, a: np.ndarray, cnt: np.ndarray, inside: np.ndarray,
+                       rows: dict[str, np.ndarray]
+                       ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Roundings carried out inside the original blocks (G643, spec 5.5: "No separate
+    rounding block is inserted; the rounding is carried out inside the original
+    blocks"): the part up to the middle of the rounding stays with the block before the
+    corner, the rest goes to the block after it, so the block boundary moves from the
+    corner to the rounding's middle (the point nearest to it; both shapes are
+    symmetric). A clothoid pair splits there already (its second piece is attributed to
+    the next block); a tangent arc (at line corners; the fillet at an arc corner) is cut
+    into two arcs of half its length (the second's start angle moved by ``omega L / 2``).
+
+    Parameters
+    ----------
+    a : numpy.ndarray of int, shape (r,)
+        Segment before each insertion, ascending.
+    cnt : numpy.ndarray of int, shape (r,)
+        Rows of each insertion (in ``rows``, in that order).
+    inside : numpy.ndarray of bool, shape (r,)
+        The insertion is block-internal (one arc row or a clothoid pair).
+    rows : dict
+        Packed rows of all insertions.
+
+    Returns
+    -------
+    rows : dict
+        The rows with every block-internal arc in two halves.
+    cnt : numpy.ndarray of int, shape (r,)
+        Rows per insertion.
+    """
+    split = inside & (cnt == 1)
+    reps = np.repeat(np.where(split, 2, 1), cnt)            # per row: 1, or 2 (split)
+    src = np.repeat(np.arange(reps.size), reps)
+    out = {key: val[src] for key, val in rows.items()}
+    cnt = cnt + split
+    last = np.cumsum(cnt) - 1                                # each insertion's last row
+    half = np.zeros(src.size, bool)
+    half[np.repeat(split, cnt)] = True
+    second = np.zeros(src.size, bool)
+    second[last[split]] = True
+    out["length"] = np.where(half, 0.5 * out["length"], out["length"])
+    out["theta0"] = np.where(second, out["theta0"] + out["omega"] * out["length"],
+                             out["theta0"])
+    nxt = np.zeros(src.size, bool)
+    nxt[last[inside]] = True
+    out["block"] = np.where(nxt, np.repeat(path.block[a + 1], cnt), out["block"])
+    return out, cnt
+
+
 def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Length cut from the start and from the end of every segment by the windows
     ``[S_c - d, S_c + d]`` around the corners at the ends of segments ``a``, mm, shape (m,)
@@ -962,7 +1133,7 @@ def _window_trims(path: Path, a: np.ndarray, d: np.ndarray) -> tuple[np.ndarray,
 
 def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.ndarray,
               g2: np.ndarray, piece: np.ndarray, table: RoundingTable,
-              extras: list | None = None) -> Path:
+              extras: list | None = None, internal: np.ndarray | None = None) -> Path:
     """The rounded path: lines shortened, roundings inserted after segments ``a``
     (a tangent arc, or the two pieces of a clothoid pair), spans moved.
 
@@ -984,7 +1155,11 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
         at its start by ``trim_out`` (an arc's start angle moves, so it stays the exact
         arc), ``n_rows`` packed ``rows`` each (G645's tangential transitions,
         :mod:`reference.rounding_tangential`; fillets at corners next to arcs,
-        :mod:`reference.rounding_arcs`).
+        :mod:`reference.rounding_arcs`), and a 6th item: which of them are inside the
+        blocks (bool, shape of ``a_x``; as ``internal``).
+    internal : numpy.ndarray of bool, shape (r,), optional
+        The rounding is carried out inside the original blocks (G643, between two
+        blocks): :func:`_inside_the_blocks`.
     """
     m = path.n_segments
     trim_start, trim_end = _window_trims(path, a, d)
@@ -992,22 +1167,33 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     n_ins[a] = np.where(g2, 2, 1)
     corner = path.origin.take(a, axis=0) + path.d.take(a, axis=0) * path.length[a][:, None]
     arcs = _inserted_rows(corner, t1, t2, d, g2, piece, path.block[a])
+    inside = np.zeros(a.size, bool) if internal is None else internal
+    cnt = np.where(g2, 2, 1)
     if extras:
-        a_all, cnt = [a], [np.where(g2, 2, 1)]
-        for at, t_in, t_out, rows, n_rows in extras:
+        a_all, cnt, inside = [a], [cnt], [inside]
+        for at, t_in, t_out, rows, n_rows, x_inside in extras:
             trim_end[at] += t_in
             trim_start[at + 1] += t_out
             n_ins[at] = n_rows
             a_all.append(at)
             cnt.append(np.full(at.size, n_rows))
+            inside.append(x_inside)
             arcs = {key: np.concatenate((val, rows[key])) for key, val in arcs.items()}
         # rows in path order: every insertion's rows sorted by its segment
-        a_all, cnt = np.concatenate(a_all), np.concatenate(cnt)
+        a_all, cnt, inside = np.concatenate(a_all), np.concatenate(cnt), \
+            np.concatenate(inside)
         rank = np.empty(a_all.size, dtype=np.int64)
         rank[np.argsort(a_all, kind="stable")] = np.arange(a_all.size)
         order = np.argsort(np.repeat(rank, cnt), kind="stable")
         arcs = {key: val[order] for key, val in arcs.items()}
-        a = np.sort(a_all)
+        srt = np.argsort(a_all, kind="stable")
+        a, cnt, inside = a_all[srt], cnt[srt], inside[srt]
+    span_shift = np.zeros(m + 1, dtype=np.int64)
+    if inside.any():
+        arcs, cnt = _inside_the_blocks(path, a, cnt, inside, arcs)
+        n_ins[a] = cnt
+        # the last row of each such rounding starts the next block's span
+        span_shift[a[inside] + 1] = 1
     length = path.length - trim_start - trim_end
     # with c = 0.5 on both ends a line can shrink to nothing: the two roundings then
     # meet tangentially and the line is dropped; a line inside a window that reaches
@@ -1063,7 +1249,8 @@ def _assemble(path: Path, a: np.ndarray, d: np.ndarray, t1: np.ndarray, t2: np.n
     # a span's segments [j0, j0 + n) become [first[j0], first[j0 + n)) (n = 0 included)
     spans = path.blocks
     j0 = spans.first_segment
-    f, e = first[j0], first[j0 + spans.n_segments]
+    at = first - span_shift               # a block-internal rounding's second half
+    f, e = at[j0], at[j0 + spans.n_segments]
     spans = spans.moved(sb[f], sb[e], f, e - f)
     return Path(axes=path.axes, geometry=path.geometry, rotary=path.rotary, feed=feed,
                 rapid=rapid, stop=stop, stop_reason=tuple(reasons), blocks=spans,

@@ -63,11 +63,13 @@ from scipy.optimize.elementwise import find_root
 
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
-from .core.rounding import (REASON_CODE, axis_deviation_limit, circle_circle_fillet,
+from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
+                            always_rounds, axis_deviation_limit, circle_circle_fillet,
                             circle_fillet_deviation, circle_fillet_radius_for_deviation,
                             circle_fillet_radius_within, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_deviation,
-                            fillet_radius_for_line_trim, line_circle_fillet)
+                            fillet_radius_for_line_trim, line_circle_fillet,
+                            very_short_blocks)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM
 from .machine import Machine
@@ -168,7 +170,8 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         ``dist`` (ADIS/ADISPOS, mm), ``contour`` (contour tolerance, mm, ``inf``: none),
         ``axis_tol`` (per-axis tolerance, shape (k, n), mm, ``inf``: none), ``g0``
         (tolerance factor), ``radius`` (programmed radius, mm), ``dyn_radius``,
-        ``dyn_length`` (G644 2xxx/3xxx: smallest radius and length, mm).
+        ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap: smallest radius
+        and length, mm), ``dyn_cap`` (bool: G644 0xxx/1xxx).
     accel : numpy.ndarray of str, shape (k,)
     centripetal_share, jerk_share : float
         The corner rounding's shares of the axis acceleration and jerk.
@@ -247,7 +250,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
-            targets["dyn_length"][i], t1[i], t2[i])
+            targets["dyn_length"][i], t1[i], t2[i], targets["dyn_cap"][i])
         clamped[i] = ro >= r_cap
         f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
         r[i] = ro
@@ -285,6 +288,10 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             v_axis = np.minimum(row_min(lim.v_max[None, :] / np.abs(t1[o2])),
                                 row_min(lim.v_max[None, :] / np.abs(t2[o2])))
             v_prog = np.minimum(np.minimum(path.feed[a[o2]], path.feed[b[o2]]), v_axis)
+            # at most one segment per IPO cycle on either side (5.3), as the heuristic
+            # caps them: the speed each side runs at beside the corner
+            # (reference.rounding._line_speeds)
+            ipo_in, ipo_out = path.length[a[o2]] / t_ipo, path.length[b[o2]] / t_ipo
             v_c = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
                                                    * ro[:, None] / wr), np.inf))
             v_j = row_min(np.where(moving, np.cbrt(jerk_share * lim.j_max[None, :]
@@ -318,18 +325,25 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             vr = np.where(soft, np.minimum(vr, v_k), vr)
         v_round[o2] = vr
         sub = np.zeros(k, bool)
-        ovl = np.isin(mode[o2], ("G641", "G642", "G645")) & (
-            not machine.channel.ignore_ovl_factor_for_adis)
-        sub[o2] = ovl & (v_g64[o2] >= v_prog)
+        ignore = machine.channel.ignore_ovl_factor_for_adis
+        ovl = np.isin(mode[o2], OVERLOAD_CHECKED_MODES) & (not ignore)
+        sub[o2] = ovl & (v_g64[o2] >= np.minimum(v_prog, np.minimum(ipo_in, ipo_out)))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
+        # G643, and G641/G642/G645 with MD20490 = TRUE, round whatever G64 costs
+        # (always_rounds), but not with an inserted block between two very short ones
+        always = always_rounds(mode[o2], ignore)
+        sub[:] = False
+        sub[o2] = always & ~np.isin(mode[o2], INTERNAL_MODES) & very_short_blocks(
+            path.length[a[o2]], path.length[b[o2]], v_prog, t_ipo)
+        decide(sub, "rounding would slow the program down (between two very short blocks)")
         # the time estimate of the line-line corners, each side ramping to its own
         # speed (an arc side to its own limit), the fillet passed at v_round
         forward = line_arc[o2] | aa
         v_line = v_prog
         v_first = np.minimum(v_line, v_arc_first)
         v_second = np.minimum(v_line, v_arc)
-        v_in = np.where(forward, v_first, v_second)
-        v_out = np.where(forward, v_second, v_first)
+        v_in = np.minimum(np.where(forward, v_first, v_second), ipo_in)
+        v_out = np.minimum(np.where(forward, v_second, v_first), ipo_out)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / np.abs(t1[o2]))
             acc_out = row_min(lim.a_max[None, :] / np.abs(t2[o2]))
@@ -339,10 +353,13 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         cut_out = np.where(forward, f.trim_second, f.trim_first)
         radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
         sub[:] = False
+        # what the fillet leaves of the two elements (one IPO cycle each, 5.3)
+        left_in = path.length[a[o2]] - cut_in
+        left_out = path.length[b[o2]] - cut_out
         sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
-                              cut_in, cut_out)
+                              cut_in, cut_out, left_in, left_out, t_ipo)
                     < time_loss(v_in, v_out, v_g64[o2], acc_in, acc_out, j_in, j_out,
-                                0.0, 0.0)) & ~radius_mode
+                                0.0, 0.0)) & ~radius_mode & ~always
         decide(sub, "rounding would be slower than G64")
 
     reason[reason < 0] = REASON_CODE["rounded"]
@@ -491,15 +508,16 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                     rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
                     cap_second: np.ndarray, dyn_radius: np.ndarray,
-                    dyn_length: np.ndarray, t1: np.ndarray,
-                    t2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    dyn_length: np.ndarray, t1: np.ndarray, t2: np.ndarray,
+                    dyn_cap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
     dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
     and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
     the tolerance holds at the radius found (True where no tolerance applies).
     ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
-    start)."""
+    start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
+    but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
@@ -545,7 +563,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
     # about like r: the same search, the largest r not longer), at least dyn_radius,
     # then clamped
-    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN))
+    dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN) | dyn_cap)
     if dy.size:
         n_geo = len(cols)
         dc = (*(col[dy] for col in cols), dyn_length[dy])
@@ -554,7 +572,8 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
             return _log_length_ratio(x, *c, n_geo=n_geo, fillet=fam.fillet)
 
         r_len = _tolerance_radius(too_long, dc, r_cap[dy])[0]
-        ro[dy] = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
+        r_dyn = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
+        ro[dy] = np.where(dyn_cap[dy], np.fmin(ro[dy], r_dyn), r_dyn)
     ro = np.where(np.isfinite(ro), ro, 0.0)
     return ro, r_cap, tol_ok
 

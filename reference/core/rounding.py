@@ -69,8 +69,52 @@ ROUNDING_REASONS: tuple[str, ...] = (
     # G645 between tangent arcs: a model limit (reference.rounding_tangential)
     "tangential transition between arcs in different planes: rounding not modelled "
     "(model limit)",                                                  # 21
+    # 5.2 group 2, where the overload check is waived (MD20490, reference.rounding.
+    # always_rounds)
+    "rounding would slow the program down (between two very short blocks)",  # 22
 )
 REASON_CODE = {r: i for i, r in enumerate(ROUNDING_REASONS)}
+
+
+#: Modes that round inside the original blocks, inserting no block of their own
+#: (5.5: "No separate rounding block is inserted; the rounding is carried out inside the
+#: original blocks").
+INTERNAL_MODES = ("G643",)
+#: Modes that round only where G64 would have to reduce the speed (4.3).
+OVERLOAD_CHECKED_MODES = ("G641", "G642", "G645")
+
+
+def always_rounds(mode: np.ndarray, ignore_ovl: bool) -> np.ndarray:
+    """Corners rounded whatever G64 would cost, bool, shape of ``mode`` (mode names).
+
+    spec 4.3: "G643 ignores the overload factor. Setting MD20490
+    IGNORE_OVL_FACTOR_FOR_ADIS = TRUE makes G641/G642 behave like G643 here (always
+    round)"; 5.5 (G643): "The overload factor is never taken into account"; 5.8:
+    "Insert the rounding only if v_corner_G64 < min(F, v_round), unless MD20490 = TRUE
+    or the mode is G643". So for these corners neither the overload check nor the
+    model's time comparison (:func:`reference.rounding.corner_time_loss`, which
+    generalises that inequality) is made: G643 always, G641/G642/G645 with MD20490 = TRUE (G645 "at
+    corners rounds like G642", 5.7). G644 and RND/RNDM are not named there: G644 keeps
+    the time comparison, RND/RNDM never make it (a programmed contour).
+    """
+    out = np.isin(mode, INTERNAL_MODES)
+    if ignore_ovl:
+        out |= np.isin(mode, OVERLOAD_CHECKED_MODES)
+    return out
+
+
+def very_short_blocks(l_in: np.ndarray, l_out: np.ndarray, v: np.ndarray,
+                      t_ipo: float) -> np.ndarray:
+    """Both blocks beside a corner are "very short", bool, shape (k,).
+
+    spec 5.2 group 2, "Rounding would slow the program down: between two very short
+    blocks (each block costs at least one IPO cycle, so an extra block could double the
+    time)"; 5.8: "If the blocks are too short (..., or less than one IPO cycle per
+    block), fall back to G64 [S1]". Model [I]: a block is very short where it is
+    crossed in at most one IPO cycle at the programmed speed ``v``, ``L <= v T_ipo``
+    (its one-IPO-cycle cap binds), mm, mm/s, s.
+    """
+    return (l_in <= v * t_ipo) & (l_out <= v * t_ipo)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -112,6 +156,13 @@ class RoundingTable:
         length replaced of the line, ``deviation_mm`` the largest distance from the
         programmed contour, ``radius_mm`` the arc's radius (the rounding's smallest),
         ``v_g64`` the curvature-jump limit (6.3). Rounded ones have ``g2`` set.
+    internal : numpy.ndarray of bool, shape (k,), optional
+        The rounding is carried out inside the original blocks (G643, 5.5: "No separate
+        rounding block is inserted"): its half up to the corner's bisector belongs to
+        ``block`` (the last segment of its span), the other half to ``next_block`` (the
+        first of its span), it is no interpolation block of its own (no one-IPO-cycle
+        cap of its own, no row of its own; :func:`reference.core.rows.
+        internal_rounding_segments`). False where inserted as a block, or not rounded.
     """
 
     block: np.ndarray
@@ -129,6 +180,11 @@ class RoundingTable:
     first_block: np.ndarray
     last_block: np.ndarray
     tangential: np.ndarray
+    internal: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.internal is None:
+            object.__setattr__(self, "internal", np.zeros(self.block.size, bool))
 
     @property
     def n(self) -> int:
@@ -759,11 +815,11 @@ def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray
     return np.where(trim < reach, r, top)
 
 
-__all__ = ["ArcFillet", "CircleFillet", "REASON_CODE", "ROUNDING_REASONS",
-           "RoundingTable", "axis_deviation_limit", "circle_circle_fillet",
-           "circle_fillet_deviation", "circle_fillet_largest_radius",
-           "circle_fillet_radius_for_deviation", "fillet_radius_for_deviation",
-           "circle_fillet_radius_for_trim", "circle_fillet_radius_within", "deflection_angle",
-           "distance_for_deviation", "fillet_deviation", "fillet_pieces",
-           "fillet_radius_for_arc_trim", "fillet_radius_for_line_trim",
-           "line_circle_fillet"]
+__all__ = ["ArcFillet", "CircleFillet", "INTERNAL_MODES", "OVERLOAD_CHECKED_MODES",
+           "REASON_CODE", "ROUNDING_REASONS", "RoundingTable", "always_rounds",
+           "axis_deviation_limit", "circle_circle_fillet", "circle_fillet_deviation",
+           "circle_fillet_largest_radius", "circle_fillet_radius_for_deviation",
+           "fillet_radius_for_deviation", "circle_fillet_radius_for_trim",
+           "circle_fillet_radius_within", "deflection_angle", "distance_for_deviation",
+           "fillet_deviation", "fillet_pieces", "fillet_radius_for_arc_trim",
+           "fillet_radius_for_line_trim", "line_circle_fillet", "very_short_blocks"]

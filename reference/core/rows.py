@@ -167,6 +167,44 @@ _ROW_KINDS = ("rounding",)
 _INSERTED_CODES = np.array([KIND_CODES.index(k) for k in _ROW_KINDS], dtype=np.int8)
 
 
+def internal_rounding_segments(path: Path) -> np.ndarray:
+    """Segments of roundings carried out inside the original blocks (G643, spec 5.5:
+    "No separate rounding block is inserted"), bool, shape (m,): per such corner of
+    ``path.rounding`` (``internal``), the last segment of the span of the block before
+    it and the first of the span of the block after it (its two halves,
+    :func:`reference.rounding._inside_the_blocks`). They are part of their blocks: no
+    row and no interpolation block of their own."""
+    out = np.zeros(path.n_segments, bool)
+    table = path.rounding
+    if table is None or not np.any(table.internal):
+        return out
+    spans = path.blocks
+    i = np.flatnonzero(table.internal)
+    # spans are in program order, one per block: the span index of a block
+    before = np.searchsorted(spans.block, table.block[i])
+    after = np.searchsorted(spans.block, table.next_block[i])
+    out[spans.first_segment[before] + spans.n_segments[before] - 1] = True
+    out[spans.first_segment[after]] = True
+    return out
+
+
+def interpolation_lengths(path: Path) -> np.ndarray:
+    """Length of the interpolation block each segment belongs to, mm, shape (m,): its
+    own length, except where a rounding is carried out inside the blocks (G643,
+    :func:`internal_rounding_segments`): that block is its span's own segments with the
+    halves of such roundings, less any rounding inserted as a block of its own. "Every
+    block, the rounding block included, needs at least one interpolation point" (spec
+    5.3): the one-IPO-cycle cap is this length over ``T_ipo``."""
+    inner = internal_rounding_segments(path)
+    if not inner.any():
+        return path.length
+    own_block = np.isin(path.kind, _INSERTED_CODES) & ~inner      # inserted as blocks
+    same = path.block[:-1] == path.block[1:]
+    join = same & (inner[:-1] | inner[1:]) & ~own_block[:-1] & ~own_block[1:]
+    unit = np.concatenate(([0], np.cumsum(~join)))
+    return np.bincount(unit, weights=path.length)[unit]
+
+
 def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
     """Inserted blocks inside program-block spans: runs of consecutive inserted segments
     (a clothoid pair's two pieces are one rounding, one row).
@@ -178,7 +216,9 @@ def inserted_pieces(path: Path) -> dict[int, np.ndarray]:
         shape (r, 2), ascending; spans that are themselves of an inserted kind are not
         split.
     """
-    segs = np.flatnonzero(np.isin(path.kind, _INSERTED_CODES))
+    # a rounding inside the blocks (G643) is part of them: no row of its own
+    segs = np.flatnonzero(np.isin(path.kind, _INSERTED_CODES)
+                          & ~internal_rounding_segments(path))
     if segs.size == 0:
         return {}
     first, nseg = path.blocks.first_segment, path.blocks.n_segments

@@ -76,13 +76,15 @@ def rounding_note(path: Path) -> str:
     order = sorted(np.flatnonzero(left), key=lambda r: (-left[r], ROUNDING_REASONS[r]))
     why = "; ".join(f"{left[r]} {ROUNDING_REASONS[r]}" for r in order)
     across = int(np.sum(table.blocks_spanned > 2))
+    n_inside = int(np.sum(table.internal))
     n_tr = int(np.sum(table.g2 & table.tangential))
     n_g2 = int(np.sum(table.g2)) - n_tr
     return (f"{int(ins.sum())} of {table.n} corners in G641..G645 rounded ({n_g2} by "
             f"clothoid pairs, {int(ins.sum()) - n_g2 - n_tr} by tangent arcs"
             + (f", {n_tr} G645 tangential transitions" if n_tr else "") + "; "
             f"{per_mode}; {float(table.length_mm.sum()):.6g} mm of rounding"
-            + (f"; {across} across short blocks" if across else "") + ")"
+            + (f"; {across} across short blocks" if across else "")
+            + (f"; {n_inside} inside the blocks (G643)" if n_inside else "") + ")"
             + (f"; no rounding block: {why}" if why else ""))
 
 

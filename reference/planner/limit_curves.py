@@ -21,7 +21,9 @@ Caps, each with its cause (:mod:`reference.planner.causes`):
 * axis velocity: ``axis velocity``;
 * centripetal: ``Q_i v^2 <= share * A_i`` (``arc_centripetal_share``): ``axis acceleration``;
 * SOFT, path jerk on arcs: ``R_i v^3 <= share * J_i`` (``arc_jerk_velocity_share``): ``jerk``;
-* at least one IPO cycle per block: ``v <= L / T_ipo``: ``IPO-cycle cap``.
+* at least one IPO cycle per block: ``v <= L / T_ipo``: ``IPO-cycle cap`` (``L`` the
+  segment's length; a rounding inside the blocks, G643, is part of its block: ``L`` the
+  block's, :func:`reference.core.rows.interpolation_lengths`).
 
 Then, at the cap speed ``C`` (the worst case, as speeds never exceed it), the tangential
 acceleration ``a_t`` is the largest that satisfies the acceleration inequality for all
@@ -48,6 +50,7 @@ import numpy as np
 
 from ..core.arrays import row_argmin, row_min, rows_where
 from ..core.geometry import Path, axis_tangent_amplitudes, moving_axes, plane_amplitudes
+from ..core.rows import interpolation_lengths
 from ..machine import Machine
 from . import causes as C
 from .parameters import PlannerParameters
@@ -199,7 +202,9 @@ def segment_limits(path: Path, machine: Machine, modes: SegmentModes,
             R3 = np.hypot(R[sr], Rn[sr])    # third-derivative amplitude (= R on circles)
             v_jerk[sr] = row_min(np.where(R3 > 0, np.cbrt(
                 params.arc_jerk_velocity_share * J[sr] / np.where(R3 > 0, R3, 1.0)), np.inf))
-    v_ipo = path.length / machine.limits.t_ipo_s
+    # one IPO cycle per interpolation block: per segment, except that a rounding inside
+    # the blocks (G643) is part of its block (reference.core.rows.interpolation_lengths)
+    v_ipo = interpolation_lengths(path) / machine.limits.t_ipo_s
     cap, cause = _min_with_cause([(path.feed, C.FEED), (v_axis, C.AXIS_VELOCITY),
                                   (v_cent, C.AXIS_ACCELERATION), (v_jerk, C.JERK),
                                   (v_ipo, C.IPO_CAP)])

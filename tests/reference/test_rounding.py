@@ -436,11 +436,16 @@ def test_small_adis_caps_the_speed_at_one_ipo_cycle_per_rounding_block():
 
 
 @pytest.mark.parametrize("mode, smoothing, expect", [
-    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given"
+    # spec 5.6 "1xxx: the rounding distance (ADIS/ADISPOS) is given", "5xxx: like
+    # 1xxx, but the distance is fully used where possible": at F3000 the 3xxx rounding
+    # (d = 1.667 mm, test_g644_digits_0_1_use_the_limit_only_where_the_dynamics_need_it)
+    # is larger than ADIS, so both use it
     ("G644 ADIS=0.4", 1000, ("distance", 0.4)),
     ("G644 ADIS=0.4", 5000, ("distance", 0.4)),
-    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL"
+    # "0xxx: keep each axis within MD33100 COMPRESS_POS_TOL", "4xxx: like 0xxx, but the
+    # tolerance is fully used": the same reason
     ("G644 ADIS=0.4", 0, ("deviation", 0.01 * math.sqrt(2))),
+    ("G644 ADIS=0.4", 4000, ("deviation", 0.01 * math.sqrt(2))),
     # 6xxx..9xxx are not documented: named
     ("G644 ADIS=0.4", 6000, ("reason", "G644 SMOOTHING_MODE digit not documented")),
     # spec 5.4 table, value 4 [M]: "rounding distance from ADIS/ADISPOS, as for G641"
@@ -461,6 +466,39 @@ def test_smoothing_mode_digits(mode, smoothing, expect):
         np.testing.assert_allclose(t.distance_mm, value, rtol=1e-12)
     else:
         np.testing.assert_allclose(t.deviation_mm, value, rtol=1e-12)
+
+
+@pytest.mark.parametrize("digit, expect_d", [
+    (0, "dyn"), (4, "tol"), (1, "dyn"), (5, "adis"), (3, "dyn")])
+def test_g644_digits_0_1_use_the_limit_only_where_the_dynamics_need_it(digit, expect_d):
+    """spec 5.6 (MD20480 thousands digit): "0xxx: Keep each axis within MD33100
+    COMPRESS_POS_TOL; if the dynamics allow, the tolerance is not fully used"; "4xxx:
+    Like 0xxx, but the tolerance is fully used where possible (the axis then stays
+    below its maximum dynamics)"; "1xxx: The rounding distance (ADIS/ADISPOS) is
+    given"; "5xxx: Like 1xxx, but the distance is fully used where possible"; 5.8:
+    "0xxx: same T_i [as 3xxx, the minimum dynamic time], but reduce v until e_i(T_i) <=
+    tol_i. The tolerance is then usually not fully used ... 4xxx: ... use the full
+    tolerance, with lower acceleration ... 1xxx / 5xxx: as 0xxx/4xxx, but the
+    constraint is the rounding distance". So 0xxx/1xxx round as 3xxx where that is
+    within the tolerance / ADIS, 4xxx/5xxx always use it.
+
+    By hand, BRISK, the 90 degree corners of the square at F60 (v = 1 mm/s, T_ipo =
+    4 ms, A = 2000 mm/s^2): the 3xxx arc is R = max(v^2 / (0.75 A), v T_ipo / theta) =
+    max(6.7e-4, 0.004 / (pi/2)) = 2.546e-3 mm (its one IPO cycle binds), d = R
+    tan(45 deg) = R, deviating by d tan(22.5 deg) = 1.05e-3 mm per corner, below the
+    tolerance (|C - M| = 0.01 sqrt(2), d = 0.0341 mm) and ADIS = 0.4 mm. 0xxx, 1xxx and
+    3xxx give the dynamic rounding, 4xxx the tolerance's, 5xxx ADIS."""
+    text = square("G644 ADIS=0.4").replace("F3000", "F60")
+    _, _, path = rounded(text, machine(1.0, SMOOTHING_MODE=1000 * digit))
+    t = path.rounding
+    assert t.inserted.all()
+    r_dyn = max(1.0 / (0.75 * 2000.0), 0.004 / (math.pi / 2))
+    assert r_dyn == pytest.approx(2.546e-3, rel=1e-3)
+    d = {"dyn": r_dyn, "tol": 0.01 * math.sqrt(2) / math.tan(math.pi / 8),
+         "adis": 0.4}[expect_d]
+    np.testing.assert_allclose(t.distance_mm, d, rtol=1e-12)
+    if expect_d == "dyn":
+        assert (t.deviation_mm < 0.01 * math.sqrt(2) / 10).all()    # not fully used
 
 
 # the hand numbers of the G644 2xxx/3xxx tests: the test machine at F3000 round a 90
@@ -610,11 +648,72 @@ def test_a_marginal_rounding_that_would_lose_time_is_not_inserted():
     prog = parse_text(square("G642"))
     path = build_path(prog, mach)
     assert reasons(path) == ["rounding would be slower than G64"] * 3
-    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
-    assert not forced.rounding.inserted.any()          # the time check is not the ovl one
     # the same roundings, inserted (as on a machine where G64 must stop) and planned on
     # this machine: slower than the sharp corners
     t_sharp = plan(prog, mach, path=path).time_s
     rounded_path = build_path(prog, machine(ovl=1.0))
     assert rounded_path.rounding.inserted.all()
     assert plan(prog, mach, path=rounded_path).time_s > t_sharp
+
+
+@pytest.mark.parametrize("mode", ["G641 ADIS=0.05", "G642", "G645"])
+def test_ignore_ovl_factor_for_adis_rounds_where_rounding_loses_time(mode):
+    """spec 4.3: "A transition is rounded only if it cannot be passed at G64 speed
+    without a reduction. Rounding would otherwise lengthen the program. ... This check
+    applies to G641/G642 only. G643 ignores the overload factor. Setting MD20490
+    IGNORE_OVL_FACTOR_FOR_ADIS = TRUE makes G641/G642 behave like G643 here (always
+    round)"; 5.8: "Insert the rounding only if v_corner_G64 < min(F, v_round), unless
+    MD20490 = TRUE or the mode is G643" (G645 "at corners rounds like G642", 5.7). The
+    corners of the previous test (not worth rounding on this machine) are rounded with
+    MD20490 = TRUE, and the program is then longer in time, as 4.3 says it would be:
+    the 90 degree arcs deviate by MD33100 per axis (|C - M| = 0.01 sqrt(2)) or, G641,
+    start ADIS = 0.05 mm before the corner."""
+    prog = parse_text(square(mode))
+    sharp = build_path(prog, machine())
+    assert not sharp.rounding.inserted.any()
+    forced = build_path(prog, machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    assert reasons(forced) == ["rounded"] * 3
+    t = forced.rounding
+    if mode.startswith("G641"):
+        np.testing.assert_allclose(t.distance_mm, 0.05, rtol=1e-12)
+    else:
+        np.testing.assert_allclose(t.deviation_mm, 0.01 * math.sqrt(2), rtol=1e-12)
+    mach = machine(IGNORE_OVL_FACTOR_FOR_ADIS=True)
+    assert plan(prog, mach, path=forced).time_s > plan(prog, mach, path=sharp).time_s
+
+
+def test_g643_rounds_where_rounding_loses_time():
+    """spec 5.5 (G643): "The overload factor is never taken into account"; 5.8: "...
+    unless MD20490 = TRUE or the mode is G643": the corners G642 leaves sharp on this
+    machine (previous tests) are rounded by G643 with the same tolerance (MD33100, the
+    units digit 0: |C - M| = 0.01 sqrt(2) on the 90 degree corners)."""
+    _, _, path = rounded(square("G643"), machine())
+    assert reasons(path) == ["rounded"] * 3
+    np.testing.assert_allclose(path.rounding.deviation_mm, 0.01 * math.sqrt(2), rtol=1e-12)
+
+
+@pytest.mark.parametrize("mode, spanned", [("G641 ADIS=0.5", None), ("G642", 8)])
+def test_ignore_ovl_keeps_no_rounding_block_between_two_very_short_blocks(mode, spanned):
+    """spec 5.2 group 2: "Rounding would slow the program down: between two very short
+    blocks (each block costs at least one IPO cycle, so an extra block could double the
+    time)"; 5.8 "If the blocks are too short (... less than one IPO cycle per block),
+    fall back to G64 [S1]" -- not waived by MD20490, which waives the overload check
+    only. By hand: 0.01 mm blocks at F3000 (50 mm/s) take 0.2 ms, less than one 4 ms
+    IPO cycle, so both blocks beside the corner are very short: G641 (one-block clamp,
+    d = 0.005 mm) keeps the corner sharp and names it. G642's window reaches across
+    the short blocks (d = 0.0341 mm, 8 blocks: spanned ones are not interpolated, one
+    rounding block replaces six), so no block is added and it is rounded."""
+    steps = ("G17 G90 {} F3000\nG1 X0 Y0\n" + "\n".join(
+        [f"X{0.01 * i:.2f}" for i in range(1, 11)] + [f"Y{0.01 * i:.2f}" for i in range(1, 11)])
+        + "\n")
+    _, _, path = rounded(steps.format(mode), machine(IGNORE_OVL_FACTOR_FOR_ADIS=True))
+    t = path.rounding
+    corner = [i for i in range(t.n) if t.reason_text(i) != "tangential transition"]
+    assert len(corner) == 1
+    i = corner[0]
+    assert 0.01 <= 50.0 * 0.004
+    if spanned is None:
+        assert t.reason_text(i) == (
+            "rounding would slow the program down (between two very short blocks)")
+    else:
+        assert t.reason_text(i) == "rounded" and t.blocks_spanned[i] == spanned

@@ -192,8 +192,10 @@ def test_tolerance_modes_keep_every_axis_within_compress_pos_tol(mode):
     assert reasons(path)[-1] == "rounded"
     t = path.rounding
     r = float(t.radius_mm[-1])
-    k = fillet_segment(path)
-    q = samples(path, k)
+    # G643 rounds inside the blocks: the fillet in two halves, one per block (spec 5.5)
+    ks = np.flatnonzero(path.kind == ROUNDING)
+    assert ks.size == (2 if mode == "G643" else 1)
+    q = np.concatenate([samples(path, int(k)) for k in ks])
     ind = independent(r, (-5.0, 0.0), 5.0, -1.0, (0.0, -8.0), 8.0, 1.0)
     # M on the fillet's radius towards C
     O = C + ind["O"]
@@ -482,3 +484,32 @@ def test_closed_form_radius_of_a_contour_deviation_between_a_line_and_a_circle()
         checked += 1
         same += got == pytest.approx(expect, rel=1e-9)
     assert checked > 100 and same >= 0.9 * checked
+
+
+@pytest.mark.parametrize("digit", [0, 4])
+def test_g644_0xxx_at_a_line_arc_corner_rounds_as_3xxx_within_the_tolerance(digit):
+    """spec 5.6: "0xxx: Keep each axis within MD33100 COMPRESS_POS_TOL; if the dynamics
+    allow, the tolerance is not fully used"; "4xxx: Like 0xxx, but the tolerance is
+    fully used where possible". At the line-arc corner of test_rounding_arcs (the line
+    y = 0 into the clockwise arc of radius 5 about (25, 0)), BRISK, F3000, MD33100 =
+    1 mm per axis: the 3xxx fillet has r = v^2 / (0.75 A) = 1.667 mm (by hand, as in the
+    3xxx test above) and its hand deviation stays within 1 mm on both axes, so 0xxx
+    takes that fillet; 4xxx the larger one whose deviation reaches 1 mm on an axis."""
+    from test_rounding_arcs import BASE, LINE_ARC
+    from test_rounding_arcs import hand as line_hand
+    r = V_F3000 ** 2 / (0.75 * A_TEST)
+    spec = copy.deepcopy(BASE)
+    spec["channel"].update(SMOOTHING_MODE=1000 * digit)
+    for ax in spec["axis"].values():
+        ax["COMPRESS_POS_TOL"] = 1.0
+    dev = line_hand(r)["deviation"]
+    assert dev < 1.0                                  # so every axis is within 1 mm
+    path = build_path(parse_text("G17 G90 G644 BRISK F3000\n" + LINE_ARC),
+                      machine_from_dict(spec))
+    t = path.rounding
+    assert reasons(path)[-1] == "rounded"
+    if digit == 0:
+        assert t.radius_mm[-1] == pytest.approx(r, rel=1e-12)
+        assert t.deviation_mm[-1] == pytest.approx(dev, rel=1e-9)
+    else:
+        assert t.radius_mm[-1] > r * 1.1 and t.deviation_mm[-1] > dev

@@ -28,6 +28,7 @@ from reference.core.geometry import KIND_CODES
 from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
+from reference.prepare import build_path
 from reference.rounding import corner_time_loss
 
 MACHINES = ("default", "linuxcnc_xyz")
@@ -58,17 +59,31 @@ def assert_not_slower(text_64: str, text: str, machine, what: str) -> int:
 @pytest.mark.parametrize("accel", ("BRISK", "SOFT"))
 @pytest.mark.parametrize("seed", (13, 7))
 def test_rounded_polyline_is_not_slower_than_g64(name, accel, seed):
-    """The benchmark's CAM-like polyline (600 blocks, two seeds) under G641, G642, G643,
-    G644 and G645 against G64, on each bundled machine, BRISK and SOFT."""
+    """The benchmark's CAM-like polyline (600 blocks, two seeds) under G641, G642, G644
+    and G645 against G64, on each bundled machine, BRISK and SOFT. (Not G643: it rounds
+    whatever G64 would cost, spec 4.3 and 5.8, :func:`test_g643_rounds_every_corner_of_
+    the_polyline`.)"""
     body = polyline(600, seed)
     m = load_machine(name)
     head = f"G90 {{}} {accel} F6000\nG1 X0 Y0\nG1 "
     total = 0
-    for mode in ("G641 ADIS=0.2", "G642", "G642 CTOL=0.02", "G645 CTOL=0.02", "G643",
-                 "G644"):
+    for mode in ("G641 ADIS=0.2", "G642", "G642 CTOL=0.02", "G645 CTOL=0.02", "G644"):
         total += assert_not_slower(head.format("G64") + body, head.format(mode) + body, m,
                                    f"{name} {accel} {mode}")
     assert total > 0                        # the case rounds somewhere
+
+
+@pytest.mark.parametrize("name", MACHINES)
+def test_g643_rounds_every_corner_of_the_polyline(name):
+    """spec 4.3: "G643 ignores the overload factor"; 5.8: "Insert the rounding only if
+    v_corner_G64 < min(F, v_round), unless MD20490 = TRUE or the mode is G643". On the
+    polyline (turns of 5..120 degrees, blocks of 0.5..5 mm, none crossed in one IPO
+    cycle at F6000) every corner is rounded, and the plan keeps
+    its limits, whatever it costs against G64."""
+    m = load_machine(name)
+    r = plan(parse_text("G90 G643 F6000\nG1 X0 Y0\nG1 " + polyline(600, 13), "t.mpf"), m)
+    tab = r.path.rounding
+    assert r.ok and tab.n == 599 and tab.inserted.all()
 
 
 #: Corpus programs with corners that the SINUMERIK parser reads once converted (the
@@ -139,6 +154,36 @@ def test_corner_time_loss_by_hand_soft_and_a_stop():
                              np.array([a]), np.array([a]), np.array([j]), np.array([j]),
                              np.array([0.3]), np.array([0.2]))
     assert never[0] == np.inf
+
+
+def test_corner_time_loss_counts_a_shortened_block_capped_by_its_ipo_cycle_by_hand():
+    """spec 5.3: "every block, the rounding block included, needs at least one
+    interpolation point". The part of a block the rounding leaves is still a block: a
+    0.0254 mm block cut to half (0.0127 mm) at T_ipo = 4 ms runs at most at 3.175 mm/s,
+    below the 6.35 mm/s of the whole block and below the 4.36 mm/s of a rounding
+    (BRISK, a = 2000 mm/s^2, l = 0.02 mm, d = 0.0127 mm). A ramp from there reaches
+    sqrt(3.175^2 + 2 a r) = 7.8 mm/s over the piece, so its cap binds: both pieces are
+    crossed at 3.175 mm/s, each side ramps 6.35 <-> 3.175, the rounding at 4.36 mm/s
+    (reached from 3.175 by its middle: sqrt(3.175^2 + a l) = 7.1 mm/s), and d + r of
+    each block is replaced. By hand; and a piece whose cap is above the block's speed
+    (1 ms: 12.7 mm/s) changes nothing. (lcnc_short_segments_0.001.ngc under G641
+    ADIS=0.05, default machine, BRISK: estimated 0.9 ms faster per corner without the
+    pieces, planned 3.9 ms slower.)"""
+    v_c, v_r, acc, l, d, r, t_ipo = 6.35, 4.36, 2000.0, 0.02, 0.0127, 0.0127, 0.004
+    cap = r / t_ipo
+    assert cap == pytest.approx(3.175) and math.sqrt(cap ** 2 + 2 * acc * r) > cap
+    hand = (2 * ((v_c - cap) ** 2 / (2 * acc * v_c) - (d + r) / v_c) + 2 * r / cap
+            + l / v_r)
+    one = np.array([1.0])
+    args = (v_c * one, v_c * one, v_r * one, acc * one, acc * one, np.inf * one,
+            np.inf * one, l * one, d * one, None)
+    got = corner_time_loss(*args, r * one, r * one, t_ipo)
+    assert got[0] == pytest.approx(hand, rel=1e-14)
+    plain = (2 * ((v_c - v_r) ** 2 / (2 * acc * v_c) - d / v_c) + l / v_r)
+    assert corner_time_loss(*args)[0] == pytest.approx(plain, rel=1e-14)
+    assert corner_time_loss(*args, r * one, r * one, 0.001)[0] == pytest.approx(plain,
+                                                                                 rel=1e-14)
+    assert got[0] > plain
 
 
 def test_a_g0_into_a_slow_feed_counts_the_rapid_side_at_rapid_speed():
@@ -291,3 +336,62 @@ def test_units_cut_at_their_cruise_are_planned_as_a_full_replan(monkeypatch):
     for name in ("t", "s", "v", "a", "j"):
         np.testing.assert_array_equal(getattr(r.profile, name), getattr(full.profile, name))
     assert r.time_s == full.time_s
+
+
+def test_small_soft_roundings_cost_time_on_the_default_machine_by_hand(monkeypatch):
+    """Issue 13 item 5: on the default SOFT machine (A = 2 m/s^2, J = 40 m/s^3, overload
+    factor 1.2, T_ipo = 4 ms) the seeded polyline under G641 ADIS=0.2 gets no rounding.
+    Spec 5.8's "G642 is much faster than G64 at sharp corners" is its BRISK example
+    (``v <= sqrt(8 tol A) / |dt_i|``); with this jerk every ramp at F6000 is jerk-limited
+    (A^2 / J = 100 mm/s = the feed), lasting about 2 sqrt(v / J) = 0.1 s whatever the
+    corner speed, so the corner speed buys little and the rounding's crawl costs much.
+
+    By hand, in the spec's own SOFT model (5.8, "each axis changes velocity by dv_i = v
+    |dt_i| with jerk J_i ... T_i = 2 sqrt(dv_i / J_i)", one common T, d = v T / 2), a 90
+    degree corner at F6000 (v_p = 100 mm/s, |dt_i| = 1), the full axis jerk: a ramp by
+    dv costs T dv / (2 v_p) = sqrt(dv^3 / J) / v_p against the programmed speed.
+
+    * G64: v = A (1.2 - 1) T_ipo = 1.6 mm/s, two ramps by 98.4 mm/s: 97.6 ms;
+    * rounding of distance d: entry speed v_r = (d^2 J)^(1/3) (T = 2 sqrt(v_r / J) =
+      2 d / v_r), two ramps by 100 - v_r, the rounding in 2 d / v_r instead of 2 d /
+      v_p: ADIS = 0.2 mm gives v_r = 11.7 mm/s and 113.2 ms, 15.6 ms slower; it pays
+      only from d = 0.80 mm on (ADIS = 2 mm: 64.6 ms).
+
+    The model agrees at ADIS = 0.2 ("rounding would be slower than G64"; its clothoid
+    pair, crossed at its jerk limit, 5.8 mm/s, slower than the axis-wise model's entry
+    speed), and so does its plan of the rounded corner. (The oracle's time-optimal
+    motion on the same paths: G64 0.5827 s, rounded at most 0.5987 s.)"""
+    from reference import rounding as rounding_stage
+    J, v_p = 40000.0, 100.0
+
+    def ramp(dv):
+        return math.sqrt(dv ** 3 / J) / v_p
+
+    def rounded(d):
+        v_r = (d * d * J) ** (1.0 / 3.0)
+        assert 2 * math.sqrt(v_r / J) == pytest.approx(2 * d / v_r, rel=1e-12)
+        return 2 * ramp(v_p - v_r) + 2 * d / v_r - 2 * d / v_p
+
+    g64 = 2 * ramp(v_p - 1.6)
+    assert g64 == pytest.approx(0.0976, abs=1e-4)
+    assert (0.2 * 0.2 * J) ** (1 / 3) == pytest.approx(11.70, abs=0.01)
+    assert rounded(0.2) - g64 == pytest.approx(0.0156, abs=1e-4)
+    assert rounded(2.0) == pytest.approx(0.0646, abs=1e-4)
+    lo, hi = 0.2, 2.0                               # the break-even distance
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if rounded(mid) > g64 else (lo, mid)
+    assert lo == pytest.approx(0.80, abs=0.005)
+    m = load_machine()
+    prog = parse_text("G90 G641 ADIS=0.2 SOFT F6000\nG1 X0 Y0\nG1 X20\nY20\n")
+    path = build_path(prog, m)
+    t = path.rounding
+    assert t.reason_text(0) == "rounding would be slower than G64"
+    assert t.v_g64[0] == pytest.approx(1.6, rel=1e-9)
+    assert t.v_round[0] < (0.2 * 0.2 * J) ** (1 / 3)
+    loss = rounding_stage.corner_time_loss
+    monkeypatch.setattr(rounding_stage, "corner_time_loss", lambda *a, **k: np.where(
+        np.asarray(a[7]) > 0, -np.inf, loss(*a, **k)))
+    forced = build_path(prog, m)
+    assert forced.rounding.inserted.all()
+    assert plan(prog, m, path=forced).time_s > plan(prog, m, path=path).time_s

@@ -119,10 +119,12 @@ def test_g641_g643_g644_keep_the_one_block_clamp(mode):
     """spec 5.3 (G641): "The rounding area is also limited by the block lengths"; 5.5
     (G643): "the rounding is carried out inside the original blocks"; G644 excerpt: the
     distance "cannot exceed half the length of the original participating blocks". d is
-    cut to half of one 0.01 mm block."""
+    cut to half of one 0.01 mm block. (G644 with SMOOTHING_MODE 4xxx, the tolerance
+    "fully used" (spec 5.6): with 0xxx at F60 the axes' dynamic rounding, d = 2.5e-3 mm,
+    is smaller than the clamp, test_rounding.py.)"""
     # F60: below the speed of a 0.005 mm rounding (5.2: it must not slow the program)
     prog = parse_text(steps(mode, feed="F60"))
-    path = build_path(prog, machine())
+    path = build_path(prog, machine(SMOOTHING_MODE=4000))
     t = path.rounding
     r = int(np.flatnonzero(t.inserted)[0])
     assert t.distance_mm[r] == pytest.approx(0.005, rel=1e-12)
@@ -180,9 +182,14 @@ def test_short_segments_program_under_g642(name):
     with G642 (converted by tests/reference/corpus_sinumerik.py): 3000 collinear 0.001 in blocks with
     two 90 degree corners. The tangential transitions are not rounded (spec 5.2 lists
     rounding only at angular transitions; G645's tangential rounding needs a curvature
-    jump, 5.7), so every 0.0254 mm block stays one interpolated block; where a corner is
-    rounded its window covers the short blocks within d, the path stays continuous, the
-    plan keeps every limit, and it is no slower than G64."""
+    jump, 5.7), so every 0.0254 mm block stays one interpolated block; the path stays
+    continuous, the plan keeps every limit, and it is no slower than G64. Where the
+    corners are rounded (the LinuxCNC machine, the next test) each window covers the
+    short blocks within d; on the default machine (SOFT, 4 ms) they are not: the
+    blocks run at 0.0254 mm / 4 ms = 6.35 mm/s, G64 passes at 1.6 mm/s and the
+    clothoid pair at 2.2 mm/s (jerk), so crawling its 0.08 mm costs more than the
+    shorter ramps save, and the plan of the rounded path says the same (12.185 s
+    against 12.063 s)."""
     mach = load_machine(name) if name else load_machine()
     prog = parse_text(SHORT(), "short_segments_g642.mpf")
     path = build_path(prog, mach)
@@ -196,9 +203,57 @@ def test_short_segments_program_under_g642(name):
     prog64 = parse_text(SHORT().replace("G642 G17", "G64 G17"))
     assert build_path(prog64, mach).rounding is None
     assert res.time_s <= plan(prog64, mach).time_s * (1 + 1e-9)
+    corners = [i for i in range(t.n) if not tangential[i]]
+    if name is None:
+        assert [t.reason_text(i) for i in corners] == [
+            "rounding would be slower than G64"] * 2
+    else:
+        assert t.inserted[corners].all()
     for i in np.flatnonzero(t.inserted):
         d = t.distance_mm[i]
         assert t.blocks_spanned[i] == 2 * math.ceil(d / 0.0254 - 1e-9)
+
+
+def test_short_segments_corners_pay_on_the_linuxcnc_machine_by_hand():
+    """Issue 13 item 4, "show the effect": the same program on the LinuxCNC machine
+    (BRISK, T_ipo = 1 ms, MAX_AX_ACCEL 0.762 m/s^2 on X, Y and Z, MAX_ACCEL_OVL_FACTOR
+    1.0, MD33100 0.01 mm by default). Spec 4.3: "A transition is rounded only if it
+    cannot be passed at G64 speed without a reduction"; 5.2 group 2: none where
+    "rounding would slow the program down"; 5.3: "every block ... needs at least one
+    interpolation point", so the 0.0254 mm blocks run at v_c = 0.0254 mm / 1 ms =
+    25.4 mm/s (not at the 203 mm/s of MAX_AX_VELO, which the decision used to ramp
+    from, and then estimated the rounding 0.4 ms slower per corner). By hand, per 90
+    degree corner (t1, t2 along two axes, plane weights 1):
+
+    * G64 stops (overload factor 1: no velocity jump): braking and accelerating at
+      a = 762 mm/s^2 cost v_c / (2 a) each, 33.333 ms;
+    * G642: d = 0.01 sqrt(2) / tan(22.5 deg) = 0.034142 mm (spec 5.4, 5.8; the arc
+      deviates by 0.01 mm per axis), R = d / tan(45 deg) = d, crossed at
+      v_r = sqrt(0.75 a R) = 4.4173 mm/s (the centripetal share); the ramps v_c <-> v_r
+      cost (v_c - v_r)^2 / (2 a v_c) each, the arc R pi / 2 at v_r less the 2 d it
+      replaces at v_c: 32.200 ms.
+
+    So each corner saves 1.1330 ms; the windows reach into the second block on each
+    side (d > 0.0254 mm: 4 blocks), and the plan is shorter than G64's by exactly the
+    two savings."""
+    mach = load_machine("linuxcnc_xyz")
+    prog = parse_text(SHORT(), "short_segments_g642.mpf")
+    path = build_path(prog, mach)
+    t = path.rounding
+    ins = np.flatnonzero(t.inserted)
+    assert ins.size == 2
+    d = 0.01 * math.sqrt(2.0) / math.tan(math.pi / 8)
+    np.testing.assert_allclose(t.distance_mm[ins], d, rtol=1e-12)
+    assert t.blocks_spanned[ins].tolist() == [4, 4]
+    v_c, acc = 0.0254 / 0.001, 762.0
+    v_r = math.sqrt(0.75 * acc * d)
+    np.testing.assert_allclose(t.v_round[ins], v_r, rtol=1e-12)
+    g64 = 2 * v_c / (2 * acc)
+    rounded = 2 * (v_c - v_r) ** 2 / (2 * acc * v_c) + d * math.pi / 2 / v_r - 2 * d / v_c
+    assert g64 - rounded == pytest.approx(1.1330e-3, abs=1e-7)
+    t_round = plan(prog, mach, path=path).time_s
+    t_g64 = plan(parse_text(SHORT().replace("G642 G17", "G64 G17")), mach).time_s
+    assert t_g64 - t_round == pytest.approx(2 * (g64 - rounded), rel=1e-9)
 
 
 def test_every_span_lies_on_its_segments_after_rounding():
