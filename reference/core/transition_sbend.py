@@ -36,7 +36,12 @@ the first arc's centre (``p = -y_Q`` each ramp's classical shift) and starts ``a
 (R1 + R2) sin theta + x_Q1 + x_Q2`` further along. The S of two symmetric clothoid pairs
 (turn ``h``, :func:`reference.core.transition.s_shift` with the rate ``c``) takes up
 ``lat`` sideways and ``2 d_p (1 + cos h)`` along; ``theta`` is the root of "the S's
-advance equals ``adv``" (one unknown per transition, solved by a safeguarded secant).
+advance equals ``adv``" (one unknown per transition). It is solved in the S's turn
+``h`` instead of ``theta`` (:func:`_turn_root`): for a given ``h`` the S's pieces,
+``d_p`` and ``lat`` are closed forms and so is the ``theta`` whose lines are ``lat``
+apart, so each step is one Fresnel evaluation and Newton's method has the exact
+derivative; where the ramps are long or the first bracket fails, by a safeguarded
+secant in ``theta`` (each step the fixed point of ``s_shift``).
 The rounding then is G2 continuous with both arcs and lands exactly; the first arc is
 shortened by ``theta R1 + L1/2``, the second by ``theta R2 + L2/2`` (both stay the exact
 programmed arcs). The curvature overshoot is the S's peak ``k_s = c L_s`` (about
@@ -63,8 +68,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import _fresnel, clothoid_rows
-from .transition import ramp_offset, s_shift
+from .geometry import _fresnel, clothoid_pair_shape, clothoid_rows
+from .transition import SOLVE_MAX_ITER, SOLVE_REL_TOL, ramp_offset
 
 #: Pieces per S-bend transition: ramp A, the S's four pieces, ramp B.
 SBEND_PIECES = 6
@@ -101,6 +106,12 @@ ROOT_MAX_ITER = 100
 #: of the heading).
 LANDING_TOL_MM = 1e-12
 THETA_TOL = 1e-15
+#: The turn ``h`` of the S (:func:`_turn_root`) also stops when its bracket is this
+#: narrow relative to ``h`` (round-off: the landing then misses by round-off too).
+TURN_REL_TOL = 4e-16
+#: The root is sought in the turn where the ramps are at most this long relative to the
+#: smaller radius, ``L / R = L^2 c`` (:func:`sbend_shape`).
+TURN_ROOT_MAX_RAMP = 0.1
 #: The rate aims at a deviation this much (relative) below the tolerance, and stops
 #: within half of it (the deviation itself is found to about 1e-13 relative), so the
 #: tolerance is used to 1.5e-9 and never exceeded.
@@ -163,11 +174,115 @@ class SBendShape:
 
 def _s_of(theta, r_in, r_out, rate, xq, yq):
     """The S for heading ``theta``: residual ``adv - advance`` (mm), ``L_s``, ``h``,
-    ``d_p``."""
+    ``d_p`` (:func:`_s_shift_each`, each transition's own fixed point)."""
     rr = r_in + r_out
     lat = 2.0 * rr * np.sin(0.5 * theta) ** 2 - yq
-    l_s, h, d_p = s_shift(lat, rate)
+    l_s, h, d_p = _s_shift_each(lat, rate)
     return rr * np.sin(theta) + xq - 2.0 * d_p * (1.0 + np.cos(h)), l_s, h, d_p
+
+
+def _s_shift_each(shift: np.ndarray, rate: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`reference.core.transition.s_shift` with each transition's fixed point
+    stopped on its own (there the batch stops at once): ``L_s``, ``h``, ``d_p``, mm,
+    rad, mm, shape (k,) each, what each transition gives alone."""
+    l_s = np.cbrt(shift / (2.0 * rate))
+    act = np.arange(l_s.size)
+    sa, ca, la = shift, rate, l_s
+    for _ in range(SOLVE_MAX_ITER):
+        h = ca * la * la
+        d_1, _ = clothoid_pair_shape(h)
+        step = np.cbrt(sa / (2.0 * la * d_1 * np.sin(h)))
+        la = la * step
+        go = ~(np.abs(step - 1.0) <= SOLVE_REL_TOL)
+        if not go.all():
+            l_s[act] = la
+            act, sa, ca, la = act[go], sa[go], ca[go], la[go]
+            if not act.size:
+                break
+    l_s[act] = la
+    h = rate * l_s * l_s
+    d_1, _ = clothoid_pair_shape(h)
+    return l_s, h, l_s * d_1
+
+
+def _s_of_turn(h, rr, rate, xq, yq):
+    """The S of turn ``h`` (rad, shape (m,)) and the heading it needs: the residual ``F =
+    adv - advance`` (mm), its derivative ``dF/dh`` (mm/rad), ``theta``, ``L_s``, ``d_p``.
+
+    The S of two symmetric pairs of turn ``h`` at rate ``c`` has pieces ``L_s = sqrt(h /
+    c)``, the tangent distance ``d_p = L_s d_1(h)`` and moves sideways by ``lat = 2 d_p
+    sin h``; the heading ``theta`` whose lines are that far apart follows from ``lat =
+    2 (R1 + R2) sin^2(theta/2) - y_Q`` in closed form, so the landing is one equation in
+    ``h`` with no inner fixed point (:func:`_s_of` has one per heading). Derivatives:
+    ``d_p' = d_p / (2 h) + L_s d_1'(h)`` (``d_1'`` in closed form,
+    :func:`_pair_distance_slope`), ``lat' = 2 (d_p' sin h + d_p cos h)``, ``d(rr sin
+    theta) = lat' cot(theta) dh`` (from ``rr sin(theta) dtheta = dlat``) and
+    ``advance' = 2 d_p' (1 + cos h) - 2 d_p sin h``."""
+    l_s = np.sqrt(h / rate)
+    d_1, e_1 = clothoid_pair_shape(h)
+    d_p = l_s * d_1
+    sin_h, cos_h = np.sin(h), np.cos(h)
+    lat = 2.0 * d_p * sin_h
+    u = np.clip((lat + yq) / (2.0 * rr), 0.0, 1.0)            # sin^2(theta/2)
+    theta = 2.0 * np.arcsin(np.sqrt(u))
+    sin_t, cos_t = np.sin(theta), np.cos(theta)
+    f = rr * sin_t + xq - 2.0 * d_p * (1.0 + cos_h)
+    dd_p = 0.5 * d_p / h + l_s * _pair_distance_slope(h, d_1, e_1)
+    dlat = 2.0 * (dd_p * sin_h + d_p * cos_h)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        df = dlat * cos_t / sin_t - 2.0 * dd_p * (1.0 + cos_h) + 2.0 * d_p * sin_h
+    return f, df, theta, l_s, d_p
+
+
+def _pair_distance_slope(h: np.ndarray, d_1: np.ndarray, e_1: np.ndarray) -> np.ndarray:
+    """``d_1'(h)``, the derivative of the unit pair's tangent distance
+    (:func:`reference.core.geometry.clothoid_pair_shape`, ``d_1``, ``e_1`` its values at
+    ``h``): ``d_1 = X + Y tan(h/2)`` with ``X = int_0^1 cos(h t^2/2) dt``, ``Y = int_0^1
+    sin(h t^2/2) dt`` (``Y = e_1 cos(h/2)``); integrating ``t^2 sin`` and ``t^2 cos`` by
+    parts, ``X' = (cos(h/2) - X) / (2 h)`` and ``Y' = (sin(h/2) - Y) / (2 h)``
+    (relative error ``~eps / h^2`` from the cancellation in ``cos(h/2) - X``; it only
+    slows Newton's method, whose root is the residual's)."""
+    ch, sh, th = np.cos(0.5 * h), np.sin(0.5 * h), np.tan(0.5 * h)
+    y = e_1 * ch
+    x = d_1 - y * th
+    return (ch - x) / (2.0 * h) + (sh - y) / (2.0 * h) * th + 0.5 * y / (ch * ch)
+
+
+def _turn_root(rr, rate, xq, yq, lo, hi, f_lo, f_hi):
+    """The S's turn ``h`` in ``[lo, hi]`` (``F(lo) < 0 < F(hi)``, :func:`_s_of_turn`)
+    where the S lands: Newton steps from the secant point, kept inside a bracket that
+    each value's sign shrinks (a step leaving it bisects instead), each transition until
+    ``|F| <= LANDING_TOL_MM`` or its bracket is round-off of ``h``; a transition that is
+    done is no longer moved (each is what it would be alone). Returns ``h`` and whether
+    it converged within :data:`ROOT_MAX_ITER` steps, shape (m,) each.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    h = np.where((h > lo) & (h < hi), h, 0.5 * (lo + hi))
+    out = h.copy()
+    conv = np.ones(h.size, bool)
+    act = np.arange(h.size)
+    cols = (rr, rate, xq, yq)
+    for _ in range(ROOT_MAX_ITER):
+        f, df = _s_of_turn(h, *cols)[:2]
+        lo = np.where(f < 0, h, lo)
+        hi = np.where(f < 0, hi, h)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nxt = h - f / df
+        nxt = np.where((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+        stop = (np.abs(f) <= LANDING_TOL_MM) | (hi - lo <= TURN_REL_TOL * h)
+        h = np.where(stop, h, nxt)
+        if stop.any():
+            out[act] = h
+            go = ~stop
+            act, h, lo, hi = act[go], h[go], lo[go], hi[go]
+            cols = tuple(c[go] for c in cols)
+            if not act.size:
+                break
+    out[act] = h
+    conv[act] = False
+    return out, conv
 
 
 def _illinois(f, lo, hi, f_lo, f_hi, tol, ftol):
@@ -556,29 +671,48 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     xq, yq = xq1 + xq2, yq1 + yq2
     lo = np.zeros_like(rate)
     hi = np.minimum(THETA_GUESS * (l1 + l2) / (r_in + r_out), THETA_MAX)
-    f_lo = _s_of(lo, r_in, r_out, rate, xq, yq)[0]
-    f_hi = _s_of(hi, r_in, r_out, rate, xq, yq)[0]
+    # the bracket's ends (headings 0 and hi): the residual and the S's turn there
+    f_lo, l_s, h, d_p = _s_of(lo, r_in, r_out, rate, xq, yq)
+    f_hi, _, h_hi, _ = _s_of(hi, r_in, r_out, rate, xq, yq)
     wide = ~(f_hi > 0)
     if wide.any():
-        hi = np.where(wide, THETA_MAX, hi)
-        f_hi = np.where(wide, _s_of(hi, r_in, r_out, rate, xq, yq)[0], f_hi)
+        w = np.flatnonzero(wide)
+        hi[w] = THETA_MAX
+        f_hi[w], _, h_hi[w], _ = _s_of(hi[w], r_in[w], r_out[w], rate[w], xq[w], yq[w])
     ok = (f_lo < 0) & (f_hi > 0)
     theta = np.full_like(rate, np.nan)
-    if ok.any():
-        sel = (r_in[ok], r_out[ok], rate[ok], xq[ok], yq[ok])
-        theta[ok] = _illinois(lambda t: _s_of(t, *sel)[0], lo[ok], hi[ok], f_lo[ok],
-                              f_hi[ok], THETA_TOL, LANDING_TOL_MM)
-    t = np.where(ok, theta, 0.0)
-    _, l_s, h, d_p = _s_of(t, r_in, r_out, rate, xq, yq)
+    # (where none lands, the S of heading 0, as it was)
+    # the root in the S's turn (_turn_root) where the first bracket holds, the ramps
+    # are short (there the residual has one root in it: none of 2783 seeded
+    # transitions with L/R <= 0.1 has two, on a grid of 401 headings) and the turns at
+    # its ends bracket the root below a quarter turn; elsewhere, and where it does not
+    # converge, the root in the heading (_illinois)
+    by_turn = np.flatnonzero(ok & ~wide & (l1 * rate * l1 <= TURN_ROOT_MAX_RAMP)
+                             & (h_hi > h) & (h_hi < THETA_MAX))
+    if by_turn.size:
+        i = by_turn
+        cols = (r_in[i] + r_out[i], rate[i], xq[i], yq[i])
+        # the bracket in the turn, its residuals as _s_of_turn has them
+        g_lo = _s_of_turn(h[i], *cols)[0]
+        g_hi = _s_of_turn(h_hi[i], *cols)[0]
+        fits = (g_lo < 0) & (g_hi > 0)
+        i, g_lo, g_hi = i[fits], g_lo[fits], g_hi[fits]
+        cols = tuple(c[fits] for c in cols)
+        h_i, conv = _turn_root(*cols, h[i], h_hi[i], g_lo, g_hi)
+        _, _, th_i, ls_i, dp_i = _s_of_turn(h_i, *cols)
+        i, h_i, th_i, ls_i, dp_i = (v[conv] for v in (i, h_i, th_i, ls_i, dp_i))
+        theta[i], h[i], l_s[i], d_p[i] = th_i, h_i, ls_i, dp_i
+    rest = np.flatnonzero(ok & np.isnan(theta))
+    if rest.size:
+        sel = (r_in[rest], r_out[rest], rate[rest], xq[rest], yq[rest])
+        theta[rest] = _illinois(lambda t: _s_of(t, *sel)[0], lo[rest], hi[rest],
+                                f_lo[rest], f_hi[rest], THETA_TOL, LANDING_TOL_MM)
+        _, l_s[rest], h[rest], d_p[rest] = _s_of(theta[rest], *sel)
     sh = SBendShape(r_in, r_out, rate, l1, l2, l_s, h, d_p, theta, theta * r_in + 0.5 * l1,
                     theta * r_out + 0.5 * l2, np.full_like(rate, np.nan),
                     l1 + l2 + 4.0 * l_s,
                     np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_s)))
-    if deviation and ok.any():
-        dev = np.full_like(rate, np.nan)
-        dev[ok] = sbend_deviation(take(sh, np.flatnonzero(ok)))
-        sh = _replace(sh, deviation=dev)
-    return sh
+    return sbend_measured(sh) if deviation and ok.any() else sh
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
@@ -600,6 +734,26 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
                               for v in (r_in, r_out, deviation))
     return size_for_deviation(sbend_shape, r_in, r_out, deviation, 0.5 * np.log(
         1.8 / (np.minimum(r_in, r_out) ** 3 * deviation)))
+
+
+def sbend_measured(sh: SBendShape) -> SBendShape:
+    """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
+    :func:`sbend_shape` returns with ``deviation=True`` for the same radii and rates
+    (its heading root is each transition's own, whatever the batch)."""
+    return _measured(sh, _canonical_pieces, -sh.r_out)
+
+
+def _measured(sh, pieces_of, centre_out: np.ndarray):
+    """``sh`` (a two-arc shape, ``theta`` nan where it does not land) with its
+    deviation measured by :func:`pieces_deviation` where it lands."""
+    ok = np.isfinite(sh.theta)
+    dev = np.full_like(sh.rate, np.nan)
+    if ok.any():
+        i = np.flatnonzero(ok)
+        part = take(sh, i)
+        dev[i] = pieces_deviation(pieces_of(part), part.r_in, part.r_out, centre_out[i])
+    return type(sh)(*(dev if f == "deviation" else getattr(sh, f)
+                      for f in type(sh).__slots__))
 
 
 def size_for_deviation(shape_of, r_in: np.ndarray, r_out: np.ndarray,
@@ -718,10 +872,6 @@ def scatter(sh, i: np.ndarray, part):
     return type(sh)(*out)
 
 
-def _replace(sh: SBendShape, **kw) -> SBendShape:
-    return SBendShape(*(kw.get(f, getattr(sh, f)) for f in SBendShape.__slots__))
-
-
 __all__ = ["SBEND_PIECES", "SBendShape", "pieces_deviation", "pieces_rows", "sbend_deviation",
-           "sbend_for_deviation", "sbend_rows", "sbend_shape", "scatter", "size_for_deviation",
-           "take"]
+           "sbend_for_deviation", "sbend_measured", "sbend_rows", "sbend_shape", "scatter",
+           "size_for_deviation", "take"]
