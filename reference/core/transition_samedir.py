@@ -88,13 +88,14 @@ Units: mm, rad. Shapes: ``k`` transitions.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from .geometry import clothoid_pair_shape
 from .transition import ramp_offset
 from .transition_sbend import (LANDING_TOL_MM, THETA_MAX, pieces_deviation, pieces_rows,
-                               size_for_deviation, take)
+                               ratio_guess, ratio_table, size_for_deviation, take)
 
 #: Pieces per transition: ramp A, the pair's two pieces, ramp B.
 SAMEDIR_PIECES = 4
@@ -104,12 +105,6 @@ NEWTON_MAX_ITER = 30
 #: A Newton step that would turn the pair backwards (or past THETA_MAX) is halved up to
 #: this many times.
 STEP_HALVINGS = 8
-#: First estimate of the rate: ``c^2 e R^3 ~ SAMEDIR_RATE_FACTOR / rho^2`` (``R =
-#: min(R1, R2)``, ``rho = max/min`` up to :data:`SAMEDIR_RATIO_CAP`; measured: 0.19 for
-#: ``rho -> 1``, 0.047 at 2, 0.0026 at 15, 0.19 with the pair on the sharper arc); the
-#: sizing iterates from it.
-SAMEDIR_RATE_FACTOR = 0.2
-SAMEDIR_RATIO_CAP = 16.0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -400,8 +395,10 @@ def _canonical_pieces(sh: SameDirShape):
 def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
                           ) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
-    :func:`reference.core.transition_sbend.size_for_deviation`, from ``c^2 e ~``
-    :data:`SAMEDIR_RATE_FACTOR`).
+    :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
+    of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
+    ``L/R = 0.01`` is 1.31 at ``rho`` = 1.2, 0.47 at 2, 0.14 at 4, 0.025 at 16, and 1.94
+    at 32, where the pair sits on the sharper arc).
 
     Parameters
     ----------
@@ -414,10 +411,16 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
-    lo, hi = np.minimum(r_in, r_out), np.maximum(r_in, r_out)
-    rho = np.where(hi / lo < SAMEDIR_RATIO_CAP, hi / lo, 1.0)
-    return size_for_deviation(samedir_shape, r_in, r_out, deviation, 0.5 * np.log(
-        SAMEDIR_RATE_FACTOR / (rho * rho * lo ** 3 * deviation)))
+    return size_for_deviation(samedir_shape, _canonical_pieces, r_out, r_in, r_out,
+                              deviation, ratio_guess(_samedir_table(), r_in, r_out,
+                                                     deviation))
+
+
+@lru_cache(maxsize=None)
+def _samedir_table() -> tuple[np.ndarray, np.ndarray]:
+    """:func:`reference.core.transition_sbend.ratio_table` of arcs curving the same way
+    (built once; its ratios avoid 1, where the two arcs are one circle)."""
+    return ratio_table(samedir_shape)
 
 
 def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,

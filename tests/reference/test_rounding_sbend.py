@@ -30,8 +30,10 @@ from scipy.integrate import quad
 
 from reference.core.geometry import clothoid_pair_shape
 from reference.core.transition_sbend import (TURN_ROOT_MAX_RAMP, _canonical_pieces,
-                                             _on_pieces, _packed, _pair_distance_slope,
-                                             sbend_for_deviation, sbend_rows, sbend_shape)
+                                             _deviation_where, _on_pieces, _packed,
+                                             _pair_distance_slope, _sbend_table,
+                                             ratio_guess, sbend_for_deviation, sbend_rows,
+                                             sbend_shape)
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
@@ -246,6 +248,47 @@ def test_the_s_lands_whichever_root_finds_its_turn(tau):
         assert x == pytest.approx(r2[i] * math.sin(b), abs=1e-8 * r2[i])
         assert y == pytest.approx(-r2[i] * (1 - math.cos(b)), abs=1e-8 * r2[i])
         assert heading == pytest.approx(-b, abs=1e-9)
+
+
+def test_the_first_estimate_follows_the_radius_ratio():
+    """The sizing's first rate (ratio_guess, from the model's own deviation at L/R =
+    0.01 against the radius ratio) is within 1 % of the rate sized (whose deviation the
+    ODE tests above check) where the ramps are short; the small-angle constant it
+    replaces (``c^2 e R^3 = 1.8``) is off by up to a factor 3 at ratios of 16."""
+    rng = np.random.default_rng(5)
+    r1, r2 = np.exp(rng.uniform(0, 6, 200)), np.exp(rng.uniform(0, 6, 200))
+    tol = np.exp(rng.uniform(np.log(1e-3), np.log(0.05), 200))
+    sh = sbend_for_deviation(r1, r2, tol)
+    short = sh.ramp_in / np.minimum(r1, r2) < 0.05
+    assert short.sum() > 80
+    guess = ratio_guess(_sbend_table(), r1, r2, tol)
+    assert (np.abs(guess - np.log(sh.rate))[short] < 0.01).all()
+    old = 0.5 * np.log(1.8 / (np.minimum(r1, r2) ** 3 * tol))
+    assert np.abs(old - np.log(sh.rate))[short].max() > 0.5
+
+
+def test_following_a_local_maximum_finds_the_full_search_value():
+    """The sizing's steps follow the largest distance from where the last search found
+    it (_deviation_where with ``near``): from the full search's place on the same shape
+    they find its value to round-off; on the plateau of the first case (two local
+    maxima ~1e-5 apart, test above) a search near the lower one finds that one, which
+    the full search at the answer then corrects (the sized deviation is the dense
+    maximum there, test above)."""
+    rng = np.random.default_rng(11)
+    r1, r2 = rng.uniform(5, 200, 50), rng.uniform(5, 200, 50)
+    sh = sbend_for_deviation(r1, r2, np.full(50, 0.02))
+    pieces = _canonical_pieces(sh)
+    full, at, _ = _deviation_where(pieces, r1, r2, -r2)
+    np.testing.assert_array_equal(full, sh.deviation)
+    near, at2, inside = _deviation_where(pieces, r1, r2, -r2, near=at)
+    assert inside.all()
+    np.testing.assert_allclose(near, full, rtol=1e-14, atol=0)
+    one = sbend_for_deviation([115.2], [177.7], [0.05])
+    pc = _canonical_pieces(one)
+    best, where, _ = _deviation_where(pc, one.r_in, one.r_out, -one.r_out)
+    # the lower maximum ~0.1 mm before the largest (the plateau)
+    low, _, _ = _deviation_where(pc, one.r_in, one.r_out, -one.r_out, near=where - 0.1)
+    assert best[0] * (1 - 1e-4) < low[0] < best[0] * (1 - 1e-7)
 
 
 # ------------------------------------------------------------------ on a rounded path
