@@ -875,7 +875,8 @@ def _measured(sh, pieces_of, centre_out: np.ndarray):
 
 
 def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.ndarray,
-                       r_out: np.ndarray, deviation: np.ndarray, log_rate: np.ndarray):
+                       r_out: np.ndarray, deviation: np.ndarray, log_rate: np.ndarray,
+                       canonical=None):
     """The transitions between two arcs whose rate makes them deviate by ``deviation``;
     the one sizing of every two-arc transition.
 
@@ -916,6 +917,10 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         mm (``deviation > 0``).
     log_rate : numpy.ndarray, shape (k,)
         ``log c`` of the first estimate (``c`` in 1/mm^2).
+    canonical : callable, optional
+        Where given, the steps build each shape ``like`` the one before
+        (``shape_of(..., like=...)``, a cheaper solve that may differ from the model's),
+        and ``canonical`` makes the answer's shape the model's before its full measure.
 
     Returns
     -------
@@ -949,13 +954,18 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
             break
         x[todo], x_old[todo], g_old[todo] = _secant_step(x[todo], gx[todo], x_old[todo],
                                                          g_old[todo])
-        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]), deviation=False)
+        like = {} if canonical is None else {"like": take(sh, todo)}
+        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]), deviation=False, **like)
         sh = scatter(sh, todo, _with_deviation(part, np.arange(todo.size),
                                                follow(todo, part)))
-    # the full search at each answer decides
+    # the full search at each answer (the model's shape) decides
     check = np.flatnonzero(~lost & (np.abs(gx) <= TRACK_REL_TOL))
     if check.size:
-        dev = _measure(take(sh, check), check, pieces, None)[0]
+        part = take(sh, check)
+        if canonical is not None:
+            part = canonical(part)
+            sh = scatter(sh, check, part)
+        dev = _measure(part, check, pieces, None)[0]
         sh = _with_deviation(sh, check, dev)
         lost[check] |= ~(np.abs(np.log(dev) - aim[check]) <= half)
     rest = np.flatnonzero(lost | ~(np.abs(gx) <= TRACK_REL_TOL))
