@@ -60,8 +60,8 @@ from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
                               transition_rows, transition_shape)
 from .core.transition_samedir import (SAMEDIR_PIECES, samedir_for_deviation,
                                       samedir_measured, samedir_rows, samedir_shape)
-from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_rows,
-                                    sbend_shape, scatter, take)
+from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_measured,
+                                    sbend_rows, sbend_shape, scatter, take)
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
@@ -293,7 +293,7 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
         for kind, sized, shape_of, measured, to_rows, n_p in (
-                (sbend, sbend_for_deviation, sbend_shape, _sbend_again, sbend_rows,
+                (sbend, sbend_for_deviation, sbend_shape, sbend_measured, sbend_rows,
                  SBEND_PIECES),
                 (samedir, samedir_for_deviation, samedir_shape, samedir_measured,
                  samedir_rows, SAMEDIR_PIECES)):
@@ -426,15 +426,6 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
-
-
-def _sbend_again(sh):
-    """The S-bends of ``sh`` built again at their rates, with the deviation: unlike the
-    same-way landing (:func:`reference.core.transition_samedir.samedir_measured`), the
-    S-bend's heading root is not quite each transition's own (the fixed point of
-    :func:`reference.core.transition.s_shift` stops for the whole batch at once), so
-    the batch it was built in could move it by round-off."""
-    return sbend_shape(sh.r_in, sh.r_out, sh.rate)
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,

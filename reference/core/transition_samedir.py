@@ -88,13 +88,15 @@ Units: mm, rad. Shapes: ``k`` transitions.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from .geometry import clothoid_pair_shape
 from .transition import ramp_offset
 from .transition_sbend import (LANDING_TOL_MM, THETA_MAX, pieces_deviation, pieces_rows,
-                               size_for_deviation, take)
+                               ratio_guess, ratio_table, scatter, size_for_deviation,
+                               take)
 
 #: Pieces per transition: ramp A, the pair's two pieces, ramp B.
 SAMEDIR_PIECES = 4
@@ -104,12 +106,6 @@ NEWTON_MAX_ITER = 30
 #: A Newton step that would turn the pair backwards (or past THETA_MAX) is halved up to
 #: this many times.
 STEP_HALVINGS = 8
-#: First estimate of the rate: ``c^2 e R^3 ~ SAMEDIR_RATE_FACTOR / rho^2`` (``R =
-#: min(R1, R2)``, ``rho = max/min`` up to :data:`SAMEDIR_RATIO_CAP`; measured: 0.19 for
-#: ``rho -> 1``, 0.047 at 2, 0.0026 at 15, 0.19 with the pair on the sharper arc); the
-#: sizing iterates from it.
-SAMEDIR_RATE_FACTOR = 0.2
-SAMEDIR_RATIO_CAP = 16.0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -242,15 +238,21 @@ def _start(r_in, r_out, ramp, rate, flat_out):
     return np.where(flat_out, 0.0, far), np.where(flat_out, far, 0.0)
 
 
-def _solve(r_in, r_out, ramp, rate, off):
+def _solve(r_in, r_out, ramp, rate, off, first=None):
     """The landing (module docstring): ``theta1, phi2``, the pair on the flatter arc
-    where that lands, else on the sharper one; nan where neither does."""
+    where that lands, else on the sharper one; nan where neither does. With ``first``
+    (bool, shape (k,): the pair on the second arc) that side is tried first, the other
+    only where it does not land: each attempt is the transition's own Newton iteration
+    from its side's start, so the result is the model's wherever the side tried first
+    is the flatter arc's or the flatter arc's does not land
+    (:func:`samedir_canonical`)."""
     flat_out = r_out > r_in
-    t1, p2 = _newton(r_in, r_out, ramp, rate, off, flat_out)
+    first = flat_out if first is None else first
+    t1, p2 = _newton(r_in, r_out, ramp, rate, off, first)
     lost = np.flatnonzero(np.isnan(t1))
     if lost.size:
         sel = (r_in[lost], r_out[lost], ramp[lost], rate[lost], tuple(o[lost] for o in off))
-        t1[lost], p2[lost] = _newton(*sel, ~flat_out[lost])
+        t1[lost], p2[lost] = _newton(*sel, ~first[lost])
     return t1, p2
 
 
@@ -329,7 +331,8 @@ def _halved(t1, p2, dt, dp):
 
 
 def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
-                  deviation: bool = True) -> SameDirShape:
+                  deviation: bool = True, like: SameDirShape | None = None
+                  ) -> SameDirShape:
     """The transition of rate ``rate`` between arcs of radii ``r_in``, ``r_out`` curving
     the same way.
 
@@ -339,6 +342,13 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
         mm, mm, 1/mm^2 (``r_in != r_out``).
     deviation : bool
         Also measure the deviation (else ``nan``).
+    like : SameDirShape, optional
+        The same transitions at a nearby rate: each tries first the side its pair sits
+        on there (:func:`_solve`; the sizing's steps, where a ratio beyond the flatter
+        arc's landing would otherwise let Newton's method wander for
+        :data:`NEWTON_MAX_ITER` steps at every rate). The result may then put the pair
+        on the sharper arc where the flatter one lands: :func:`samedir_canonical`
+        makes it the model's.
 
     Returns
     -------
@@ -349,7 +359,9 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     ramp = 1.0 / (np.minimum(r_in, r_out) * rate)
     xq1, yq1, _, _ = ramp_offset(r_in, ramp)
     xq2, yq2, _, _ = ramp_offset(r_out, ramp)
-    t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2))
+    first = None if like is None else np.where(np.isfinite(like.theta), _on_second(like),
+                                                r_out > r_in)
+    t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2), first)
     trim_in, trim_out = t1 * r_in + 0.5 * ramp, p2 * r_out + 0.5 * ramp
     ok = (trim_in > 0) & (trim_out > 0)
     t1, p2 = np.where(ok, t1, np.nan), np.where(ok, p2, np.nan)
@@ -360,6 +372,31 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
                       trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
                       np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
     return samedir_measured(sh) if deviation else sh
+
+
+def _on_second(sh: SameDirShape) -> np.ndarray:
+    """The pair sits on the second arc (the ramp onto it is the one far from ``J``: its
+    line is the farther from the common tangent, module docstring), shape (k,)."""
+    return np.abs(sh.theta) < np.abs(sh.phi)
+
+
+def samedir_canonical(sh: SameDirShape) -> SameDirShape:
+    """``sh`` (built ``like`` another shape, :func:`samedir_shape`) as the model has it:
+    where its pair sits on the sharper arc, the flatter arc's landing is tried (as
+    :func:`_solve` tries it first) and, where that lands, the transition is built
+    again; elsewhere ``sh`` is already the model's (the same iterations)."""
+    sharp = np.flatnonzero(np.isfinite(sh.theta) & (_on_second(sh) != (sh.r_out > sh.r_in)))
+    if not sharp.size:
+        return sh
+    r1, r2, c, ramp = sh.r_in[sharp], sh.r_out[sharp], sh.rate[sharp], sh.ramp_in[sharp]
+    xq1, yq1, _, _ = ramp_offset(r1, ramp)
+    xq2, yq2, _, _ = ramp_offset(r2, ramp)
+    t1, _ = _newton(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
+    again = sharp[np.isfinite(t1)]
+    if not again.size:
+        return sh
+    part = samedir_shape(sh.r_in[again], sh.r_out[again], sh.rate[again], deviation=False)
+    return scatter(sh, again, part)
 
 
 def samedir_measured(sh: SameDirShape) -> SameDirShape:
@@ -400,8 +437,10 @@ def _canonical_pieces(sh: SameDirShape):
 def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
                           ) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
-    :func:`reference.core.transition_sbend.size_for_deviation`, from ``c^2 e ~``
-    :data:`SAMEDIR_RATE_FACTOR`).
+    :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
+    of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
+    ``L/R = 0.01`` is 1.31 at ``rho`` = 1.2, 0.47 at 2, 0.14 at 4, 0.025 at 16, and 1.94
+    at 32, where the pair sits on the sharper arc).
 
     Parameters
     ----------
@@ -414,10 +453,17 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
-    lo, hi = np.minimum(r_in, r_out), np.maximum(r_in, r_out)
-    rho = np.where(hi / lo < SAMEDIR_RATIO_CAP, hi / lo, 1.0)
-    return size_for_deviation(samedir_shape, r_in, r_out, deviation, 0.5 * np.log(
-        SAMEDIR_RATE_FACTOR / (rho * rho * lo ** 3 * deviation)))
+    return size_for_deviation(samedir_shape, _canonical_pieces, r_out, r_in, r_out,
+                              deviation, ratio_guess(_samedir_table(), r_in, r_out,
+                                                     deviation),
+                              canonical=samedir_canonical)
+
+
+@lru_cache(maxsize=None)
+def _samedir_table() -> tuple[np.ndarray, np.ndarray]:
+    """:func:`reference.core.transition_sbend.ratio_table` of arcs curving the same way
+    (built once; its ratios avoid 1, where the two arcs are one circle)."""
+    return ratio_table(samedir_shape)
 
 
 def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
@@ -429,5 +475,6 @@ def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
     return pieces_rows(_canonical_pieces(sh), junction, along, inward, block, kind_code)
 
 
-__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_for_deviation", "samedir_measured",
+__all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_canonical", "samedir_for_deviation",
+           "samedir_measured",
            "samedir_rows", "samedir_shape"]

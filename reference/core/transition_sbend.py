@@ -36,7 +36,12 @@ the first arc's centre (``p = -y_Q`` each ramp's classical shift) and starts ``a
 (R1 + R2) sin theta + x_Q1 + x_Q2`` further along. The S of two symmetric clothoid pairs
 (turn ``h``, :func:`reference.core.transition.s_shift` with the rate ``c``) takes up
 ``lat`` sideways and ``2 d_p (1 + cos h)`` along; ``theta`` is the root of "the S's
-advance equals ``adv``" (one unknown per transition, solved by a safeguarded secant).
+advance equals ``adv``" (one unknown per transition). It is solved in the S's turn
+``h`` instead of ``theta`` (:func:`_turn_root`): for a given ``h`` the S's pieces,
+``d_p`` and ``lat`` are closed forms and so is the ``theta`` whose lines are ``lat``
+apart, so each step is one Fresnel evaluation and Newton's method has the exact
+derivative; where the ramps are long or the first bracket fails, by a safeguarded
+secant in ``theta`` (each step the fixed point of ``s_shift``).
 The rounding then is G2 continuous with both arcs and lands exactly; the first arc is
 shortened by ``theta R1 + L1/2``, the second by ``theta R2 + L2/2`` (both stay the exact
 programmed arcs). The curvature overshoot is the S's peak ``k_s = c L_s`` (about
@@ -48,7 +53,9 @@ form: it is sampled along the rounding (:data:`DEV_SAMPLES` per piece), the larg
 sample refined on finer grids around it (:data:`SCAN_ROUNDS`) and then by Newton steps
 on the distance's slope (:func:`pieces_deviation`). The rate ``c`` is the root of
 "deviation = tolerance" (the deviation grows like ``1/c^2``; Newton-secant steps in
-``log c``).
+``log c`` from a table of the model's own deviation against the radius ratio,
+:func:`ratio_table`), the steps measuring cheaply by following one local maximum and
+the answer by the full search (:func:`size_for_deviation`).
 
 Canonical frame (per transition): origin ``J``, ``x`` along the direction of travel,
 ``y`` towards the first arc's centre (so the centres are at ``(0, R1)`` and
@@ -60,11 +67,12 @@ Units: mm, rad. Shapes: ``k`` transitions, ``n`` axes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
-from .geometry import _fresnel, clothoid_rows
-from .transition import ramp_offset, s_shift
+from .geometry import _fresnel, clothoid_pair_shape, clothoid_rows
+from .transition import SOLVE_MAX_ITER, SOLVE_REL_TOL, ramp_offset
 
 #: Pieces per S-bend transition: ramp A, the S's four pieces, ramp B.
 SBEND_PIECES = 6
@@ -82,6 +90,9 @@ DEV_SAMPLES = 12
 SCAN_ROUNDS = 2
 REFINE_POINTS = 9
 REFINE_SHRINK = 4.0
+#: Samples per piece of the first, coarse search of the sizing (:func:`size_for_deviation`:
+#: it only has to find a local maximum to follow; the answer is measured in full).
+LOCATE_SAMPLES = 4
 #: Cap of the Newton steps on the distance's slope (3-6 in practice) and the step
 #: below which they stop, relative to the rounding's length (the maximum's value is then
 #: exact to round-off: it is flat to second order).
@@ -101,10 +112,23 @@ ROOT_MAX_ITER = 100
 #: of the heading).
 LANDING_TOL_MM = 1e-12
 THETA_TOL = 1e-15
+#: The turn ``h`` of the S (:func:`_turn_root`) also stops when its bracket is this
+#: narrow relative to ``h`` (round-off: the landing then misses by round-off too).
+TURN_REL_TOL = 4e-16
+#: The root is sought in the turn where the ramps are at most this long relative to the
+#: smaller radius, ``L / R = L^2 c`` (:func:`sbend_shape`).
+TURN_ROOT_MAX_RAMP = 0.1
 #: The rate aims at a deviation this much (relative) below the tolerance, and stops
 #: within half of it (the deviation itself is found to about 1e-13 relative), so the
 #: tolerance is used to 1.5e-9 and never exceeded.
 DEVIATION_REL_TOL = 1e-9
+#: A followed local maximum (:func:`size_for_deviation`) is taken to have met the aim
+#: when its ``log`` deviation is this close to it; the full measure at that rate then
+#: decides (it finds the same maximum to round-off, well inside the margin's half).
+TRACK_REL_TOL = 0.1 * DEVIATION_REL_TOL
+#: Steps of the sizing that follow a local maximum (4-6 in practice); a transition not
+#: settled by then is sized with the full search at every step.
+TRACK_MAX_ITER = 20
 #: Largest ``theta`` searched, rad: a larger one would mean a rounding that replaces
 #: more than a quarter turn of each arc (the block-length clamp acts long before).
 THETA_MAX = 0.5 * np.pi
@@ -114,6 +138,13 @@ THETA_MAX = 0.5 * np.pi
 THETA_GUESS = 16.0
 #: A rate for which no heading lands (pieces far too long) is raised by this factor.
 RATE_BRACKET_STEP = 4.0
+#: The table of the sizing's first estimate (:func:`ratio_table`): ``L/R`` of its
+#: transitions, its number of radius ratios and the largest ``|log rho|`` (a ratio of
+#: 1000); the small-angle S-bend value ``e c^2 R^3`` for ``R1 = R2`` where it has none.
+GUESS_RAMP = 0.01
+GUESS_POINTS = 96
+GUESS_MAX_LOG_RATIO = np.log(1000.0)
+GUESS_G = 1.8
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -163,11 +194,115 @@ class SBendShape:
 
 def _s_of(theta, r_in, r_out, rate, xq, yq):
     """The S for heading ``theta``: residual ``adv - advance`` (mm), ``L_s``, ``h``,
-    ``d_p``."""
+    ``d_p`` (:func:`_s_shift_each`, each transition's own fixed point)."""
     rr = r_in + r_out
     lat = 2.0 * rr * np.sin(0.5 * theta) ** 2 - yq
-    l_s, h, d_p = s_shift(lat, rate)
+    l_s, h, d_p = _s_shift_each(lat, rate)
     return rr * np.sin(theta) + xq - 2.0 * d_p * (1.0 + np.cos(h)), l_s, h, d_p
+
+
+def _s_shift_each(shift: np.ndarray, rate: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`reference.core.transition.s_shift` with each transition's fixed point
+    stopped on its own (there the batch stops at once): ``L_s``, ``h``, ``d_p``, mm,
+    rad, mm, shape (k,) each, what each transition gives alone."""
+    l_s = np.cbrt(shift / (2.0 * rate))
+    act = np.arange(l_s.size)
+    sa, ca, la = shift, rate, l_s
+    for _ in range(SOLVE_MAX_ITER):
+        h = ca * la * la
+        d_1, _ = clothoid_pair_shape(h)
+        step = np.cbrt(sa / (2.0 * la * d_1 * np.sin(h)))
+        la = la * step
+        go = ~(np.abs(step - 1.0) <= SOLVE_REL_TOL)
+        if not go.all():
+            l_s[act] = la
+            act, sa, ca, la = act[go], sa[go], ca[go], la[go]
+            if not act.size:
+                break
+    l_s[act] = la
+    h = rate * l_s * l_s
+    d_1, _ = clothoid_pair_shape(h)
+    return l_s, h, l_s * d_1
+
+
+def _s_of_turn(h, rr, rate, xq, yq):
+    """The S of turn ``h`` (rad, shape (m,)) and the heading it needs: the residual ``F =
+    adv - advance`` (mm), its derivative ``dF/dh`` (mm/rad), ``theta``, ``L_s``, ``d_p``.
+
+    The S of two symmetric pairs of turn ``h`` at rate ``c`` has pieces ``L_s = sqrt(h /
+    c)``, the tangent distance ``d_p = L_s d_1(h)`` and moves sideways by ``lat = 2 d_p
+    sin h``; the heading ``theta`` whose lines are that far apart follows from ``lat =
+    2 (R1 + R2) sin^2(theta/2) - y_Q`` in closed form, so the landing is one equation in
+    ``h`` with no inner fixed point (:func:`_s_of` has one per heading). Derivatives:
+    ``d_p' = d_p / (2 h) + L_s d_1'(h)`` (``d_1'`` in closed form,
+    :func:`_pair_distance_slope`), ``lat' = 2 (d_p' sin h + d_p cos h)``, ``d(rr sin
+    theta) = lat' cot(theta) dh`` (from ``rr sin(theta) dtheta = dlat``) and
+    ``advance' = 2 d_p' (1 + cos h) - 2 d_p sin h``."""
+    l_s = np.sqrt(h / rate)
+    d_1, e_1 = clothoid_pair_shape(h)
+    d_p = l_s * d_1
+    sin_h, cos_h = np.sin(h), np.cos(h)
+    lat = 2.0 * d_p * sin_h
+    u = np.clip((lat + yq) / (2.0 * rr), 0.0, 1.0)            # sin^2(theta/2)
+    theta = 2.0 * np.arcsin(np.sqrt(u))
+    sin_t, cos_t = np.sin(theta), np.cos(theta)
+    f = rr * sin_t + xq - 2.0 * d_p * (1.0 + cos_h)
+    dd_p = 0.5 * d_p / h + l_s * _pair_distance_slope(h, d_1, e_1)
+    dlat = 2.0 * (dd_p * sin_h + d_p * cos_h)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        df = dlat * cos_t / sin_t - 2.0 * dd_p * (1.0 + cos_h) + 2.0 * d_p * sin_h
+    return f, df, theta, l_s, d_p
+
+
+def _pair_distance_slope(h: np.ndarray, d_1: np.ndarray, e_1: np.ndarray) -> np.ndarray:
+    """``d_1'(h)``, the derivative of the unit pair's tangent distance
+    (:func:`reference.core.geometry.clothoid_pair_shape`, ``d_1``, ``e_1`` its values at
+    ``h``): ``d_1 = X + Y tan(h/2)`` with ``X = int_0^1 cos(h t^2/2) dt``, ``Y = int_0^1
+    sin(h t^2/2) dt`` (``Y = e_1 cos(h/2)``); integrating ``t^2 sin`` and ``t^2 cos`` by
+    parts, ``X' = (cos(h/2) - X) / (2 h)`` and ``Y' = (sin(h/2) - Y) / (2 h)``
+    (relative error ``~eps / h^2`` from the cancellation in ``cos(h/2) - X``; it only
+    slows Newton's method, whose root is the residual's)."""
+    ch, sh, th = np.cos(0.5 * h), np.sin(0.5 * h), np.tan(0.5 * h)
+    y = e_1 * ch
+    x = d_1 - y * th
+    return (ch - x) / (2.0 * h) + (sh - y) / (2.0 * h) * th + 0.5 * y / (ch * ch)
+
+
+def _turn_root(rr, rate, xq, yq, lo, hi, f_lo, f_hi):
+    """The S's turn ``h`` in ``[lo, hi]`` (``F(lo) < 0 < F(hi)``, :func:`_s_of_turn`)
+    where the S lands: Newton steps from the secant point, kept inside a bracket that
+    each value's sign shrinks (a step leaving it bisects instead), each transition until
+    ``|F| <= LANDING_TOL_MM`` or its bracket is round-off of ``h``; a transition that is
+    done is no longer moved (each is what it would be alone). Returns ``h`` and whether
+    it converged within :data:`ROOT_MAX_ITER` steps, shape (m,) each.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    h = np.where((h > lo) & (h < hi), h, 0.5 * (lo + hi))
+    out = h.copy()
+    conv = np.ones(h.size, bool)
+    act = np.arange(h.size)
+    cols = (rr, rate, xq, yq)
+    for _ in range(ROOT_MAX_ITER):
+        f, df = _s_of_turn(h, *cols)[:2]
+        lo = np.where(f < 0, h, lo)
+        hi = np.where(f < 0, hi, h)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nxt = h - f / df
+        nxt = np.where((nxt > lo) & (nxt < hi), nxt, 0.5 * (lo + hi))
+        stop = (np.abs(f) <= LANDING_TOL_MM) | (hi - lo <= TURN_REL_TOL * h)
+        h = np.where(stop, h, nxt)
+        if stop.any():
+            out[act] = h
+            go = ~stop
+            act, h, lo, hi = act[go], h[go], lo[go], hi[go]
+            cols = tuple(c[go] for c in cols)
+            if not act.size:
+                break
+    out[act] = h
+    conv[act] = False
+    return out, conv
 
 
 def _illinois(f, lo, hi, f_lo, f_hi, tol, ftol):
@@ -385,17 +520,18 @@ def _bracket_max(packed, a, b, first, start, r_in, r_out, centre_out):
     ``b``) the maximum is that end; else Newton steps on the slope from ``start``, kept
     inside a bracket that each step's slope sign shrinks (a step leaving it, or a point
     where the distance is not concave, bisects instead), until a step is below
-    :data:`NEWTON_STEP_TOL` of ``b``. Returns the value, shape (m,), and whether it
-    converged."""
+    :data:`NEWTON_STEP_TOL` of ``b``. Returns the value, whether it converged and where
+    (the distance from the rounding's start), shape (m,) each."""
     d_a, g_a, _ = _distance_slopes(packed, a, first, r_in, r_out, centre_out)
     d_b, g_b, _ = _distance_slopes(packed, b, first, r_in, r_out, centre_out)
     at_a = g_a <= 0
     at_b = ~at_a & (g_b >= 0)
     value = np.where(at_a, d_a, np.where(at_b, d_b, -np.inf))
+    where = np.where(at_a, a, b)
     inner = np.flatnonzero(~(at_a | at_b))
     done = np.ones(a.shape, dtype=bool)
     if not inner.size:
-        return value, done
+        return value, done, where
     pk, lo, hi = packed[inner], a[inner], b[inner]
     fi, r1, r2, c2 = first[inner], r_in[inner], r_out[inner], centre_out[inner]
     x = start[inner]
@@ -414,7 +550,8 @@ def _bracket_max(packed, a, b, first, start, r_in, r_out, centre_out):
             break
     value[inner] = _distance_slopes(pk, x, fi, r1, r2, c2)[0]
     done[inner] = conv
-    return value, done
+    where[inner] = x
+    return value, done, where
 
 
 def sbend_deviation(sh: SBendShape) -> np.ndarray:
@@ -452,28 +589,60 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
     r_in, r_out, centre_out : numpy.ndarray, shape (k,)
         Radii of the arcs and the canonical ``y`` of the second arc's centre, mm.
     """
+    return _deviation_where(pieces, r_in, r_out, centre_out)[0]
+
+
+def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
+                     scan=SCAN_ROUNDS):
+    """:func:`pieces_deviation` and where the largest distance was found (distance from
+    the rounding's start, mm), shape (k,) each.
+
+    ``samples`` per piece and ``scan`` rounds other than :data:`DEV_SAMPLES` and
+    :data:`SCAN_ROUNDS` make a coarser search (:data:`LOCATE_SAMPLES`, no scan: the
+    refinement then starts from the largest sample over ``+-`` its spacing), which
+    finds a local maximum, not always the largest.
+
+    With ``near`` (shape (k,), mm) the search is local instead: no samples and no scan,
+    the refinement alone (the window cut at the crossing, :func:`_bracket_max`) over
+    ``+-h`` around ``near``, ``h`` the sample spacing of the piece there divided by
+    :data:`REFINE_SHRINK` (one scan round's window): the local maximum a full search
+    found, followed to a nearby rate (:func:`size_for_deviation`), at a fraction of the
+    cost. It is the largest distance only where no other local maximum is higher, which
+    the sizing checks by a full search at its answer.
+
+    Returns the deviation, where it was found and whether that lies inside the last
+    window (a maximum at its end lies beyond it, which a search ``near`` misses)."""
     lengths = pieces[4]
     k, n_pieces = lengths.shape
-    s, sx, sy = _samples(pieces, DEV_SAMPLES)
-    dev = _distance(sx, sy, r_in, r_out, centre_out)
-    i = dev.argmax(axis=1)
     rows = np.arange(k)
-    best, at = dev[rows, i], s[rows, i]
     total = lengths.sum(axis=1)
-    h0 = lengths[rows, np.minimum(i // (DEV_SAMPLES + 1), n_pieces - 1)] / DEV_SAMPLES
     packed = _packed(pieces)
-    off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
-    h = h0
-    for _ in range(SCAN_ROUNDS):
-        x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
-        p = _on_pieces(packed, x, derivatives=False)
-        d = _distance(p[..., 0], p[..., 1], r_in, r_out, centre_out)
-        j = d.argmax(axis=1)
-        better = d[rows, j] > best
-        best = np.where(better, d[rows, j], best)
-        at = np.where(better, x[rows, j], at)
-        h = h / REFINE_SHRINK
+    if near is None:
+        s, sx, sy = _samples(pieces, samples)
+        dev = _distance(sx, sy, r_in, r_out, centre_out)
+        i = dev.argmax(axis=1)
+        best, at = dev[rows, i], s[rows, i]
+        h0 = lengths[rows, np.minimum(i // (samples + 1), n_pieces - 1)] / samples
+        off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
+        h = h0
+        for _ in range(scan):
+            x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
+            p = _on_pieces(packed, x, derivatives=False)
+            d = _distance(p[..., 0], p[..., 1], r_in, r_out, centre_out)
+            j = d.argmax(axis=1)
+            better = d[rows, j] > best
+            best = np.where(better, d[rows, j], best)
+            at = np.where(better, x[rows, j], at)
+            h = h / REFINE_SHRINK
+    else:
+        at = np.clip(near, 0.0, total)
+        piece = (at[:, None] >= np.cumsum(lengths, axis=1)[:, :-1]).sum(axis=1)
+        h0 = lengths[rows, piece] / DEV_SAMPLES
+        h = h0 / REFINE_SHRINK
+        best = np.full(k, -np.inf)
+    where = at.copy()
     lo, hi = np.maximum(at - h, 0.0), np.minimum(at + h, total)
+    win_lo, win_hi = lo, hi
     # the window's parts either side of the crossing, each with its circle
     ends = _on_pieces(packed, np.stack((lo, hi), axis=1), derivatives=False)[..., 0]
     split = np.flatnonzero((ends[:, 0] <= 0) & (ends[:, 1] > 0))
@@ -484,9 +653,15 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
     a = np.concatenate((lo, cross))
     b = np.concatenate((mid, hi[split]))
     first = np.concatenate((ends[:, 0] <= 0, np.zeros(split.size, dtype=bool)))
-    value, done = _bracket_max(packed[which], a, b, first, at[which], r_in[which],
-                               r_out[which], centre_out[which])
-    np.maximum.at(best, which, value)
+    value, done, at_value = _bracket_max(packed[which], a, b, first, at[which],
+                                         r_in[which], r_out[which], centre_out[which])
+    # where: the window's part with the larger value (the first part where they tie,
+    # as np.maximum.at keeps it)
+    for part in (slice(0, k), slice(k, None)):
+        rw = which[part]
+        up = value[part] > best[rw]
+        where[rw[up]] = at_value[part][up]
+        best[rw[up]] = value[part][up]
     ok = np.ones(k, dtype=bool)
     np.logical_and.at(ok, which, done)
     if not ok.all():
@@ -494,7 +669,7 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
         best[rest] = np.maximum(best[rest], _refine_sampled(
             packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
             centre_out[rest]))
-    return best
+    return best, where, (where > win_lo) & (where < win_hi)
 
 
 def _refine_sampled(packed: np.ndarray, at: np.ndarray, h: np.ndarray, best: np.ndarray,
@@ -556,36 +731,54 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     xq, yq = xq1 + xq2, yq1 + yq2
     lo = np.zeros_like(rate)
     hi = np.minimum(THETA_GUESS * (l1 + l2) / (r_in + r_out), THETA_MAX)
-    f_lo = _s_of(lo, r_in, r_out, rate, xq, yq)[0]
-    f_hi = _s_of(hi, r_in, r_out, rate, xq, yq)[0]
+    # the bracket's ends (headings 0 and hi): the residual and the S's turn there
+    f_lo, l_s, h, d_p = _s_of(lo, r_in, r_out, rate, xq, yq)
+    f_hi, _, h_hi, _ = _s_of(hi, r_in, r_out, rate, xq, yq)
     wide = ~(f_hi > 0)
     if wide.any():
-        hi = np.where(wide, THETA_MAX, hi)
-        f_hi = np.where(wide, _s_of(hi, r_in, r_out, rate, xq, yq)[0], f_hi)
+        w = np.flatnonzero(wide)
+        hi[w] = THETA_MAX
+        f_hi[w], _, h_hi[w], _ = _s_of(hi[w], r_in[w], r_out[w], rate[w], xq[w], yq[w])
     ok = (f_lo < 0) & (f_hi > 0)
     theta = np.full_like(rate, np.nan)
-    if ok.any():
-        sel = (r_in[ok], r_out[ok], rate[ok], xq[ok], yq[ok])
-        theta[ok] = _illinois(lambda t: _s_of(t, *sel)[0], lo[ok], hi[ok], f_lo[ok],
-                              f_hi[ok], THETA_TOL, LANDING_TOL_MM)
-    t = np.where(ok, theta, 0.0)
-    _, l_s, h, d_p = _s_of(t, r_in, r_out, rate, xq, yq)
+    # (where none lands, the S of heading 0, as it was)
+    # the root in the S's turn (_turn_root) where the first bracket holds, the ramps
+    # are short (there the residual has one root in it: none of 2783 seeded
+    # transitions with L/R <= 0.1 has two, on a grid of 401 headings) and the turns at
+    # its ends bracket the root below a quarter turn; elsewhere, and where it does not
+    # converge, the root in the heading (_illinois)
+    by_turn = np.flatnonzero(ok & ~wide & (l1 * rate * l1 <= TURN_ROOT_MAX_RAMP)
+                             & (h_hi > h) & (h_hi < THETA_MAX))
+    if by_turn.size:
+        i = by_turn
+        cols = (r_in[i] + r_out[i], rate[i], xq[i], yq[i])
+        # the bracket in the turn, its residuals as _s_of_turn has them
+        g_lo = _s_of_turn(h[i], *cols)[0]
+        g_hi = _s_of_turn(h_hi[i], *cols)[0]
+        fits = (g_lo < 0) & (g_hi > 0)
+        i, g_lo, g_hi = i[fits], g_lo[fits], g_hi[fits]
+        cols = tuple(c[fits] for c in cols)
+        h_i, conv = _turn_root(*cols, h[i], h_hi[i], g_lo, g_hi)
+        _, _, th_i, ls_i, dp_i = _s_of_turn(h_i, *cols)
+        i, h_i, th_i, ls_i, dp_i = (v[conv] for v in (i, h_i, th_i, ls_i, dp_i))
+        theta[i], h[i], l_s[i], d_p[i] = th_i, h_i, ls_i, dp_i
+    rest = np.flatnonzero(ok & np.isnan(theta))
+    if rest.size:
+        sel = (r_in[rest], r_out[rest], rate[rest], xq[rest], yq[rest])
+        theta[rest] = _illinois(lambda t: _s_of(t, *sel)[0], lo[rest], hi[rest],
+                                f_lo[rest], f_hi[rest], THETA_TOL, LANDING_TOL_MM)
+        _, l_s[rest], h[rest], d_p[rest] = _s_of(theta[rest], *sel)
     sh = SBendShape(r_in, r_out, rate, l1, l2, l_s, h, d_p, theta, theta * r_in + 0.5 * l1,
                     theta * r_out + 0.5 * l2, np.full_like(rate, np.nan),
                     l1 + l2 + 4.0 * l_s,
                     np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_s)))
-    if deviation and ok.any():
-        dev = np.full_like(rate, np.nan)
-        dev[ok] = sbend_deviation(take(sh, np.flatnonzero(ok)))
-        sh = _replace(sh, deviation=dev)
-    return sh
+    return sbend_measured(sh) if deviation and ok.any() else sh
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
                         ) -> SBendShape:
     """The S-bend transitions that deviate from the arcs by ``deviation``
-    (:func:`size_for_deviation` from the small-angle estimate ``c = sqrt(1.8 / (R^3
-    e))``, ``R = min(R1, R2)``, measured for ``R1 = R2``).
+    (:func:`size_for_deviation` from the first estimate :func:`ratio_guess`).
 
     Parameters
     ----------
@@ -598,12 +791,92 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
-    return size_for_deviation(sbend_shape, r_in, r_out, deviation, 0.5 * np.log(
-        1.8 / (np.minimum(r_in, r_out) ** 3 * deviation)))
+    return size_for_deviation(sbend_shape, _canonical_pieces, -r_out, r_in, r_out,
+                              deviation, ratio_guess(_sbend_table(), r_in, r_out, deviation))
 
 
-def size_for_deviation(shape_of, r_in: np.ndarray, r_out: np.ndarray,
-                       deviation: np.ndarray, log_rate: np.ndarray):
+@lru_cache(maxsize=None)
+def _sbend_table() -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ratio_table` of the S-bend (built once)."""
+    return ratio_table(sbend_shape)
+
+
+def ratio_table(shape_of) -> tuple[np.ndarray, np.ndarray]:
+    """The deviation of a two-arc transition against its radius ratio, the table of the
+    sizing's first estimate (:func:`ratio_guess`).
+
+    Every length of a transition scales like ``1/c`` and its deviation like their
+    square over the radius, so ``e c^2 R^3 = G(rho, L/R)`` (``R = min(R1, R2)``, ``rho
+    = R2/R1``, ``L = 1/(R c)``), nearly independent of ``L/R`` when that is small
+    (measured: 1e-3 relative from ``L/R`` = 0.003 to 0.03), but with ``rho`` by a
+    factor of ten and more (S-bends: 1.94 at ``rho`` = 1.2, 0.17 at 16). Built from the
+    model itself (``shape_of``, with its deviation) at ``L/R`` = :data:`GUESS_RAMP` on
+    :data:`GUESS_POINTS` ratios, ``log rho`` evenly from ``-GUESS_MAX_LOG_RATIO`` to
+    ``+GUESS_MAX_LOG_RATIO``; where one does not land, none (``nan``).
+
+    Returns
+    -------
+    log_rho, log_g : numpy.ndarray, shape (GUESS_POINTS,)
+    """
+    q = np.linspace(-GUESS_MAX_LOG_RATIO, GUESS_MAX_LOG_RATIO, GUESS_POINTS)
+    r_in = np.exp(np.minimum(-q, 0.0))          # the smaller radius is 1 mm
+    r_out = np.exp(np.minimum(q, 0.0))
+    r_in, r_out = r_in / np.minimum(r_in, r_out), r_out / np.minimum(r_in, r_out)
+    rate = np.full(q.size, 1.0 / GUESS_RAMP)
+    sh = shape_of(r_in, r_out, rate)
+    return q, np.log(sh.deviation * rate * rate)
+
+
+def ratio_guess(table: tuple[np.ndarray, np.ndarray], r_in: np.ndarray, r_out: np.ndarray,
+                deviation: np.ndarray) -> np.ndarray:
+    """First estimate of ``log c`` for the sizing (:func:`size_for_deviation`): ``e c^2
+    R^3 = G(rho)`` with ``G`` interpolated in ``log rho`` from ``table``
+    (:func:`ratio_table`, over the ratios that have a value; beyond its ends, its end
+    values; where none has one, the small-angle S-bend estimate :data:`GUESS_G`). Only
+    the number of steps depends on it, not the answer's accuracy.
+
+    Parameters
+    ----------
+    table : tuple
+        ``(log_rho, log_g)`` of :func:`ratio_table`.
+    r_in, r_out, deviation : numpy.ndarray, shape (k,)
+        mm.
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+        ``log c``, ``c`` in 1/mm^2.
+    """
+    q, log_g = table
+    fin = np.isfinite(log_g)
+    g = (np.interp(np.log(r_out / r_in), q[fin], log_g[fin]) if fin.any()
+         else np.full(r_in.shape, np.log(GUESS_G)))
+    return 0.5 * (g - np.log(np.minimum(r_in, r_out) ** 3 * deviation))
+
+
+def sbend_measured(sh: SBendShape) -> SBendShape:
+    """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
+    :func:`sbend_shape` returns with ``deviation=True`` for the same radii and rates
+    (its heading root is each transition's own, whatever the batch)."""
+    return _measured(sh, _canonical_pieces, -sh.r_out)
+
+
+def _measured(sh, pieces_of, centre_out: np.ndarray):
+    """``sh`` (a two-arc shape, ``theta`` nan where it does not land) with its
+    deviation measured by :func:`pieces_deviation` where it lands."""
+    ok = np.isfinite(sh.theta)
+    dev = np.full_like(sh.rate, np.nan)
+    if ok.any():
+        i = np.flatnonzero(ok)
+        part = take(sh, i)
+        dev[i] = pieces_deviation(pieces_of(part), part.r_in, part.r_out, centre_out[i])
+    return type(sh)(*(dev if f == "deviation" else getattr(sh, f)
+                      for f in type(sh).__slots__))
+
+
+def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.ndarray,
+                       r_out: np.ndarray, deviation: np.ndarray, log_rate: np.ndarray,
+                       canonical=None):
     """The transitions between two arcs whose rate makes them deviate by ``deviation``;
     the one sizing of every two-arc transition.
 
@@ -616,44 +889,164 @@ def size_for_deviation(shape_of, r_in: np.ndarray, r_out: np.ndarray,
     half of that margin: the result never exceeds ``deviation`` and is at most ``1.5
     DEVIATION_REL_TOL`` below it.
 
+    The steps measure cheaply: a coarse search at the first rate finds a local maximum
+    (:data:`LOCATE_SAMPLES`), and each later step follows it by the refinement alone
+    around the same fraction of the rounding's length (:func:`_deviation_where` with
+    ``near``: the shape changes little from one rate to the next, every length scales
+    about like ``1/c``), until it meets the aim to :data:`TRACK_REL_TOL`. A transition
+    is done only when the full search (:func:`pieces_deviation`) at that rate meets the
+    aim to half the margin: the answer's deviation is always the full search's, as
+    :func:`pieces_deviation` gives it for that shape. Where it does not (another local
+    maximum is higher), where the followed maximum leaves its window or the steps do
+    not settle in :data:`TRACK_MAX_ITER`, the transition is sized again by the steps
+    with the full search from the start (:func:`_size_in_full`, the sizing as it was).
+
     Parameters
     ----------
     shape_of : callable
-        ``shape_of(r_in, r_out, rate)``: the transitions of that rate, a frozen dataclass
-        with ``rate`` and ``deviation`` (``nan`` where none lands) among its fields,
-        shape (k,) each.
+        ``shape_of(r_in, r_out, rate, deviation=False)``: the transitions of that rate,
+        a frozen dataclass with ``rate``, ``theta`` (``nan`` where none lands) and
+        ``deviation`` among its fields, shape (k,) each, each transition's own
+        (not depending on the others in the batch).
+    pieces_of : callable
+        A shape of transitions that land -> their canonical pieces
+        (:func:`pieces_deviation`).
+    centre_out : numpy.ndarray, shape (k,)
+        Canonical ``y`` of the second arc's centre, mm.
     r_in, r_out, deviation : numpy.ndarray, shape (k,)
         mm (``deviation > 0``).
     log_rate : numpy.ndarray, shape (k,)
         ``log c`` of the first estimate (``c`` in 1/mm^2).
+    canonical : callable, optional
+        Where given, the steps build each shape ``like`` the one before
+        (``shape_of(..., like=...)``, a cheaper solve that may differ from the model's),
+        and ``canonical`` makes the answer's shape the model's before its full measure.
 
     Returns
     -------
-    The ``shape_of`` result of the rates found.
+    The ``shape_of`` result of the rates found, with the deviation.
     """
     aim = np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
+    half = 0.5 * DEVIATION_REL_TOL
     x = np.array(log_rate, dtype=np.float64)
-    sh = shape_of(r_in, r_out, np.exp(x))
-    gx = np.log(sh.deviation) - aim                   # nan: no landing heading
+    k = x.size
+    sh = shape_of(r_in, r_out, np.exp(x), deviation=False)
+    gx = np.full(k, np.nan)                  # log(deviation) - aim; nan: no landing
+    where = np.full(k, np.nan)               # the followed maximum's place / length
+    lost = np.zeros(k, bool)                 # to be sized in full (_size_in_full)
+    pieces = (pieces_of, centre_out, r_in, r_out)
+
+    def follow(i, part):
+        """Deviation of the shape ``part`` of transitions ``i`` where it lands, near
+        ``where`` (by the coarse search where none was found yet); writes gx, where and
+        lost."""
+        dev, at, inside = _measure(part, i, pieces, where[i])
+        where[i] = at
+        lost[i] |= ~inside
+        gx[i] = np.log(dev) - aim[i]
+        return dev
+
+    sh = _with_deviation(sh, np.arange(k), follow(np.arange(k), sh))
+    x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
+    for _ in range(TRACK_MAX_ITER):
+        todo = np.flatnonzero(~(np.abs(gx) <= TRACK_REL_TOL) & ~lost)
+        if not todo.size:
+            break
+        x[todo], x_old[todo], g_old[todo] = _secant_step(x[todo], gx[todo], x_old[todo],
+                                                         g_old[todo])
+        like = {} if canonical is None else {"like": take(sh, todo)}
+        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]), deviation=False, **like)
+        sh = scatter(sh, todo, _with_deviation(part, np.arange(todo.size),
+                                               follow(todo, part)))
+    # the full search at each answer (the model's shape) decides
+    check = np.flatnonzero(~lost & (np.abs(gx) <= TRACK_REL_TOL))
+    if check.size:
+        part = take(sh, check)
+        if canonical is not None:
+            part = canonical(part)
+            sh = scatter(sh, check, part)
+        dev = _measure(part, check, pieces, None)[0]
+        sh = _with_deviation(sh, check, dev)
+        lost[check] |= ~(np.abs(np.log(dev) - aim[check]) <= half)
+    rest = np.flatnonzero(lost | ~(np.abs(gx) <= TRACK_REL_TOL))
+    if rest.size:
+        sh = scatter(sh, rest, _size_in_full(shape_of, pieces_of, centre_out[rest],
+                                             r_in[rest], r_out[rest], aim[rest],
+                                             np.asarray(log_rate, np.float64)[rest]))
+    return sh
+
+
+def _size_in_full(shape_of, pieces_of, centre_out, r_in, r_out, aim, log_rate):
+    """:func:`size_for_deviation` with every step measured by the full search: the
+    steps from ``log_rate`` until ``log(deviation)`` is within half the margin of
+    ``aim`` (shape (k,) each), each only for the transitions not yet done."""
+    x = np.array(log_rate, dtype=np.float64)
+    pieces = (pieces_of, centre_out, r_in, r_out)
+    sh = shape_of(r_in, r_out, np.exp(x), deviation=False)
+    dev = _measure(sh, np.arange(x.size), pieces, None)[0]
+    sh = _with_deviation(sh, np.arange(x.size), dev)
+    gx = np.log(dev) - aim
     x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
     for _ in range(ROOT_MAX_ITER):
         todo = np.flatnonzero(~(np.abs(gx) <= 0.5 * DEVIATION_REL_TOL))
         if not todo.size:
             break
-        xs, gs = x[todo], gx[todo]
-        lost = np.isnan(gs)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            slope = (gs - g_old[todo]) / (xs - x_old[todo])
-        # the secant slope where it is sane (the deviation falls with the rate), else -2
-        slope = np.where((slope < -0.5) & (slope > -8.0), slope, -2.0)
-        step = np.where(lost, np.log(RATE_BRACKET_STEP), -gs / slope)
-        x_old[todo] = np.where(lost, x_old[todo], xs)
-        g_old[todo] = np.where(lost, g_old[todo], gs)
-        x[todo] = xs + step
-        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]))
-        sh = scatter(sh, todo, part)
-        gx[todo] = np.log(part.deviation) - aim[todo]
+        x[todo], x_old[todo], g_old[todo] = _secant_step(x[todo], gx[todo], x_old[todo],
+                                                         g_old[todo])
+        part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]), deviation=False)
+        dev = _measure(part, todo, pieces, None)[0]
+        sh = scatter(sh, todo, _with_deviation(part, np.arange(todo.size), dev))
+        gx[todo] = np.log(dev) - aim[todo]
     return sh
+
+
+def _secant_step(x, g, x_old, g_old):
+    """One step of the sizing in ``x = log c`` from ``(x, g)`` with the last point
+    ``(x_old, g_old)`` (shape (m,) each; ``g`` nan: no landing, the rate raised by
+    :data:`RATE_BRACKET_STEP`): the new ``x`` and the new last point."""
+    lost = np.isnan(g)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (g - g_old) / (x - x_old)
+    # the secant slope where it is sane (the deviation falls with the rate), else -2
+    slope = np.where((slope < -0.5) & (slope > -8.0), slope, -2.0)
+    step = np.where(lost, np.log(RATE_BRACKET_STEP), -g / slope)
+    return x + step, np.where(lost, x_old, x), np.where(lost, g_old, g)
+
+
+def _measure(part, i, pieces, near):
+    """Deviation of the two-arc shape ``part`` (of transitions ``i`` of the sizing,
+    ``pieces`` = (pieces_of, centre_out, r_in, r_out) of all) where it lands (``nan``
+    elsewhere), where it was found (a fraction of the rounding's length; ``near`` where
+    it does not land) and whether that is inside the search's window, shape (m,) each:
+    by the full search (``near`` None), else near the fractions ``near`` (shape (m,);
+    ``nan``: the coarse search)."""
+    pieces_of, centre_out, r_in, r_out = pieces
+    ok = np.isfinite(part.theta)
+    dev = np.full(i.size, np.nan)
+    at = np.full(i.size, np.nan) if near is None else near.copy()
+    inside = np.ones(i.size, bool)
+    modes = ((ok, {}),) if near is None else (
+        (ok & np.isnan(near), {"samples": LOCATE_SAMPLES, "scan": 0}),
+        (ok & ~np.isnan(near), None))
+    for sel, kw in modes:
+        sel = np.flatnonzero(sel)
+        if not sel.size:
+            continue
+        j = i[sel]
+        pc = pieces_of(take(part, sel))
+        total = pc[4].sum(axis=1)
+        kw = {"near": near[sel] * total} if kw is None else kw
+        d, s, ins = _deviation_where(pc, r_in[j], r_out[j], centre_out[j], **kw)
+        dev[sel], at[sel], inside[sel] = d, s / total, ins
+    return dev, at, inside
+
+
+def _with_deviation(sh, i: np.ndarray, dev: np.ndarray):
+    """``sh`` with the deviation of transitions ``i`` set to ``dev``."""
+    d = sh.deviation.copy()
+    d[i] = dev
+    return type(sh)(*(d if f == "deviation" else getattr(sh, f)
+                      for f in type(sh).__slots__))
 
 
 def sbend_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
@@ -718,10 +1111,6 @@ def scatter(sh, i: np.ndarray, part):
     return type(sh)(*out)
 
 
-def _replace(sh: SBendShape, **kw) -> SBendShape:
-    return SBendShape(*(kw.get(f, getattr(sh, f)) for f in SBendShape.__slots__))
-
-
 __all__ = ["SBEND_PIECES", "SBendShape", "pieces_deviation", "pieces_rows", "sbend_deviation",
-           "sbend_for_deviation", "sbend_rows", "sbend_shape", "scatter", "size_for_deviation",
-           "take"]
+           "sbend_for_deviation", "sbend_measured", "sbend_rows", "sbend_shape", "scatter",
+           "ratio_guess", "ratio_table", "size_for_deviation", "take"]

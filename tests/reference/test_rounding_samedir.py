@@ -31,8 +31,9 @@ from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
 from reference.core.transition import ramp_offset
 from reference.core.transition_samedir import (STEP_HALVINGS, THETA_MAX, _halved,
-                                               _newton, samedir_for_deviation,
-                                               samedir_measured, samedir_shape)
+                                               _newton, samedir_canonical,
+                                               samedir_for_deviation, samedir_measured,
+                                               samedir_shape)
 from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_text
 from reference.planner import plan
@@ -221,6 +222,29 @@ def test_each_landing_is_the_transitions_own_and_measured_later_alike():
     late = samedir_measured(samedir_shape(r1, r2, rate, deviation=False))
     for f in sh.__slots__:
         np.testing.assert_array_equal(getattr(late, f), getattr(sh, f))
+
+
+def test_a_shape_built_like_another_is_made_the_models():
+    """The sizing's steps build each shape ``like`` the one before (each transition tries
+    first the side its pair sat on), which skips the flatter arc's wandering landing at
+    ratios beyond its fold; samedir_canonical then makes it the model's: bit for bit
+    what samedir_shape gives, also where the hint is wrong (taken from rates far off,
+    where the pair may sit on the other arc)."""
+    rng = np.random.default_rng(9)
+    r1 = rng.uniform(2.0, 50.0, 80)
+    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, 80))
+    rate = np.exp(rng.uniform(np.log(2.0), np.log(300.0), 80)) / np.minimum(r1, r2) ** 2
+    want = samedir_shape(r1, r2, rate, deviation=False)
+    for factor in (1.0, 1.1, 0.3, 5.0):
+        like = samedir_shape(r1, r2, rate * factor, deviation=False)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            got = samedir_canonical(samedir_shape(r1, r2, rate, deviation=False,
+                                                  like=like))
+        for f in want.__slots__:
+            np.testing.assert_array_equal(getattr(got, f), getattr(want, f))
+    # the hints matter: some pairs sit on the sharper arc
+    on_sharp = (np.abs(want.theta) < np.abs(want.phi)) != (r2 > r1)
+    assert on_sharp[np.isfinite(want.theta)].any()
 
 
 # ------------------------------------------------------------------ on a rounded path

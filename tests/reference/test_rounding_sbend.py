@@ -26,8 +26,14 @@ from scipy.optimize import brentq
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.core.transition_sbend import (_canonical_pieces, _on_pieces, _packed,
-                                             sbend_for_deviation, sbend_rows, sbend_shape)
+from scipy.integrate import quad
+
+from reference.core.geometry import clothoid_pair_shape
+from reference.core.transition_sbend import (TURN_ROOT_MAX_RAMP, _canonical_pieces,
+                                             _deviation_where, _on_pieces, _packed,
+                                             _pair_distance_slope, _sbend_table,
+                                             ratio_guess, sbend_for_deviation, sbend_rows,
+                                             sbend_shape)
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
@@ -199,6 +205,90 @@ def test_points_on_the_pieces_are_the_clothoid_rows():
     np.testing.assert_allclose(p.reshape(-1, 2), q, rtol=0, atol=1e-12)
     np.testing.assert_allclose(t.reshape(-1, 2), dq, rtol=0, atol=1e-12)
     np.testing.assert_allclose(dd.reshape(-1, 2), ddq, rtol=0, atol=1e-9)
+
+
+def test_the_pair_distance_slope_is_the_derivative_of_its_integrals():
+    """Closed form (module _pair_distance_slope, used by the S's turn root): the unit
+    pair's tangent distance ``d_1 = X + Y tan(h/2)``, ``X = int_0^1 cos(h t^2/2) dt``,
+    ``Y = int_0^1 sin(h t^2/2) dt``, has ``d_1' = X' + Y' tan(h/2) + Y / (2 cos^2(h/2))``
+    with ``X'``, ``Y'`` the integrals of the integrands' ``h``-derivatives (by quadrature,
+    scipy): to ``1e-10`` relative, plus the closed form's cancellation ``~eps / h^2`` at
+    small turns (which only slows Newton's method there: its root is the residual's)."""
+    h = np.array([1e-4, 3e-3, 0.05, 0.3, 1.0, 1.5])
+    d_1, e_1 = clothoid_pair_shape(h)
+    got = _pair_distance_slope(h, d_1, e_1)
+    for hi, g in zip(h, got):
+        y = quad(lambda t: math.sin(hi * t * t / 2), 0, 1, epsabs=0, epsrel=1e-13)[0]
+        dx = quad(lambda t: -t * t / 2 * math.sin(hi * t * t / 2), 0, 1, epsabs=0,
+                  epsrel=1e-13)[0]
+        dy = quad(lambda t: t * t / 2 * math.cos(hi * t * t / 2), 0, 1, epsabs=0,
+                  epsrel=1e-13)[0]
+        ref = dx + dy * math.tan(hi / 2) + y / (2 * math.cos(hi / 2) ** 2)
+        assert g == pytest.approx(ref, rel=1e-10 + 1e-14 / hi ** 2)
+
+
+@pytest.mark.parametrize("tau", [0.003, 0.03, 0.09, 0.2])
+def test_the_s_lands_whichever_root_finds_its_turn(tau):
+    """Exactness at a given rate: the S's turn root (short ramps, L/R up to
+    TURN_ROOT_MAX_RAMP) and the heading root (longer ramps) both give shapes that,
+    integrated from their curvature profile alone, land on the second arc with its
+    tangent (hand geometry, as above), over seeded radius pairs."""
+    rng = np.random.default_rng(int(tau * 1000))
+    r1, r2 = rng.uniform(2.0, 200.0, 6), rng.uniform(2.0, 200.0, 6)
+    rate = 1.0 / (np.minimum(r1, r2) ** 2 * tau)
+    sh = sbend_shape(r1, r2, rate)
+    assert (tau <= TURN_ROOT_MAX_RAMP) == (float(sh.ramp_in[0] / min(r1[0], r2[0]))
+                                           <= TURN_ROOT_MAX_RAMP)
+    for i in range(6):
+        if not np.isfinite(sh.theta[i]):
+            continue
+        sol, total = integrate(sh, i)
+        x, y, heading = sol.y[:, -1]
+        b = float(sh.trim_out[i]) / r2[i]
+        assert x == pytest.approx(r2[i] * math.sin(b), abs=1e-8 * r2[i])
+        assert y == pytest.approx(-r2[i] * (1 - math.cos(b)), abs=1e-8 * r2[i])
+        assert heading == pytest.approx(-b, abs=1e-9)
+
+
+def test_the_first_estimate_follows_the_radius_ratio():
+    """The sizing's first rate (ratio_guess, from the model's own deviation at L/R =
+    0.01 against the radius ratio) is within 1 % of the rate sized (whose deviation the
+    ODE tests above check) where the ramps are short; the small-angle constant it
+    replaces (``c^2 e R^3 = 1.8``) is off by up to a factor 3 at ratios of 16."""
+    rng = np.random.default_rng(5)
+    r1, r2 = np.exp(rng.uniform(0, 6, 200)), np.exp(rng.uniform(0, 6, 200))
+    tol = np.exp(rng.uniform(np.log(1e-3), np.log(0.05), 200))
+    sh = sbend_for_deviation(r1, r2, tol)
+    short = sh.ramp_in / np.minimum(r1, r2) < 0.05
+    assert short.sum() > 80
+    guess = ratio_guess(_sbend_table(), r1, r2, tol)
+    assert (np.abs(guess - np.log(sh.rate))[short] < 0.01).all()
+    old = 0.5 * np.log(1.8 / (np.minimum(r1, r2) ** 3 * tol))
+    assert np.abs(old - np.log(sh.rate))[short].max() > 0.5
+
+
+def test_following_a_local_maximum_finds_the_full_search_value():
+    """The sizing's steps follow the largest distance from where the last search found
+    it (_deviation_where with ``near``): from the full search's place on the same shape
+    they find its value to round-off; on the plateau of the first case (two local
+    maxima ~1e-5 apart, test above) a search near the lower one finds that one, which
+    the full search at the answer then corrects (the sized deviation is the dense
+    maximum there, test above)."""
+    rng = np.random.default_rng(11)
+    r1, r2 = rng.uniform(5, 200, 50), rng.uniform(5, 200, 50)
+    sh = sbend_for_deviation(r1, r2, np.full(50, 0.02))
+    pieces = _canonical_pieces(sh)
+    full, at, _ = _deviation_where(pieces, r1, r2, -r2)
+    np.testing.assert_array_equal(full, sh.deviation)
+    near, at2, inside = _deviation_where(pieces, r1, r2, -r2, near=at)
+    assert inside.all()
+    np.testing.assert_allclose(near, full, rtol=1e-14, atol=0)
+    one = sbend_for_deviation([115.2], [177.7], [0.05])
+    pc = _canonical_pieces(one)
+    best, where, _ = _deviation_where(pc, one.r_in, one.r_out, -one.r_out)
+    # the lower maximum ~0.1 mm before the largest (the plateau)
+    low, _, _ = _deviation_where(pc, one.r_in, one.r_out, -one.r_out, near=where - 0.1)
+    assert best[0] * (1 - 1e-4) < low[0] < best[0] * (1 - 1e-7)
 
 
 # ------------------------------------------------------------------ on a rounded path
