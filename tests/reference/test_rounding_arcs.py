@@ -17,7 +17,6 @@ touches it from outside: |O - (25, 0)| = 5 + r, x = 25 - sqrt(25 + 10 r).
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
@@ -25,21 +24,14 @@ import pytest
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.machine import load_machine, machine_from_dict
+from reference.machine import load_machine
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
+from rounding_machines import rounding_machine
 
 ROUNDING = KIND_CODES.index("rounding")
 ARC = KIND_CODES.index("arc")
-BASE = {
-    "machine": {"name": "t", "ipo_cycle_ms": 4.0},
-    "channel": {"lookahead_blocks": 50, "acceleration_mode": "BRISK"},
-    "axis": {ax: {"MAX_AX_VELO": 30000.0, "MAX_AX_ACCEL": 2.0, "MAX_AX_JERK": 40.0,
-                  "MAX_ACCEL_OVL_FACTOR": 1.0, "LOOKAH_FREQUENCY": 20.0,
-                  "COMPRESS_POS_TOL": 0.01}
-             for ax in "XYZ"},
-}
 LINE_ARC = "G1 X0 Y0\nG1 X20\nG2 X30 Y0 I5 J0\n"
 #: The mirror image in time: the counter-clockwise arc about (5, 0) ends at (10, 0) going
 #: up, the line then runs along +x (a right turn; the fillet's centre (10 + 1.7082, -2)
@@ -50,9 +42,7 @@ ARC_LINE = "G1 X0 Y0\nG3 X10 Y0 I5 J0\nG1 X30\n"
 def machine(**channel):
     """G64 stops at every corner (overload factor 1.0): where the feed is low the
     rounding costs nothing and every parameterised corner is rounded."""
-    d = copy.deepcopy(BASE)
-    d["channel"].update(channel)
-    return machine_from_dict(d)
+    return rounding_machine(**channel)
 
 
 def reasons(path) -> list[str]:

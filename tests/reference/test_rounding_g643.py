@@ -14,35 +14,22 @@ under SOFT), which keeps every axis within MD33100.
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
 import pytest
 
 from reference.core.geometry import KIND_CODES
-from reference.machine import machine_from_dict
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
+from rounding_machines import rounding_machine
 
 ROUNDING = KIND_CODES.index("rounding")
-BASE = {
-    "machine": {"name": "t", "ipo_cycle_ms": 4.0},
-    "channel": {"lookahead_blocks": 50, "acceleration_mode": "BRISK"},
-    "axis": {ax: {"MAX_AX_VELO": 30000.0, "MAX_AX_ACCEL": 2.0, "MAX_AX_JERK": 40.0,
-                  "MAX_ACCEL_OVL_FACTOR": 1.0, "LOOKAH_FREQUENCY": 20.0,
-                  "COMPRESS_POS_TOL": 0.01}
-             for ax in "XYZ"},
-}
 
 
 def machine(tol: float = 0.01, **channel):
-    d = copy.deepcopy(BASE)
-    d["channel"].update(channel)
-    for ax in d["axis"].values():
-        ax["COMPRESS_POS_TOL"] = tol
-    return machine_from_dict(d)
+    return rounding_machine(tol, **channel)
 
 
 def square(mode: str, accel: str = "BRISK") -> str:

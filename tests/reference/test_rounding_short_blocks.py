@@ -12,7 +12,6 @@ G644 keep the one-block clamp.
 
 from __future__ import annotations
 
-import copy
 import math
 from pathlib import Path as FsPath
 
@@ -21,34 +20,22 @@ import pytest
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
-from reference.machine import load_machine, machine_from_dict
+from reference.machine import load_machine
 from corpus_sinumerik import short_segments_g642
-from reference.nc import parse_file, parse_text
+from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
+from rounding_machines import rounding_machine
 
 ROOT = FsPath(__file__).resolve().parents[2]
 SHORT = short_segments_g642     # the corpus program converted at test time
 ROUNDING = KIND_CODES.index("rounding")
 MEET_MM = 1e-9           # consecutive segments meet to this (test_path_continuity)
 
-BASE = {
-    "machine": {"name": "t", "ipo_cycle_ms": 4.0},
-    "channel": {"lookahead_blocks": 50, "acceleration_mode": "BRISK"},
-    "axis": {ax: {"MAX_AX_VELO": 30000.0, "MAX_AX_ACCEL": 2.0, "MAX_AX_JERK": 40.0,
-                  # 1.0: G64 must stop at every corner; where the rounding runs at the
-                  # feed (F60 below), it costs no speed and shortens the path, so every
-                  # corner is rounded and a test sees the geometry alone
-                  "MAX_ACCEL_OVL_FACTOR": 1.0, "LOOKAH_FREQUENCY": 20.0,
-                  "COMPRESS_POS_TOL": 0.01}
-             for ax in "XYZ"},
-}
 
 
 def machine(**channel):
-    d = copy.deepcopy(BASE)
-    d["channel"].update(channel)
-    return machine_from_dict(d)
+    return rounding_machine(**channel)
 
 
 def steps(mode: str, n: int = 10, step: float = 0.01, feed: str = "F3000") -> str:
