@@ -29,11 +29,14 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    piecewise monotone and each of its maximal monotone *stretches* contains at least one
    whole phase (a stretch ends only where a phase of the other sign begins; the motion
    starts and ends at rest), which lasts at least its effective duration ``>= g_P``.
-   Every bound below is on ``w``; ``v <= w + delta`` and ``w <= v + delta <= e + delta`` turn
-   them into bounds on ``v`` with the cell speeds raised by ``2 delta``, and by the
-   checker's standstill tolerance ``VEL_TOL_MM_S`` (the relaxation has ``b = 0`` at stops,
-   the checker accepts that speed there): ``hi = e_hi + 2 delta + VEL_TOL_MM_S``, ``lo``
-   alike.
+   Bounds carried along a stretch by the monotonicity of ``w`` (the running minima of
+   step 3, the valley's speed) are on ``w``; ``v <= w + delta`` and ``w <= v + delta <=
+   e + delta`` turn them into bounds on ``v`` with the cell speeds raised by ``2 delta``,
+   and all bounds by the checker's standstill tolerance ``VEL_TOL_MM_S`` (the relaxation
+   has ``b = 0`` at stops, the checker accepts that speed there). A cell's own bound on
+   ``v``, and the stretch's largest speed ``V`` (step 3), need no drift: ``hi = e_hi +
+   VEL_TOL_MM_S`` there, ``e_hi + 2 delta + VEL_TOL_MM_S`` where carried, ``lo`` (only
+   ever carried) ``e_lo + 2 delta + VEL_TOL_MM_S``.
 3. *One stretch.* A rising stretch from a valley ``a`` (in cell ``i``) to a peak ``p`` (in
    cell ``c``) has ``w(s) <= w(s') <= e(s') + delta`` for every ``s' in [s, p]``; with
    step 1, in each cell ``k`` strictly between ``i`` and ``c``:
@@ -417,7 +420,11 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     # step 2's drift, and the checker's standstill: at a stop it accepts up to
     # VEL_TOL_MM_S where the relaxation has b = 0
     slack = 2.0 * drift + VEL_TOL_MM_S
-    hi = env.hi + slack
+    # a cell's own bound on v needs the standstill tolerance only; bounds carried along
+    # a stretch by the monotonicity of w (the running minima, the valley's speed) also
+    # the drift (step 2)
+    hi = env.hi + VEL_TOL_MM_S
+    hi_m = env.hi + slack
     lo = np.minimum(env.lo, env.hi) + slack
     g = env.period
     with np.errstate(divide="ignore"):
@@ -436,7 +443,7 @@ def hump_plan(env: Envelope, drift: float = 0.0,
     # predecessor (kind, level, cell): compiled (optimal.freq.humps_kernel), the states
     # and costs of steps 3, 4 and 4b as plain loops
     from .humps_kernel import programme, unpack
-    valley, _, _, pv, pp, pc = programme(np.ascontiguousarray(s, np.float64), hi, lo,
+    valley, _, _, pv, pp, pc = programme(np.ascontiguousarray(s, np.float64), hi, hi_m, lo,
                                    np.ascontiguousarray(g, np.float64), turn_t,
                                    first.astype(np.int64), last.astype(np.int64),
                                    float(chain), HUMP_SLACK_LEVELS, HUMP_SPEED_RATIO,

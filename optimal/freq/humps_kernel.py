@@ -65,7 +65,8 @@ def unpack(x: int, NQ: int, K: int) -> tuple[int, int, int, int]:
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def programme(s: np.ndarray, hi: np.ndarray, lo: np.ndarray, g: np.ndarray,
+def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
+              g: np.ndarray,
               turn_t: np.ndarray, first: np.ndarray, last: np.ndarray, chain: float,
               levels: np.ndarray, ratio: float, n_speed: int):  # pragma: no cover - compiled
     """Costs and predecessors of every state of the turn programme.
@@ -74,8 +75,13 @@ def programme(s: np.ndarray, hi: np.ndarray, lo: np.ndarray, g: np.ndarray,
     ----------
     s : numpy.ndarray, shape (N + 1,)
         Cell ends, mm.
-    hi, lo : numpy.ndarray, shape (N,)
-        Speed bounds per cell, slack of step 2 included, mm/s (``lo <= hi``, ``hi > 0``).
+    hi : numpy.ndarray, shape (N,)
+        Speed bound everywhere in each cell, the checker's standstill tolerance
+        included, mm/s (``> 0``): a cell's own bound on ``v``.
+    hi_m, lo : numpy.ndarray, shape (N,)
+        The same and the bound at some point of each cell, with step 2's drift added
+        too: the bounds a stretch carries from cell to cell through the monotonicity of
+        ``w`` (``lo <= hi_m``).
     g : numpy.ndarray, shape (N,)
         Shortest phase per cell, s.
     turn_t : numpy.ndarray, shape (N,)
@@ -130,7 +136,7 @@ def programme(s: np.ndarray, hi: np.ndarray, lo: np.ndarray, g: np.ndarray,
         if c > 0:
             # rises ending in cell c, from valleys and cuts in cells i = c-1 .. first[c]
             R = 0.0               # cells i+1 .. c-1, at the monotone bounds
-            suf = hi[c]           # least bound over hi_c and lo of cells i+1 .. c-1
+            suf = hi_m[c]         # least bound over hi_c and lo of cells i+1 .. c-1
             gmin = g[c]
             lo_i = min(first[c], c - 1)
             for i in range(c - 1, lo_i - 1, -1):
@@ -188,9 +194,9 @@ def programme(s: np.ndarray, hi: np.ndarray, lo: np.ndarray, g: np.ndarray,
             # falls starting in cell c, to valleys and cuts in cells j = c+1 .. last[c]
             hi_j = max(last[c], c + 1)
             F = 0.0               # cells c+1 .. j-1
-            pre = hi[c]           # least bound over hi_c and lo of cells c+1 .. j-1
+            pre = hi_m[c]         # least bound over hi_c and lo of cells c+1 .. j-1
             F2 = 0.0              # cells c .. j-1, from a cut at cell c's start
-            pre2 = hi[c]
+            pre2 = hi_m[c]
             gmin = g[c]
             for j in range(c + 1, hi_j + 1):
                 gmin = min(gmin, g[j])

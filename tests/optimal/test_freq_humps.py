@@ -225,7 +225,9 @@ def test_single_corner_bound_is_sound_and_within_a_percent_of_a_hand_motion():
     assert T <= t_hand
     assert T >= t_hand / 1.01
     sol = optimal.solve(path, lim, bounds="acc+freq")
-    assert sol.lower_bound_s >= T
+    # the oracle runs the programme with its own verified upper bound (a little above
+    # t_hand), which sets the drift of step 2: a few 1e-9 of difference
+    assert sol.lower_bound_s >= T * (1 - 1e-7)
     # and the oracle's verified motion is as fast as the hand one to 0.1 % (measured:
     # 0.02 % slower: its adapted caps are not exactly the ramps of 1/f)
     assert sol.upper_bound_s <= t_hand * 1.001
