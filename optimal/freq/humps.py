@@ -509,7 +509,9 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     grid : Grid
         Nodes of the ``acc`` relaxation.
     t_upper : float
-        A verified upper bound of the minimum motion time (holds excluded), s.
+        A time (holds excluded), s: the bound holds for every motion no slower than it
+        (step 2's drift grows with it), so ``min(bound, t_upper)`` holds for every
+        motion; a verified upper bound of the minimum keeps that at the bound.
     beat : float
         The best lower bound known so far, s. The programme runs on coarse cells
         (:data:`HUMP_COARSE_CELL_TIME_REL`) first, and on fine ones, cut further where the

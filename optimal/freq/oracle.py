@@ -14,7 +14,9 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each; for
    ``jerk+freq`` where these leave the bracket open, the jerk optimum re-solved under caps
    adapted to its own short phases, :mod:`optimal.freq.jerk_adapted`), and the fastest
-   candidate per rest-to-rest piece, joined;
+   candidate per rest-to-rest piece, joined, the ramp plan of every straight piece among
+   them (:mod:`optimal.freq.ramps`: humps of ramps of at least ``1/f`` per segment,
+   S-curves for ``jerk+freq``);
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -42,9 +44,10 @@ from ..grid import grid_on
 from ..jerk.oracle import jerk_grid
 from .humps import humps_bound
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
-from .lower import freq_lower_bound, segment_periods
+from .lower import freq_lower_bound, rest_pieces, segment_periods
+from .ramps import ramp_plan
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
-                    line_pieces, pieced, scaled, verified)
+                    pieced, scaled, verified)
 
 ProgressFn = Callable[..., object]
 
@@ -173,8 +176,9 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                                   widen=widen, asymmetric=asym,
                                   progress=(lambda msg: progress(msg, 0.85))
                                   if progress else None)
-    # pieces start and end at rest: the fastest candidate on each, joined
-    joined = pieced(path, cands, line_pieces(path, limits) if base == "acc" else None)
+    # pieces start and end at rest: the fastest candidate on each, joined, the ramp plan
+    # of every straight piece among them (optimal.freq.ramps: S-curve ramps for jerk+freq)
+    joined = pieced(path, cands, ramp_plan(path, limits, jerk=base == "jerk"))
     if joined is not None:
         c = verified("fastest per piece", path, limits, joined, name)
         if c is not None:
@@ -188,9 +192,19 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         if progress:
             progress("frequency lower bound: where the motion turns", 0.9)
         tb = time.perf_counter()
+        # the programme holds for the motions no slower than t_up, so min(bound, t_up)
+        # for every motion, whatever t_up is: under jerk+freq the acc+freq motion of
+        # ramps (optimal.freq.ramps), where it covers the path, may stand in for the
+        # slower jerk+freq candidates (less drift in step 2, and the same as the acc+freq
+        # oracle takes where that motion is its upper bound, so that the jerk set's
+        # bound, with its segment floors, is not below it)
         t_up = min(c.duration for c in cands)
-        lb_humps = humps_bound(work, sub_lim, grid_on(work, acc.grid), t_up,
-                               lb - hold_t, base_sol.segment_lower_bounds_s)
+        if base == "jerk":
+            plan = ramp_plan(path, limits)
+            if plan and len(plan) == rest_pieces(work).shape[0]:
+                t_up = min(t_up, sum(p.duration for p in plan.values()))
+        lb_humps = min(humps_bound(work, sub_lim, grid_on(work, acc.grid), t_up,
+                                   lb - hold_t, base_sol.segment_lower_bounds_s), t_up)
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

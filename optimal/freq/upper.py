@@ -48,7 +48,6 @@ Units: mm, s.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +67,7 @@ from reference.core.rules import curvature_jump_speed_cap
 from .lower import path_rate_bounds, rest_pieces, segment_periods
 
 __all__ = ["Candidate", "ErodedPlan", "candidate_windows", "eroded_plans", "fir_filtered",
-           "line_pieces", "pieced", "scaled", "verified", "window_caps"]
+           "pieced", "scaled", "verified", "window_caps"]
 
 
 
@@ -154,65 +153,6 @@ def _scale_pieces(path: Path, prof: Profile, pieces: np.ndarray, lam_k: np.ndarr
                    block=prof.block)
 
 
-def line_pieces(path: Path, limits: MachineLimits) -> dict[int, Profile]:
-    """The fastest ``acc+freq`` motion of every rest-to-rest piece that is one straight
-    segment, in closed form.
-
-    On a line of length ``L`` the path acceleration is at most ``A = min_i A_i / |d_i|``
-    and the speed at most ``V = min(F, min_i V_i / |d_i|)`` (``d`` the unit direction).
-    A ramp to ``v`` is a phase; it lasts ``tau = max(1/f, v/A)`` at the fastest (each phase
-    at least ``1/f``, DESIGN 6), and as a constant acceleration its effective duration is
-    its duration. So the motion is a trapezoid of time ``L/v + tau(v)`` with ``v tau <= L``:
-    decreasing in ``v`` while ``tau = 1/f`` (up to ``v = A/f``, or ``L f``), then
-    ``L/v + v/A``, least at ``v = sqrt(L A)``. The closed form of DESIGN 6
-    (``L/v + 1/f`` for ``v/A < 1/f``) is its first branch.
-
-    Parameters
-    ----------
-    path : Path
-    limits : MachineLimits
-
-    Returns
-    -------
-    dict
-        Piece index (of :func:`optimal.freq.lower.rest_pieces`) to the motion on it (path
-        positions absolute, time from 0).
-    """
-    out: dict[int, Profile] = {}
-    moving = path.moving_axes()
-    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
-    lim = limits.for_axes(work.axes)
-    per = segment_periods(work, lim)
-    line = (work.radius * np.abs(work.omega) == 0) & (work.sharpness == 0)
-    for k, (lo, hi) in enumerate(rest_pieces(work)):
-        if hi - lo != 1 or not line[lo] or per[lo] <= 0:
-            continue
-        d = np.abs(work.d[lo])
-        L, g = float(work.length[lo]), float(per[lo])
-        with np.errstate(divide="ignore"):
-            A = float(np.min(np.where(d > 0, lim.a_max / d, np.inf)))
-            V = float(min(work.feed[lo], np.min(np.where(d > 0, lim.v_max / d, np.inf))))
-        if not (L > 0 and np.isfinite(A) and np.isfinite(V)):
-            continue
-        best = None
-        for v in (min(V, A * g, L / g), min(V, math.sqrt(L * A))):
-            tau = max(g, v / A)
-            if v <= 0 or v * tau > L * (1 + 1e-12):
-                continue
-            T = L / v + tau
-            if best is None or T < best[0]:
-                best = (T, v, tau)
-        if best is None:
-            continue
-        _, v, tau = best
-        cruise = max(L / v - tau, 0.0)
-        a = v / tau
-        blk = int(work.block[lo])
-        out[k] = Profile.from_phases([tau, cruise, tau], [a, 0.0, -a], [0.0, 0.0, 0.0],
-                                     s0=float(work.s_breaks[lo]), block=[blk] * 3)
-    return out
-
-
 def pieced(path: Path, candidates: list[Candidate],
            local: dict[int, Profile] | None = None) -> Profile | None:
     """The fastest candidate on each rest-to-rest piece, joined at the stops.
@@ -231,7 +171,8 @@ def pieced(path: Path, candidates: list[Candidate],
         Verified motions on ``path`` (holds excluded).
     local : dict, optional
         Motions of single pieces (piece index to profile over that piece alone, path
-        positions absolute), e.g. :func:`line_pieces`; they take part on their piece.
+        positions absolute), e.g. :func:`optimal.freq.ramps.ramp_plan`; they take
+        part on their piece.
 
     Returns
     -------

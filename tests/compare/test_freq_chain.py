@@ -2,10 +2,11 @@
 
 spec/oracle-formulations 1.9: "Relaxations: T*_acc <= T*_jerk <= T*_freq. Dropping
 constraints always gives a lower bound." So on the same path LB(acc) <= LB(jerk) <=
-LB(jerk+freq), and likewise through acc+freq (each bound set's bound is at least the previous one's: the jerk oracle
-starts from the acc bound, the freq oracle from the jerk bound) and, for the verified
-motions, UB(acc) <= UB(jerk) <= UB(jerk+freq) within the brackets: UB(acc) is at most
-the acc bracket above T*_acc <= T*_jerk <= UB(jerk), and likewise one step up.
+LB(jerk+freq) and LB(acc) <= LB(acc+freq) <= LB(jerk+freq), and for the verified motions
+UB(acc) <= UB(jerk) <= UB(jerk+freq), each within the brackets: every oracle stops once
+its bracket meets the requested gap, so its bounds are its optimum only to within that
+(UB(acc) is at most the acc bracket above T*_acc <= T*_jerk <= UB(jerk); LB(acc+freq) <=
+T*_acc+freq <= T*_jerk+freq <= LB(jerk+freq) + its bracket), and likewise one step up.
 Small programs keep this fast; the frequency check itself is check_profile's.
 """
 
@@ -42,7 +43,11 @@ def test_relaxation_chain(program, machine):
         lb = [sols[b].lower_bound_s for b in chain]
         ub = [sols[b].upper_bound_s for b in chain]
         gap = [sols[b].upper_bound_s - sols[b].lower_bound_s for b in chain]
-        assert lb[0] <= lb[1] <= lb[2], chain
+        # each set's optimum is at least the one before's (fewer constraints); its bounds
+        # are that within their own brackets: an oracle stops once its bracket meets the
+        # requested gap (lcnc_corner_decel: jerk+freq met 2 % with the jerk oracle's
+        # bound alone, 2e-5 s below the acc+freq bound's turn programme)
+        assert lb[0] <= lb[1] + gap[1] and lb[1] <= lb[2] + gap[2], chain
         assert ub[0] <= ub[1] + gap[0] and ub[1] <= ub[2] + gap[1], chain
         assert all(lo <= hi for lo, hi in zip(lb, ub))
     for b in ("acc+freq", "jerk+freq"):

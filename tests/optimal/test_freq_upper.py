@@ -139,18 +139,99 @@ def _xyz(v=500.0, a=2000.0, f=10.0):
     # ... and two ramps of exactly 1/f (peak L f) when they would not
     (1.0, 100.0, 2000.0, 10.0, 0.2),
 ])
-def test_line_pieces_closed_forms(L, F, a, f, expected):
-    """Rest-to-rest single lines: the closed forms of the fastest ``acc+freq`` motion, and
-    the checker accepts each."""
+def test_ramp_plan_closed_forms_on_single_lines(L, F, a, f, expected):
+    """Rest-to-rest single lines: the closed forms of the fastest ``acc+freq`` motion
+    (the ramp plan's one hump), and the checker accepts each."""
     from oracle_cases import line_path
-    from optimal.freq.upper import line_pieces
+    from optimal.freq.ramps import ramp_plan
     from reference.core.constraints import BOUND_SETS, check_profile
 
     path = line_path([[0, 0, 0], [L, 0, 0]], feed=F, stops=("start", "end"))
     lim = _xyz(a=a, f=f)
-    prof = line_pieces(path, lim)[0]
+    prof = ramp_plan(path, lim)[0]
     assert prof.duration == pytest.approx(expected, rel=1e-12)
     assert check_profile(path, lim, prof).ok(BOUND_SETS["acc+freq"])
+
+
+@pytest.mark.parametrize("F, L1, L2", [(20.0, 20.0, 20.0), (43.1, 4.16, 3.10),
+                                       (100.0, 30.0, 1.0)])
+def test_ramp_plan_on_a_corner_is_the_hand_motion(F, L1, L2):
+    """Two lines with a 90 degree corner: the ramp plan is the hand motion of ramps of
+    exactly 1/f: rest to the feed, down to the corner's speed ``v_c`` and back, down to
+    rest; where the second line is too short for that (1 mm at F100: ramps of 1/f cover
+    (v_c + P) / (2 f) + P / (2 f)), up to the plateau ``P = f L2 - v_c / 2`` and straight
+    down. ``v_c`` is the largest corner speed the checker accepts (bisection); the plan,
+    at the junction rule's cap, is that motion to 1e-8. The checker accepts the plan."""
+    from oracle_cases import line_path
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    f = 20.0
+    lim = _xyz(a=2000.0, f=f)
+    path = line_path([[0, 0, 0], [L1, 0, 0], [L1, L2, 0]], feed=F)
+    prof = ramp_plan(path, lim)[0]
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["acc+freq"])
+
+    def hand(vc):
+        up, dn = F / (2 * f), (F + vc) / (2 * f)
+        if F / (2 * f) + (F + vc) / (2 * f) <= L2:
+            return Profile.from_path_velocity([0.0, up, L1 - dn, L1, L1 + dn, L1 + L2 - up,
+                                               L1 + L2], [0.0, F, F, vc, F, F, 0.0])
+        P = f * L2 - vc / 2
+        return Profile.from_path_velocity([0.0, up, L1 - dn, L1, L1 + (vc + P) / (2 * f),
+                                           L1 + L2], [0.0, F, F, vc, P, 0.0])
+
+    lo_v, hi_v = 0.0, min(F, 10.0)
+    for _ in range(50):
+        mid = 0.5 * (lo_v + hi_v)
+        if check_profile(path, lim, hand(mid)).ok(BOUND_SETS["acc+freq"]):
+            lo_v = mid
+        else:
+            hi_v = mid
+    assert prof.duration == pytest.approx(hand(lo_v).duration, rel=1e-8)
+
+
+@pytest.mark.parametrize("J, expected", [
+    # the shortest S-curve to 100 mm/s lasts 2 sqrt(100 / 4e4) = 0.1 s = 1/f: L/v + 1/f
+    (4e4, 100.0 / 100.0 + 0.1),
+    # a jerk ten times lower: 2 sqrt(100 / 4e3) = 0.316 s, longer than 1/f
+    (4e3, 100.0 / 100.0 + 2.0 * np.sqrt(100.0 / 4e3)),
+])
+def test_ramp_plan_s_curves_on_single_lines(J, expected):
+    """Rest-to-rest single lines under ``jerk+freq``: S-curve ramps of ``max(1/f, the
+    shortest S-curve)`` (L = 100 mm at F100, A = 2000, f = 10 Hz), time ``L/v + tau`` by
+    hand, accepted under ``jerk+freq``."""
+    from oracle_cases import line_path
+    from reference.core import AxisLimits, MachineLimits
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    path = line_path([[0, 0, 0], [100.0, 0, 0]], feed=100.0, stops=("start", "end"))
+    lim = MachineLimits(tuple(AxisLimits(n, 500.0, 2000.0, J, 1.2, 10.0) for n in "XYZ"),
+                        0.004)
+    prof = ramp_plan(path, lim, jerk=True)[0]
+    assert prof.duration == pytest.approx(expected, rel=1e-12)
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["jerk+freq"])
+
+
+def test_ramp_plan_s_curves_keep_the_corner_times_where_1_f_binds():
+    """A 90 degree corner between 20 mm lines at F1200, 20 Hz, jerk 40 m/s^3: every
+    S-curve to a change of at most 20 mm/s is shorter than 1/f, and an S-curve of 1/f
+    covers what the constant ramp of 1/f covers, so the S plan takes the constant plan's
+    time; and it keeps every axis jerk at the corner (the ramps end there at zero
+    acceleration, each segment's phases end exactly at the break)."""
+    from oracle_cases import line_path
+    from reference.core import AxisLimits, MachineLimits
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    lim = MachineLimits(tuple(AxisLimits(n, 500.0, 2000.0, 4e4, 1.2, 20.0) for n in "XYZ"),
+                        0.004)
+    path = line_path([[0, 0, 0], [20.0, 0, 0], [20.0, 20.0, 0]], feed=20.0)
+    brisk = ramp_plan(path, lim)[0]
+    soft = ramp_plan(path, lim, jerk=True)[0]
+    assert soft.duration == pytest.approx(brisk.duration, rel=1e-12)
+    assert check_profile(path, lim, soft).ok(BOUND_SETS["jerk+freq"])
 
 
 def test_pieced_takes_the_faster_motion_on_each_piece():
