@@ -29,6 +29,11 @@ CTOL: same roundings) came out 1.37 and 1.92. Rows of:
   control model, and on arcs its cost follows the swept angle (0.125 degree samples
   where a maximum may be), which a rounding adds at every corner.
 
+The compiled LookAhead loops (:mod:`reference.planner.lookahead_kernel`, numba) load once
+per process (about 0.5 s, shown on its own line, not in the rows); the planner uses them
+on large programs or once they are loaded, so here every row runs them warm, as the
+G64 side does.
+
 Per block means per program block. Rounding inserts a block at most corners (the control
 then prepares and interpolates that many more blocks), so the row also shows the time per
 *planned* block (program blocks with motion plus inserted roundings), which is the
@@ -124,6 +129,11 @@ def _with_trans_tol(name: str, tol_mm: float):
 def main(argv=None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     n = 2000 if "--quick" in argv else 10000
+    t0 = time.perf_counter()
+    from reference.planner import lookahead_kernel  # noqa: F401 - loaded once, then warm
+    plan(parse_text("G90 SOFT F6000\nG1 X0 Y0\nG1 X1\nG1 Y1\n"), load_machine(), check=False)
+    print(f"  compiled LookAhead loops: loaded once per process in "
+          f"{time.perf_counter() - t0:.2f} s (not in the rows)")
     body = polyline(n, 13)
     machine = load_machine()
     worst = worst_pl = 0.0
