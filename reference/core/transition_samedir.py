@@ -362,16 +362,23 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     first = None if like is None else np.where(np.isfinite(like.theta), _on_second(like),
                                                 r_out > r_in)
     t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2), first)
+    sh = _shaped(r_in, r_out, rate, ramp, t1, p2)
+    return samedir_measured(sh) if deviation else sh
+
+
+def _shaped(r_in, r_out, rate, ramp, t1, p2) -> SameDirShape:
+    """The transitions (without their deviation) of the landing ``theta1 = t1``,
+    ``phi2 = p2`` (shape (k,) each, ``nan``: none) at rate ``rate`` with ramps of length
+    ``ramp``: the rest of :func:`samedir_shape` once its landing is known."""
     trim_in, trim_out = t1 * r_in + 0.5 * ramp, p2 * r_out + 0.5 * ramp
     ok = (trim_in > 0) & (trim_out > 0)
     t1, p2 = np.where(ok, t1, np.nan), np.where(ok, p2, np.nan)
     h = np.where(ok, t1 + p2, 1.0)
     l_p = np.sqrt(h / rate)
     d_p = _pair_distance(h, rate)
-    sh = SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
-                      trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
-                      np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
-    return samedir_measured(sh) if deviation else sh
+    return SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
+                        trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
+                        np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
 
 
 def _on_second(sh: SameDirShape) -> np.ndarray:
@@ -384,19 +391,22 @@ def samedir_canonical(sh: SameDirShape) -> SameDirShape:
     """``sh`` (built ``like`` another shape, :func:`samedir_shape`) as the model has it:
     where its pair sits on the sharper arc, the flatter arc's landing is tried (as
     :func:`_solve` tries it first) and, where that lands, the transition is built
-    again; elsewhere ``sh`` is already the model's (the same iterations)."""
+    again; elsewhere ``sh`` is already the model's (the same iterations). The flatter
+    arc's landing found here is the one :func:`samedir_shape` would find first (the
+    same Newton iteration from the same start, each transition's own), so the
+    transitions are built from it (:func:`_shaped`) instead of solved a second time."""
     sharp = np.flatnonzero(np.isfinite(sh.theta) & (_on_second(sh) != (sh.r_out > sh.r_in)))
     if not sharp.size:
         return sh
     r1, r2, c, ramp = sh.r_in[sharp], sh.r_out[sharp], sh.rate[sharp], sh.ramp_in[sharp]
     xq1, yq1, _, _ = ramp_offset(r1, ramp)
     xq2, yq2, _, _ = ramp_offset(r2, ramp)
-    t1, _ = _newton(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
-    again = sharp[np.isfinite(t1)]
-    if not again.size:
+    t1, p2 = _newton(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
+    lands = np.flatnonzero(np.isfinite(t1))
+    if not lands.size:
         return sh
-    part = samedir_shape(sh.r_in[again], sh.r_out[again], sh.rate[again], deviation=False)
-    return scatter(sh, again, part)
+    part = _shaped(r1[lands], r2[lands], c[lands], ramp[lands], t1[lands], p2[lands])
+    return scatter(sh, sharp[lands], part)
 
 
 def samedir_measured(sh: SameDirShape) -> SameDirShape:
