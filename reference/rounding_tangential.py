@@ -46,6 +46,7 @@ ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,6 +79,12 @@ CLAMP_MARGIN = 1e-9
 #: Largest factor one clamp round raises an S-bend's rate by (a transition that found
 #: no landing heading has no trims to scale by: it is raised by this much).
 RATE_RAISE_MAX = 1e3
+#: Two-arc transitions from which the sizing runs the compiled deviation search
+#: (:mod:`reference.transition_kernel`) even before it is loaded: loading numba and the
+#: cached kernel costs about 0.5 s once per process, what the vectorised searches cost
+#: on some 2 10^4 transitions; once it is loaded every size uses it (the same numbers).
+SEARCH_COMPILED_MIN = 20_000
+_KERNEL = __name__.rsplit(".", 1)[0] + ".transition_kernel"
 #: Named where a tangential transition next to an arc is not between a line and an arc
 #: or two arcs (an inserted block's segment).
 _BETWEEN_ARCS = "tangential transition between arcs: rounding not modelled yet"
@@ -404,7 +411,8 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     until both fit; whether it was cut, and whether it is too small (bool, shape (j,)
     each)."""
     r1, r2 = R[o], R_b[o]
-    sh = for_deviation(r1, r2, dev)
+    search = _search(o.size)
+    sh = for_deviation(r1, r2, dev, search=search)
     rate = sh.rate.copy()
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
     cut = np.zeros(o.size, bool)
@@ -421,11 +429,22 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     again = np.flatnonzero(cut)
     if again.size:
         # each was last shaped at its final rate, without the deviation
-        sh = scatter(sh, again, measured(take(sh, again)))
+        sh = scatter(sh, again, measured(take(sh, again), search=search))
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
+
+
+def _search(n: int):
+    """The deviation search of the sizing of ``n`` two-arc transitions: the compiled one
+    (:func:`reference.transition_kernel.deviation_where`, bit for bit the vectorised
+    search) from :data:`SEARCH_COMPILED_MIN` transitions on or once it is loaded, else
+    ``None`` (the vectorised search, without loading numba)."""
+    if n < SEARCH_COMPILED_MIN and _KERNEL not in sys.modules:
+        return None
+    from .transition_kernel import deviation_where
+    return deviation_where
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,

@@ -409,17 +409,18 @@ def samedir_canonical(sh: SameDirShape) -> SameDirShape:
     return scatter(sh, sharp[lands], part)
 
 
-def samedir_measured(sh: SameDirShape) -> SameDirShape:
+def samedir_measured(sh: SameDirShape, search=None) -> SameDirShape:
     """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
     :func:`samedir_shape` returns with ``deviation=True`` for the same radii and rates
-    (its landing is each transition's own, whatever the batch)."""
+    (its landing is each transition's own, whatever the batch); ``search`` as for
+    :func:`reference.core.transition_sbend.pieces_deviation`."""
     ok = np.isfinite(sh.theta)
     dev = np.full_like(sh.rate, np.nan)
     if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
         dev[i] = pieces_deviation(_canonical_pieces(part), part.r_in, part.r_out,
-                                  part.r_out)
+                                  part.r_out, search)
     return SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
                           for f in SameDirShape.__slots__))
 
@@ -444,8 +445,8 @@ def _canonical_pieces(sh: SameDirShape):
             lengths)
 
 
-def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
-                          ) -> SameDirShape:
+def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
+                          search=None) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
     :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
     of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
@@ -456,6 +457,8 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     ----------
     r_in, r_out, deviation : numpy.ndarray, shape (k,)
         mm (``deviation > 0``, ``r_in != r_out``).
+    search : callable, optional
+        As for :func:`reference.core.transition_sbend.pieces_deviation`.
 
     Returns
     -------
@@ -466,7 +469,7 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     return size_for_deviation(samedir_shape, _canonical_pieces, r_out, r_in, r_out,
                               deviation, ratio_guess(_samedir_table(), r_in, r_out,
                                                      deviation),
-                              canonical=samedir_canonical)
+                              canonical=samedir_canonical, search=search)
 
 
 @lru_cache(maxsize=None)
