@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -299,11 +300,14 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
+        search, newton = _compiled_parts(int(np.sum(sbend[o] | samedir[o])))
         for kind, sized, shape_of, measured, to_rows, n_p in (
-                (sbend, sbend_for_deviation, sbend_shape, sbend_measured, sbend_rows,
-                 SBEND_PIECES),
-                (samedir, samedir_for_deviation, samedir_shape, samedir_measured,
-                 samedir_rows, SAMEDIR_PIECES)):
+                (sbend, partial(sbend_for_deviation, search=search), sbend_shape,
+                 partial(sbend_measured, search=search), sbend_rows, SBEND_PIECES),
+                (samedir, partial(samedir_for_deviation, search=search, newton=newton),
+                 partial(samedir_shape, newton=newton),
+                 partial(samedir_measured, search=search), samedir_rows,
+                 SAMEDIR_PIECES)):
             sel = kind[o]
             at = o[sel]
             if not at.size:
@@ -411,8 +415,7 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     until both fit; whether it was cut, and whether it is too small (bool, shape (j,)
     each)."""
     r1, r2 = R[o], R_b[o]
-    search = _search(o.size)
-    sh = for_deviation(r1, r2, dev, search=search)
+    sh = for_deviation(r1, r2, dev)
     rate = sh.rate.copy()
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
     cut = np.zeros(o.size, bool)
@@ -429,22 +432,24 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     again = np.flatnonzero(cut)
     if again.size:
         # each was last shaped at its final rate, without the deviation
-        sh = scatter(sh, again, measured(take(sh, again), search=search))
+        sh = scatter(sh, again, measured(take(sh, again)))
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
 
 
-def _search(n: int):
-    """The deviation search of the sizing of ``n`` two-arc transitions: the compiled one
-    (:func:`reference.transition_kernel.deviation_where`, bit for bit the vectorised
-    search) from :data:`SEARCH_COMPILED_MIN` transitions on or once it is loaded, else
-    ``None`` (the vectorised search, without loading numba)."""
+def _compiled_parts(n: int) -> tuple:
+    """The deviation search and the same-way landing's Newton iteration for ``n``
+    two-arc transitions: the compiled ones (:func:`reference.transition_kernel.
+    deviation_where` and :func:`~reference.transition_kernel.samedir_newton`, bit for
+    bit the vectorised ones) from :data:`SEARCH_COMPILED_MIN` transitions on or once
+    they are loaded, else ``(None, None)`` (the vectorised ones, without loading
+    numba)."""
     if n < SEARCH_COMPILED_MIN and _KERNEL not in sys.modules:
-        return None
-    from .transition_kernel import deviation_where
-    return deviation_where
+        return None, None
+    from .transition_kernel import deviation_where, samedir_newton
+    return deviation_where, samedir_newton
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
