@@ -386,7 +386,8 @@ def test_g644_3xxx_at_arc_corners_is_the_smallest_fillet_passed_at_the_path_velo
     SOFT the fillet's curvature jumps at its ends (6.3) are allowed the largest
     PATH_TRANS_JERK_LIM, so that they do not decide the speed (with the axis jerk there
     they would allow 17 mm/s, and stopping at the corner is estimated the faster)."""
-    from test_rounding_arcs import BASE, LINE_ARC
+    from rounding_machines import BASE
+    from test_rounding_arcs import LINE_ARC
     from test_rounding_arcs import hand as line_hand
     r = V_F3000 ** 2 / (0.75 * A_TEST)
     spec = copy.deepcopy(BASE)
@@ -417,7 +418,7 @@ def test_g644_2xxx_at_an_arc_corner_lasts_one_period_of_the_lowest_frequency():
     path velocity"; spec 5.8 "2xxx: T_i >= 1/f_i". X at 20 Hz, Y at 10 Hz: the fillet at
     the OUTSIDE corner lasts 1/10 s at F1200, 2 mm of path; its radius by root finding
     on the hand formulas (length r (pi/2 - 2 atan(mu / (5 + mu))))."""
-    from test_rounding_arcs import BASE
+    from rounding_machines import BASE
     spec = copy.deepcopy(BASE)
     spec["channel"].update(SMOOTHING_MODE=2000)
     for ax, f in (("X", 20.0), ("Y", 10.0), ("Z", 20.0)):
@@ -495,7 +496,8 @@ def test_g644_0xxx_at_a_line_arc_corner_rounds_as_3xxx_within_the_tolerance(digi
     1 mm per axis: the 3xxx fillet has r = v^2 / (0.75 A) = 1.667 mm (by hand, as in the
     3xxx test above) and its hand deviation stays within 1 mm on both axes, so 0xxx
     takes that fillet; 4xxx the larger one whose deviation reaches 1 mm on an axis."""
-    from test_rounding_arcs import BASE, LINE_ARC
+    from rounding_machines import BASE
+    from test_rounding_arcs import LINE_ARC
     from test_rounding_arcs import hand as line_hand
     r = V_F3000 ** 2 / (0.75 * A_TEST)
     spec = copy.deepcopy(BASE)
