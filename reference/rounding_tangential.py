@@ -46,7 +46,9 @@ ROUNDING_REASONS`), and sizes the transition (:mod:`reference.core.transition`):
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -78,6 +80,12 @@ CLAMP_MARGIN = 1e-9
 #: Largest factor one clamp round raises an S-bend's rate by (a transition that found
 #: no landing heading has no trims to scale by: it is raised by this much).
 RATE_RAISE_MAX = 1e3
+#: Two-arc transitions from which the sizing runs the compiled deviation search
+#: (:mod:`reference.transition_kernel`) even before it is loaded: loading numba and the
+#: cached kernel costs about 0.5 s once per process, what the vectorised searches cost
+#: on some 2 10^4 transitions; once it is loaded every size uses it (the same numbers).
+SEARCH_COMPILED_MIN = 20_000
+_KERNEL = __name__.rsplit(".", 1)[0] + ".transition_kernel"
 #: Named where a tangential transition next to an arc is not between a line and an arc
 #: or two arcs (an inserted block's segment).
 _BETWEEN_ARCS = "tangential transition between arcs: rounding not modelled yet"
@@ -292,11 +300,14 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
+        search, newton = _compiled_parts(int(np.sum(sbend[o] | samedir[o])))
         for kind, sized, shape_of, measured, to_rows, n_p in (
-                (sbend, sbend_for_deviation, sbend_shape, sbend_measured, sbend_rows,
-                 SBEND_PIECES),
-                (samedir, samedir_for_deviation, samedir_shape, samedir_measured,
-                 samedir_rows, SAMEDIR_PIECES)):
+                (sbend, partial(sbend_for_deviation, search=search), sbend_shape,
+                 partial(sbend_measured, search=search), sbend_rows, SBEND_PIECES),
+                (samedir, partial(samedir_for_deviation, search=search, newton=newton),
+                 partial(samedir_shape, newton=newton),
+                 partial(samedir_measured, search=search), samedir_rows,
+                 SAMEDIR_PIECES)):
             sel = kind[o]
             at = o[sel]
             if not at.size:
@@ -426,6 +437,19 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))
     return sh, cut, small
+
+
+def _compiled_parts(n: int) -> tuple:
+    """The deviation search and the same-way landing's Newton iteration for ``n``
+    two-arc transitions: the compiled ones (:func:`reference.transition_kernel.
+    deviation_where` and :func:`~reference.transition_kernel.samedir_newton`, bit for
+    bit the vectorised ones) from :data:`SEARCH_COMPILED_MIN` transitions on or once
+    they are loaded, else ``(None, None)`` (the vectorised ones, without loading
+    numba)."""
+    if n < SEARCH_COMPILED_MIN and _KERNEL not in sys.modules:
+        return None, None
+    from .transition_kernel import deviation_where, samedir_newton
+    return deviation_where, samedir_newton
 
 
 def _programmed_speed(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,

@@ -178,12 +178,21 @@ def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None
     """
     cl = np.flatnonzero(sharpness[idx]) if sharpness is not None else np.zeros(0, np.intp)
     if cl.size:
-        out = _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius,
-                            length)
+        # the circle/line/spiral rows and the clothoid rows each by their own formula
+        # (row by row the numbers of evaluating every row as a circle first and
+        # overwriting the clothoids, without that work on the clothoid rows: most rows
+        # of a path with G645 transitions)
         rows = idx[cl]
-        for arr, part in zip(out, _eval_clothoid(origin[rows], e1[rows], e2[rows],
-                                                 sharpness[rows], length[rows], s[cl])):
-            arr[cl] = part
+        parts = _eval_clothoid(origin[rows], e1[rows], e2[rows], sharpness[rows],
+                               length[rows], s[cl])
+        if cl.size == idx.size:
+            return parts
+        rest = np.flatnonzero(sharpness[idx] == 0)
+        other = _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx[rest], s[rest],
+                              dradius, length)
+        out = tuple(np.empty((idx.size,) + p.shape[1:]) for p in parts)
+        for arr, a, b in zip(out, other, parts):
+            arr[rest], arr[cl] = a, b
         return out
     r = radius[idx]
     w = omega[idx]

@@ -88,7 +88,7 @@ Units: mm, rad. Shapes: ``k`` transitions.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 
@@ -238,21 +238,23 @@ def _start(r_in, r_out, ramp, rate, flat_out):
     return np.where(flat_out, 0.0, far), np.where(flat_out, far, 0.0)
 
 
-def _solve(r_in, r_out, ramp, rate, off, first=None):
+def _solve(r_in, r_out, ramp, rate, off, first=None, newton=None):
     """The landing (module docstring): ``theta1, phi2``, the pair on the flatter arc
     where that lands, else on the sharper one; nan where neither does. With ``first``
     (bool, shape (k,): the pair on the second arc) that side is tried first, the other
     only where it does not land: each attempt is the transition's own Newton iteration
     from its side's start, so the result is the model's wherever the side tried first
     is the flatter arc's or the flatter arc's does not land
-    (:func:`samedir_canonical`)."""
+    (:func:`samedir_canonical`). ``newton``: another implementation of
+    :func:`_newton` (:func:`samedir_shape`)."""
     flat_out = r_out > r_in
     first = flat_out if first is None else first
-    t1, p2 = _newton(r_in, r_out, ramp, rate, off, first)
+    newton = newton or _newton
+    t1, p2 = newton(r_in, r_out, ramp, rate, off, first)
     lost = np.flatnonzero(np.isnan(t1))
     if lost.size:
         sel = (r_in[lost], r_out[lost], ramp[lost], rate[lost], tuple(o[lost] for o in off))
-        t1[lost], p2[lost] = _newton(*sel, ~first[lost])
+        t1[lost], p2[lost] = newton(*sel, ~first[lost])
     return t1, p2
 
 
@@ -331,8 +333,8 @@ def _halved(t1, p2, dt, dp):
 
 
 def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
-                  deviation: bool = True, like: SameDirShape | None = None
-                  ) -> SameDirShape:
+                  deviation: bool = True, like: SameDirShape | None = None,
+                  newton=None) -> SameDirShape:
     """The transition of rate ``rate`` between arcs of radii ``r_in``, ``r_out`` curving
     the same way.
 
@@ -349,6 +351,10 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
         :data:`NEWTON_MAX_ITER` steps at every rate). The result may then put the pair
         on the sharper arc where the flatter one lands: :func:`samedir_canonical`
         makes it the model's.
+    newton : callable, optional
+        Another implementation of :func:`_newton` (the same arguments and results, bit
+        for bit: the compiled steps of :mod:`reference.transition_kernel`, which this
+        package cannot import); by default :func:`_newton`.
 
     Returns
     -------
@@ -361,17 +367,24 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     xq2, yq2, _, _ = ramp_offset(r_out, ramp)
     first = None if like is None else np.where(np.isfinite(like.theta), _on_second(like),
                                                 r_out > r_in)
-    t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2), first)
+    t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2), first, newton)
+    sh = _shaped(r_in, r_out, rate, ramp, t1, p2)
+    return samedir_measured(sh) if deviation else sh
+
+
+def _shaped(r_in, r_out, rate, ramp, t1, p2) -> SameDirShape:
+    """The transitions (without their deviation) of the landing ``theta1 = t1``,
+    ``phi2 = p2`` (shape (k,) each, ``nan``: none) at rate ``rate`` with ramps of length
+    ``ramp``: the rest of :func:`samedir_shape` once its landing is known."""
     trim_in, trim_out = t1 * r_in + 0.5 * ramp, p2 * r_out + 0.5 * ramp
     ok = (trim_in > 0) & (trim_out > 0)
     t1, p2 = np.where(ok, t1, np.nan), np.where(ok, p2, np.nan)
     h = np.where(ok, t1 + p2, 1.0)
     l_p = np.sqrt(h / rate)
     d_p = _pair_distance(h, rate)
-    sh = SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
-                      trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
-                      np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
-    return samedir_measured(sh) if deviation else sh
+    return SameDirShape(r_in, r_out, rate, ramp, ramp, l_p, h, d_p, t1, p2, trim_in,
+                        trim_out, np.full_like(rate, np.nan), 2.0 * ramp + 2.0 * l_p,
+                        np.minimum(np.minimum(r_in, r_out), 1.0 / (rate * l_p)))
 
 
 def _on_second(sh: SameDirShape) -> np.ndarray:
@@ -380,36 +393,41 @@ def _on_second(sh: SameDirShape) -> np.ndarray:
     return np.abs(sh.theta) < np.abs(sh.phi)
 
 
-def samedir_canonical(sh: SameDirShape) -> SameDirShape:
+def samedir_canonical(sh: SameDirShape, newton=None) -> SameDirShape:
     """``sh`` (built ``like`` another shape, :func:`samedir_shape`) as the model has it:
     where its pair sits on the sharper arc, the flatter arc's landing is tried (as
     :func:`_solve` tries it first) and, where that lands, the transition is built
-    again; elsewhere ``sh`` is already the model's (the same iterations)."""
+    again; elsewhere ``sh`` is already the model's (the same iterations). The flatter
+    arc's landing found here is the one :func:`samedir_shape` would find first (the
+    same Newton iteration from the same start, each transition's own), so the
+    transitions are built from it (:func:`_shaped`) instead of solved a second time.
+    ``newton`` as for :func:`samedir_shape`."""
     sharp = np.flatnonzero(np.isfinite(sh.theta) & (_on_second(sh) != (sh.r_out > sh.r_in)))
     if not sharp.size:
         return sh
     r1, r2, c, ramp = sh.r_in[sharp], sh.r_out[sharp], sh.rate[sharp], sh.ramp_in[sharp]
     xq1, yq1, _, _ = ramp_offset(r1, ramp)
     xq2, yq2, _, _ = ramp_offset(r2, ramp)
-    t1, _ = _newton(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
-    again = sharp[np.isfinite(t1)]
-    if not again.size:
+    t1, p2 = (newton or _newton)(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
+    lands = np.flatnonzero(np.isfinite(t1))
+    if not lands.size:
         return sh
-    part = samedir_shape(sh.r_in[again], sh.r_out[again], sh.rate[again], deviation=False)
-    return scatter(sh, again, part)
+    part = _shaped(r1[lands], r2[lands], c[lands], ramp[lands], t1[lands], p2[lands])
+    return scatter(sh, sharp[lands], part)
 
 
-def samedir_measured(sh: SameDirShape) -> SameDirShape:
+def samedir_measured(sh: SameDirShape, search=None) -> SameDirShape:
     """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
     :func:`samedir_shape` returns with ``deviation=True`` for the same radii and rates
-    (its landing is each transition's own, whatever the batch)."""
+    (its landing is each transition's own, whatever the batch); ``search`` as for
+    :func:`reference.core.transition_sbend.pieces_deviation`."""
     ok = np.isfinite(sh.theta)
     dev = np.full_like(sh.rate, np.nan)
     if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
         dev[i] = pieces_deviation(_canonical_pieces(part), part.r_in, part.r_out,
-                                  part.r_out)
+                                  part.r_out, search)
     return SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
                           for f in SameDirShape.__slots__))
 
@@ -434,8 +452,8 @@ def _canonical_pieces(sh: SameDirShape):
             lengths)
 
 
-def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
-                          ) -> SameDirShape:
+def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
+                          search=None, newton=None) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
     :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
     of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
@@ -446,6 +464,10 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     ----------
     r_in, r_out, deviation : numpy.ndarray, shape (k,)
         mm (``deviation > 0``, ``r_in != r_out``).
+    search : callable, optional
+        As for :func:`reference.core.transition_sbend.pieces_deviation`.
+    newton : callable, optional
+        As for :func:`samedir_shape`.
 
     Returns
     -------
@@ -453,10 +475,14 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     """
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
-    return size_for_deviation(samedir_shape, _canonical_pieces, r_out, r_in, r_out,
+    shape_of, canonical = samedir_shape, samedir_canonical
+    if newton is not None:
+        shape_of = partial(samedir_shape, newton=newton)
+        canonical = partial(samedir_canonical, newton=newton)
+    return size_for_deviation(shape_of, _canonical_pieces, r_out, r_in, r_out,
                               deviation, ratio_guess(_samedir_table(), r_in, r_out,
                                                      deviation),
-                              canonical=samedir_canonical)
+                              canonical=canonical, search=search)
 
 
 @lru_cache(maxsize=None)

@@ -490,7 +490,10 @@ def _distance_slopes(packed, s, first, r_in, r_out, centre_out):
     qt = x * tangent[:, 0] + qy * tangent[:, 1]
     qa = x * second[:, 0] + qy * second[:, 1]
     slope = sign * qt / norm
-    bend = sign * ((1.0 + qa) / norm - qt * qt / norm ** 3)
+    # |q|^3 as two products, not ``** 3``: numpy's power may take a vectorised path
+    # (SVML on AVX-512) whose last bit differs from the C library's, so a compiled
+    # search (reference.transition_kernel) could not give the same numbers
+    bend = sign * ((1.0 + qa) / norm - qt * qt / (norm * norm * norm))
     return np.abs(num) / (norm + r), slope, bend
 
 
@@ -561,7 +564,7 @@ def sbend_deviation(sh: SBendShape) -> np.ndarray:
 
 
 def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
-                     centre_out: np.ndarray) -> np.ndarray:
+                     centre_out: np.ndarray, search=None) -> np.ndarray:
     """Largest distance of clothoid pieces between two tangent arcs from the arcs, mm,
     shape (k,), for every transition between two arcs.
 
@@ -588,8 +591,13 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
         rates and lengths (shape (k, p)) of the ``p`` pieces in path order.
     r_in, r_out, centre_out : numpy.ndarray, shape (k,)
         Radii of the arcs and the canonical ``y`` of the second arc's centre, mm.
+    search : callable, optional
+        Another implementation of :func:`_deviation_where` (the same arguments and
+        results, bit for bit: the compiled search of
+        :mod:`reference.transition_kernel`, which this package cannot import); by
+        default :func:`_deviation_where`.
     """
-    return _deviation_where(pieces, r_in, r_out, centre_out)[0]
+    return (search or _deviation_where)(pieces, r_in, r_out, centre_out)[0]
 
 
 def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
@@ -775,8 +783,8 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     return sbend_measured(sh) if deviation and ok.any() else sh
 
 
-def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray
-                        ) -> SBendShape:
+def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
+                        search=None) -> SBendShape:
     """The S-bend transitions that deviate from the arcs by ``deviation``
     (:func:`size_for_deviation` from the first estimate :func:`ratio_guess`).
 
@@ -784,6 +792,8 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
     ----------
     r_in, r_out, deviation : numpy.ndarray, shape (k,)
         mm (``deviation > 0``).
+    search : callable, optional
+        As for :func:`pieces_deviation`.
 
     Returns
     -------
@@ -792,7 +802,8 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
     r_in, r_out, deviation = (np.asarray(v, dtype=np.float64)
                               for v in (r_in, r_out, deviation))
     return size_for_deviation(sbend_shape, _canonical_pieces, -r_out, r_in, r_out,
-                              deviation, ratio_guess(_sbend_table(), r_in, r_out, deviation))
+                              deviation, ratio_guess(_sbend_table(), r_in, r_out, deviation),
+                              search=search)
 
 
 @lru_cache(maxsize=None)
@@ -854,29 +865,31 @@ def ratio_guess(table: tuple[np.ndarray, np.ndarray], r_in: np.ndarray, r_out: n
     return 0.5 * (g - np.log(np.minimum(r_in, r_out) ** 3 * deviation))
 
 
-def sbend_measured(sh: SBendShape) -> SBendShape:
+def sbend_measured(sh: SBendShape, search=None) -> SBendShape:
     """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
     :func:`sbend_shape` returns with ``deviation=True`` for the same radii and rates
-    (its heading root is each transition's own, whatever the batch)."""
-    return _measured(sh, _canonical_pieces, -sh.r_out)
+    (its heading root is each transition's own, whatever the batch); ``search`` as
+    for :func:`pieces_deviation`."""
+    return _measured(sh, _canonical_pieces, -sh.r_out, search)
 
 
-def _measured(sh, pieces_of, centre_out: np.ndarray):
+def _measured(sh, pieces_of, centre_out: np.ndarray, search=None):
     """``sh`` (a two-arc shape, ``theta`` nan where it does not land) with its
-    deviation measured by :func:`pieces_deviation` where it lands."""
+    deviation measured by :func:`pieces_deviation` (``search``) where it lands."""
     ok = np.isfinite(sh.theta)
     dev = np.full_like(sh.rate, np.nan)
     if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
-        dev[i] = pieces_deviation(pieces_of(part), part.r_in, part.r_out, centre_out[i])
+        dev[i] = pieces_deviation(pieces_of(part), part.r_in, part.r_out, centre_out[i],
+                                  search)
     return type(sh)(*(dev if f == "deviation" else getattr(sh, f)
                       for f in type(sh).__slots__))
 
 
 def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.ndarray,
                        r_out: np.ndarray, deviation: np.ndarray, log_rate: np.ndarray,
-                       canonical=None):
+                       canonical=None, search=None):
     """The transitions between two arcs whose rate makes them deviate by ``deviation``;
     the one sizing of every two-arc transition.
 
@@ -921,6 +934,9 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         Where given, the steps build each shape ``like`` the one before
         (``shape_of(..., like=...)``, a cheaper solve that may differ from the model's),
         and ``canonical`` makes the answer's shape the model's before its full measure.
+    search : callable, optional
+        The implementation of :func:`_deviation_where` every measure uses (as for
+        :func:`pieces_deviation`).
 
     Returns
     -------
@@ -934,7 +950,7 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
     gx = np.full(k, np.nan)                  # log(deviation) - aim; nan: no landing
     where = np.full(k, np.nan)               # the followed maximum's place / length
     lost = np.zeros(k, bool)                 # to be sized in full (_size_in_full)
-    pieces = (pieces_of, centre_out, r_in, r_out)
+    pieces = (pieces_of, centre_out, r_in, r_out, search)
 
     def follow(i, part):
         """Deviation of the shape ``part`` of transitions ``i`` where it lands, near
@@ -972,16 +988,18 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
     if rest.size:
         sh = scatter(sh, rest, _size_in_full(shape_of, pieces_of, centre_out[rest],
                                              r_in[rest], r_out[rest], aim[rest],
-                                             np.asarray(log_rate, np.float64)[rest]))
+                                             np.asarray(log_rate, np.float64)[rest],
+                                             search))
     return sh
 
 
-def _size_in_full(shape_of, pieces_of, centre_out, r_in, r_out, aim, log_rate):
+def _size_in_full(shape_of, pieces_of, centre_out, r_in, r_out, aim, log_rate,
+                  search=None):
     """:func:`size_for_deviation` with every step measured by the full search: the
     steps from ``log_rate`` until ``log(deviation)`` is within half the margin of
     ``aim`` (shape (k,) each), each only for the transitions not yet done."""
     x = np.array(log_rate, dtype=np.float64)
-    pieces = (pieces_of, centre_out, r_in, r_out)
+    pieces = (pieces_of, centre_out, r_in, r_out, search)
     sh = shape_of(r_in, r_out, np.exp(x), deviation=False)
     dev = _measure(sh, np.arange(x.size), pieces, None)[0]
     sh = _with_deviation(sh, np.arange(x.size), dev)
@@ -1020,7 +1038,7 @@ def _measure(part, i, pieces, near):
     it does not land) and whether that is inside the search's window, shape (m,) each:
     by the full search (``near`` None), else near the fractions ``near`` (shape (m,);
     ``nan``: the coarse search)."""
-    pieces_of, centre_out, r_in, r_out = pieces
+    pieces_of, centre_out, r_in, r_out, search = pieces
     ok = np.isfinite(part.theta)
     dev = np.full(i.size, np.nan)
     at = np.full(i.size, np.nan) if near is None else near.copy()
@@ -1036,7 +1054,8 @@ def _measure(part, i, pieces, near):
         pc = pieces_of(take(part, sel))
         total = pc[4].sum(axis=1)
         kw = {"near": near[sel] * total} if kw is None else kw
-        d, s, ins = _deviation_where(pc, r_in[j], r_out[j], centre_out[j], **kw)
+        d, s, ins = (search or _deviation_where)(pc, r_in[j], r_out[j], centre_out[j],
+                                                 **kw)
         dev[sel], at[sel], inside[sel] = d, s / total, ins
     return dev, at, inside
 

@@ -49,6 +49,7 @@ Three steps, all O(n) in the number of segments:
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -66,6 +67,23 @@ from .stops import SegmentModes
 #: of a clothoid pair differ by round-off (1e-13), and a gain below 1e-9 is not worth
 #: planning the program again.
 SPLIT_GAIN_REL = 1e-9
+
+#: Units (segments, for the merges) from which :func:`lookahead_passes` and
+#: :func:`_merge_flags` run the compiled loops of :mod:`reference.planner.lookahead_kernel`
+#: (the same speeds and merges, bitwise): loading numba and the cached kernel costs about
+#: 0.5 s once per process, what the Python passes cost on some 10^5 units; once it is
+#: loaded (a large program earlier in this process, or a caller that imports it, as the
+#: benchmarks do) every size uses it.
+PASSES_COMPILED_MIN_UNITS = 100_000
+_KERNEL = __name__.rsplit(".", 1)[0] + ".lookahead_kernel"
+
+
+def _compiled(size: int, compiled: bool | None) -> bool:
+    """Whether to run the compiled loops: ``compiled`` if given, else from
+    :data:`PASSES_COMPILED_MIN_UNITS` on or once the kernel is loaded."""
+    if compiled is not None:
+        return compiled
+    return size >= PASSES_COMPILED_MIN_UNITS or _KERNEL in sys.modules
 
 
 # ----------------------------------------------------------------- horizon
@@ -198,11 +216,14 @@ def _limit_nodes(node_cap, node_cause, cap, cap_cause):
 
 def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
                  own_cap: np.ndarray, through: np.ndarray, ratio: float,
-                 accel_ratio: float, split: np.ndarray | None = None) -> np.ndarray:
+                 accel_ratio: float, split: np.ndarray | None = None,
+                 compiled: bool | None = None) -> np.ndarray:
     """True at interior breaks where two SOFT segments become one unit (greedy runs):
     both SOFT, no stop, not ``split``, the break lets ``accel_ratio`` of the smaller
     acceleration through, the two segments' accelerations and jerks within
-    ``accel_ratio`` of each other, and the effective caps of the run within ``ratio``."""
+    ``accel_ratio`` of each other, and the effective caps of the run within ``ratio``.
+    The runs are walked in Python or, with ``compiled`` (default: :func:`_compiled`), by
+    :func:`reference.planner.lookahead_kernel.greedy_merges` (the same comparisons)."""
     m = path.n_segments
     merge = np.zeros(m + 1, dtype=bool)
     if m < 2:
@@ -226,6 +247,13 @@ def _merge_flags(path: Path, seg: SegmentLimits, modes: SegmentModes,
     low = np.minimum(c, np.minimum(np.concatenate(([np.inf], c[:-1])),
                                    np.concatenate((c[1:], [np.inf]))))
     reach = ramp_reach(low, 0.5 * path.length, seg.accel, seg.jerk)
+    if _compiled(m, compiled):
+        from .lookahead_kernel import greedy_merges
+        eff = np.minimum(c, reach)
+        merge[idx[greedy_merges(idx.astype(np.int64), np.ascontiguousarray(c, np.float64),
+                                eff, np.ascontiguousarray(own_cap, np.float64),
+                                float(ratio))]] = True
+        return merge
     eff = np.minimum(c, reach).tolist()
     cap = c.tolist()
     own = own_cap.tolist()
@@ -503,7 +531,7 @@ def cruise_splits(path: Path, seg: SegmentLimits, units: Units, v_peak: np.ndarr
     return split
 
 
-def lookahead_passes(units: Units) -> NodeSpeeds:
+def lookahead_passes(units: Units, compiled: bool | None = None) -> NodeSpeeds:
     """Backward and forward passes over the units (closed-form steps).
 
     Each step first tries the cheap sufficient test :func:`_fits` (most nodes are bound
@@ -518,9 +546,15 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     taking every step in order: each node is either decided from its neighbour's own
     limit with the same operations, or stepped from its neighbour's final speed.
 
+    With ``compiled`` (default: :func:`_compiled`) the same steps run as the compiled
+    loops of :func:`reference.planner.lookahead_kernel.passes`, every node in order
+    (bitwise the same speeds).
+
     Parameters
     ----------
     units : Units
+    compiled : bool, optional
+        Force (True) or avoid (False) the compiled loops.
 
     Returns
     -------
@@ -536,6 +570,15 @@ def lookahead_passes(units: Units) -> NodeSpeeds:
     # the cheap test with the acceleration above the knee (the smallest of a unit)
     r_fit = np.where(drive, units.knee_ratio, 1.0)
     ad_fit, au_fit = ad * r_fit, au * r_fit
+    if _compiled(n, compiled):
+        from .lookahead_kernel import passes
+        f64 = np.float64
+        w, b, origin, acc_lim = passes(
+            cap, np.ascontiguousarray(L, f64), jl.astype(np.int64),
+            *(np.ascontiguousarray(x, f64) for x in (ad, jd, au, ju, kn, kr, ad_fit,
+                                                     au_fit)),
+            np.array(units.node_cause, dtype=np.int64))
+        return NodeSpeeds(v=w, backward=b, origin_cause=origin, accel_limited=acc_lim)
     brisk = ~units.jerk_limited & ~drive
     reach = _REACH
     fits = _fits

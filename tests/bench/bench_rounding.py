@@ -29,6 +29,12 @@ CTOL: same roundings) came out 1.37 and 1.92. Rows of:
   control model, and on arcs its cost follows the swept angle (0.125 degree samples
   where a maximum may be), which a rounding adds at every corner.
 
+The compiled LookAhead loops (:mod:`reference.planner.lookahead_kernel`, numba) and the
+compiled deviation search of the two-arc transitions (:mod:`reference.transition_kernel`)
+load once per process (about 0.5 s, shown on its own line, not in the rows); the heuristic
+uses them on large programs or once they are loaded (the same numbers either way), so
+here every row runs them warm, the G64 side too.
+
 Per block means per program block. Rounding inserts a block at most corners (the control
 then prepares and interpolates that many more blocks), so the row also shows the time per
 *planned* block (program blocks with motion plus inserted roundings), which is the
@@ -124,6 +130,14 @@ def _with_trans_tol(name: str, tol_mm: float):
 def main(argv=None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     n = 2000 if "--quick" in argv else 10000
+    t0 = time.perf_counter()
+    from reference import transition_kernel  # noqa: F401 - loaded once, then warm
+    from reference.planner import lookahead_kernel  # noqa: F401
+    plan(parse_text("G90 SOFT F6000\nG1 X0 Y0\nG1 X1\nG1 Y1\n"), load_machine(), check=False)
+    build_path(parse_text("G17 G90 G645 SOFT F8000\n" + s_bend_chain(6, 5)),
+               _with_trans_tol("default", 0.05))
+    print(f"  compiled LookAhead loops and deviation search: loaded once per process in "
+          f"{time.perf_counter() - t0:.2f} s (not in the rows)")
     body = polyline(n, 13)
     machine = load_machine()
     worst = worst_pl = 0.0

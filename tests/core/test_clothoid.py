@@ -138,3 +138,20 @@ def test_derivative_norm_bounds_hold_up_to_the_fifth():
             for m, val in enumerate((dq, ddq, dddq, q4, q5)):
                 tol = 1e-12 if m < 3 else 1e-3
                 assert np.all(np.linalg.norm(val, axis=1) <= norms[m][0] * (1 + tol)), m
+
+
+def test_a_batch_of_mixed_rows_is_each_kind_evaluated_alone():
+    """Path.evaluate on lines and clothoids mixed (in random order, repeated rows) gives
+    bit for bit what the lines alone and the clothoids alone give: each row by its own
+    formula, whatever else is in the batch."""
+    path = corner_path(0.9, 2.0)[0]
+    rng = np.random.default_rng(4)
+    s = rng.uniform(0.0, path.total_length, 500)
+    seg = path.segment_index(s)
+    mixed = path.evaluate(s)
+    clo = path.sharpness[seg] != 0
+    assert clo.any() and (~clo).any()
+    for sel in (clo, ~clo):
+        alone = path.evaluate(s[sel])
+        for a, b in zip(mixed, alone, strict=True):
+            assert np.array_equal(a[sel], b)

@@ -19,6 +19,8 @@ allowed)."
 
 from __future__ import annotations
 
+import dataclasses
+
 import math
 import tomllib
 from importlib import resources
@@ -235,13 +237,20 @@ def test_a_shape_built_like_another_is_made_the_models():
     r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, 80))
     rate = np.exp(rng.uniform(np.log(2.0), np.log(300.0), 80)) / np.minimum(r1, r2) ** 2
     want = samedir_shape(r1, r2, rate, deviation=False)
-    for factor in (1.0, 1.1, 0.3, 5.0):
-        like = samedir_shape(r1, r2, rate * factor, deviation=False)
+    # the hints of nearby and far rates, and every hint wrong (the sides swapped: each
+    # pair tried first on the other arc, so samedir_canonical builds again every one
+    # whose flatter arc lands)
+    likes = [samedir_shape(r1, r2, rate * factor, deviation=False)
+             for factor in (1.0, 1.1, 0.3, 5.0)]
+    likes.append(dataclasses.replace(want, theta=want.phi, phi=want.theta))
+    for like in likes:
         with np.errstate(invalid="ignore", divide="ignore"):
-            got = samedir_canonical(samedir_shape(r1, r2, rate, deviation=False,
-                                                  like=like))
+            hinted = samedir_shape(r1, r2, rate, deviation=False, like=like)
+            got = samedir_canonical(hinted)
         for f in want.__slots__:
             np.testing.assert_array_equal(getattr(got, f), getattr(want, f))
+    # the swapped hints were wrong where both arcs land: canonical built those again
+    assert np.sum(np.isfinite(want.theta) & (hinted.theta != want.theta)) > 10
     # the hints matter: some pairs sit on the sharper arc
     on_sharp = (np.abs(want.theta) < np.abs(want.phi)) != (r2 > r1)
     assert on_sharp[np.isfinite(want.theta)].any()

@@ -1,0 +1,531 @@
+"""Compiled parts of the two-arc transitions' sizing (numba): the deviation search of
+:func:`reference.core.transition_sbend._deviation_where` and the steps of the same-way
+landing's Newton iteration (:func:`reference.core.transition_samedir._newton`), written
+as the plain loops they are.
+
+The search is that of :func:`reference.core.transition_sbend.pieces_deviation` (its
+docstring has the argument): samples along the rounding, scan rounds around the largest,
+the last window cut where the rounding crosses the normal at ``J`` and the largest
+distance on each part by safeguarded Newton steps on its slope; or, with ``near``, the
+refinement alone around a place found before. Each transition's numbers are the
+vectorised search's: the same floating-point operations in the same order, point by
+point (``numpy.clip``, ``maximum`` and ``minimum`` with their NaN rules, ``argmax``
+taking the first largest), and the iterations of the crossing and of the Newton steps
+run, as there, until every transition of the batch has converged (a converged one keeps
+stepping while another has not). The Fresnel integrals are scipy's own (the
+``cython_special`` export of the function ``scipy.special.fresnel`` evaluates), ``sqrt``,
+``sin`` and ``cos`` the C library's, which numpy's float64 loops match bit for bit
+(``|q|^3`` is two products in both, not a power: numpy's vectorised ``power`` differs
+from the C library's in the last bit). ``tests/reference/test_transition_kernel.py``
+compares both on random S-bends and same-way transitions and on every search of the
+seeded bench programs' sizing. The rare transitions whose Newton steps do not converge
+are refined by the vectorised fallback (:func:`reference.core.transition_sbend.
+_refine_sampled`), as there.
+
+Why compiled: the search works on a few dozen points per transition at a time through
+some forty numpy operations per round, each a pass over a (transitions x points) array
+and its temporaries, and the sizing runs it five to ten times per transition (measured,
+CPU time per ``build_path`` of the quick rows of ``tests/bench/bench_rounding.py``:
+SOFT G645 S-bends, 1,976 transitions, 44 ms of a 84 ms build in the searches; same-way
+arcs, 1,586 transitions, 29 of 90 ms; the same searches compiled: 37.2 -> 14.6 ms and
+26.9 -> 11.4 ms, what is left mostly the Fresnel integrals, one per point, as many as
+before). Loaded like :mod:`reference.planner.
+lookahead_kernel`: from :data:`reference.rounding_tangential.SEARCH_COMPILED_MIN`
+transitions on, or once loaded, else the vectorised search runs (the core modules take
+it as an argument, ``search``: they import only numpy and scipy).
+
+The same-way landing (:func:`samedir_newton`): each Newton step of every transition still
+iterating is one compiled loop (:func:`_newton_step`: the landing's miss and Jacobian,
+the step and its halvings, with ``_landing``'s and ``_halved``'s operations), the
+iteration around it, its compaction and its verdicts those of ``_newton``. Only
+``tan(h/2)`` is taken from numpy, once per step over the transitions still iterating:
+numpy's float64 ``tan`` is vectorised (SVML on AVX-512) and differs from the C
+library's in the last bit. Why: the transitions beyond the flatter arc's fold (radius
+ratio about 16) wander for all ``NEWTON_MAX_ITER`` steps there, each step some 170
+numpy operations on a few hundred transitions (measured: the 22 landings of the
+same-way quick row's sizing, 63 -> 12 ms CPU).
+
+Units: mm. Shapes: ``k`` transitions, ``p`` pieces each.
+"""
+
+from __future__ import annotations
+
+import math
+
+import llvmlite.binding as llvm
+import numpy as np
+from numba import njit, types
+from numba.extending import get_cython_function_address
+
+from .core.transition_samedir import NEWTON_MAX_ITER as NEWTON_MAX_ITER_SAMEDIR
+from .core.transition_samedir import STEP_HALVINGS, _start
+from .core.transition_sbend import (DEV_SAMPLES, LANDING_TOL_MM, NEWTON_MAX_ITER,
+                                    NEWTON_STEP_TOL, REFINE_POINTS, REFINE_SHRINK,
+                                    SCAN_ROUNDS, THETA_MAX, _packed, _refine_sampled)
+
+# scipy's Fresnel integrals for one double (S, C by pointer), the C function behind
+# scipy.special.fresnel, called by its symbol name (a ctypes pointer would be a constant
+# address, which numba cannot cache: the kernel would compile in every process, ~9 s)
+_FRESNEL_SYMBOL = "feedoracle_scipy_fresnel"
+llvm.add_symbol(_FRESNEL_SYMBOL, get_cython_function_address(
+    "scipy.special.cython_special", "__pyx_fuse_1fresnel"))
+_FRESNEL = types.ExternalFunction(_FRESNEL_SYMBOL, types.void(
+    types.float64, types.CPointer(types.float64), types.CPointer(types.float64)))
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _max(a: float, b: float) -> float:  # pragma: no cover - compiled
+    """``numpy.maximum`` of two floats (NaN propagates)."""
+    return a if (a >= b or a != a) else b
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _min(a: float, b: float) -> float:  # pragma: no cover - compiled
+    """``numpy.minimum`` of two floats (NaN propagates)."""
+    return a if (a <= b or a != a) else b
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _clip(x: float, lo: float, hi: float) -> float:  # pragma: no cover - compiled
+    """``numpy.clip(x, lo, hi)`` (its float rule: NaN kept, ``>``/``<`` otherwise)."""
+    if not x != x:
+        x = x if x > lo else lo
+    if not x != x:
+        x = x if x < hi else hi
+    return x
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _point(packed: np.ndarray, t: int, s: float, sc: np.ndarray,
+           out: np.ndarray, derivatives: bool) -> None:  # pragma: no cover - compiled
+    """``_on_pieces`` at one distance ``s`` of transition ``t``: ``out[0:2]`` the point,
+    ``out[2:4]`` the unit tangent, ``out[4:6]`` the second derivative (the last two only
+    with ``derivatives``); ``sc`` (2,) scratch for the Fresnel integrals."""
+    p = packed.shape[1]
+    idx = 0
+    for j in range(p - 1):
+        if s >= packed[t, j, 7] + packed[t, j, 8]:
+            idx += 1
+    rate, length = packed[t, idx, 6], packed[t, idx, 7]
+    s_local = s - packed[t, idx, 8]
+    c = abs(rate)
+    sigma = _min(_max(length - s_local if rate < 0 else s_local, 0.0), length)
+    scale = math.sqrt(np.pi / c)
+    _FRESNEL(sigma / scale, sc[0:].ctypes, sc[1:].ctypes)
+    a, b = scale * sc[1], scale * sc[0]
+    g2, g3 = packed[t, idx, 2], packed[t, idx, 3]
+    g4, g5 = packed[t, idx, 4], packed[t, idx, 5]
+    out[0] = packed[t, idx, 0] + a * g2 + b * g4
+    out[1] = packed[t, idx, 1] + a * g3 + b * g5
+    if derivatives:
+        phi = 0.5 * c * sigma * sigma
+        cs, sn = math.cos(phi), math.sin(phi)
+        sign = -1.0 if rate < 0 else 1.0
+        out[2] = sign * (cs * g2 + sn * g4)
+        out[3] = sign * (cs * g3 + sn * g5)
+        kappa = c * sigma
+        out[4] = kappa * (cs * g4 - sn * g2)
+        out[5] = kappa * (cs * g5 - sn * g3)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _distance(x: float, y: float, first: bool, r_in: float, r_out: float,
+              centre_out: float) -> float:  # pragma: no cover - compiled
+    """``_distance`` of one canonical point from the circle ``first`` selects."""
+    yc = r_in if first else centre_out
+    r = r_in if first else r_out
+    qy = y - yc
+    return abs(x * x + y * (y - 2.0 * yc)) / (math.sqrt(x * x + qy * qy) + r)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _slopes(packed, t, s, first, r_in, r_out, centre_out, sc, buf):  # pragma: no cover
+    """``_distance_slopes`` at one distance: the distance, its slope and its bend."""
+    _point(packed, t, s, sc, buf, True)
+    x, y = buf[0], buf[1]
+    yc = r_in if first else centre_out
+    r = r_in if first else r_out
+    qy = y - yc
+    norm = math.sqrt(x * x + qy * qy)
+    num = x * x + y * (y - 2.0 * yc)
+    sign = 1.0 if num > 0 else (-1.0 if num < 0 else (0.0 if num == 0 else num))
+    qt = x * buf[2] + qy * buf[3]
+    qa = x * buf[4] + qy * buf[5]
+    slope = sign * qt / norm
+    bend = sign * ((1.0 + qa) / norm - qt * qt / (norm * norm * norm))
+    return abs(num) / (norm + r), slope, bend
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _argmax(d: np.ndarray) -> int:  # pragma: no cover - compiled
+    """``numpy.argmax`` of a 1-d float array: the first largest, a NaN first of all."""
+    best, k = d[0], 0
+    if best != best:
+        return 0
+    for i in range(1, d.size):
+        v = d[i]
+        if v > best:
+            best, k = v, i
+        elif v != v:
+            return i
+    return k
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _bracket_max(packed, rows, a, b, first, start, r_in, r_out,
+                 centre_out):  # pragma: no cover - compiled
+    """``_bracket_max`` over the parts ``[a, b]`` of transitions ``rows`` (shape (m,)
+    each): value, converged, where; the Newton steps run until every inner part has
+    converged (or NEWTON_MAX_ITER)."""
+    m = rows.size
+    sc = np.empty(2)
+    buf = np.empty(6)
+    value = np.empty(m)
+    where = np.empty(m)
+    done = np.ones(m, dtype=np.bool_)
+    inner = np.zeros(m, dtype=np.bool_)
+    for i in range(m):
+        t = rows[i]
+        d_a, g_a, _ = _slopes(packed, t, a[i], first[i], r_in[t], r_out[t], centre_out[t],
+                              sc, buf)
+        d_b, g_b, _ = _slopes(packed, t, b[i], first[i], r_in[t], r_out[t], centre_out[t],
+                              sc, buf)
+        at_a = g_a <= 0
+        at_b = (not at_a) and g_b >= 0
+        value[i] = d_a if at_a else (d_b if at_b else -np.inf)
+        where[i] = a[i] if at_a else b[i]
+        inner[i] = not (at_a or at_b)
+    idx = np.flatnonzero(inner)
+    if idx.size == 0:
+        return value, done, where
+    lo = a[idx].copy()
+    hi = b[idx].copy()
+    x = start[idx].copy()
+    for n in range(idx.size):
+        if not (x[n] > lo[n] and x[n] < hi[n]):
+            x[n] = 0.5 * (lo[n] + hi[n])
+    conv = np.zeros(idx.size, dtype=np.bool_)
+    for _ in range(NEWTON_MAX_ITER):
+        every = True
+        for n in range(idx.size):
+            i = idx[n]
+            t = rows[i]
+            _, slope, bend = _slopes(packed, t, x[n], first[i], r_in[t], r_out[t],
+                                     centre_out[t], sc, buf)
+            if slope > 0:
+                lo[n] = x[n]
+            else:
+                hi[n] = x[n]
+            nxt = x[n] - slope / bend
+            if not (bend < 0 and nxt >= lo[n] and nxt <= hi[n]):
+                nxt = 0.5 * (lo[n] + hi[n])
+            conv[n] = abs(nxt - x[n]) <= NEWTON_STEP_TOL * b[i]
+            every = every and conv[n]
+            x[n] = nxt
+        if every:
+            break
+    for n in range(idx.size):
+        i = idx[n]
+        t = rows[i]
+        value[i] = _slopes(packed, t, x[n], first[i], r_in[t], r_out[t], centre_out[t],
+                           sc, buf)[0]
+        done[i] = conv[n]
+        where[i] = x[n]
+    return value, done, where
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _crossing(packed, rows, a, b, xa, xb):  # pragma: no cover - compiled
+    """``_crossing`` of transitions ``rows`` between ``a`` and ``b`` (shape (m,) each):
+    Newton steps on ``x(s)`` from the secant's root, all until every one has stopped."""
+    m = rows.size
+    sc = np.empty(2)
+    buf = np.empty(6)
+    t = np.empty(m)
+    for i in range(m):
+        v = a[i] - xa[i] * (b[i] - a[i]) / (xb[i] - xa[i])
+        t[i] = v if (v >= a[i] and v <= b[i]) else 0.5 * (a[i] + b[i])
+    for _ in range(NEWTON_MAX_ITER):
+        stop = True
+        for i in range(m):
+            _point(packed, rows[i], t[i], sc, buf, True)
+            nxt = _clip(t[i] - buf[0] / buf[2], a[i], b[i])
+            stop = stop and abs(nxt - t[i]) <= NEWTON_STEP_TOL * b[i]
+            t[i] = nxt
+        if stop:
+            break
+    return t
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
+           centre_out: np.ndarray, near: np.ndarray, use_near: bool, samples: int,
+           scan: int, lin: np.ndarray, off: np.ndarray):  # pragma: no cover - compiled
+    """The search of ``_deviation_where`` up to its fallback refinement.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray, shape (k, p, 9)
+        ``_packed`` pieces.
+    total : numpy.ndarray, shape (k,)
+        Rounding lengths (``lengths.sum(axis=1)``), mm.
+    r_in, r_out, centre_out : numpy.ndarray, shape (k,)
+        mm.
+    near : numpy.ndarray, shape (k,)
+        Where to refine (with ``use_near``), mm.
+    samples, scan : int
+        Samples per piece and scan rounds (without ``use_near``).
+    lin : numpy.ndarray, shape (samples + 1,)
+        ``numpy.linspace(0, 1, samples + 1)``.
+    off : numpy.ndarray, shape (REFINE_POINTS,)
+        The scan's offsets, in units of its half width.
+
+    Returns
+    -------
+    best, where, at, h0, win_lo, win_hi : numpy.ndarray, shape (k,)
+        The deviation, where it was found, the scan's last centre and the sample spacing
+        (both for the fallback), the last window, mm.
+    ok : numpy.ndarray of bool, shape (k,)
+        The Newton steps converged on every part of the window.
+    """
+    k, p = packed.shape[0], packed.shape[1]
+    sc = np.empty(2)
+    buf = np.empty(6)
+    best = np.empty(k)
+    at = np.empty(k)
+    h = np.empty(k)
+    h0 = np.empty(k)
+    if not use_near:
+        n1 = samples + 1
+        dev = np.empty(p * n1)
+        sv = np.empty(p * n1)
+        d = np.empty(off.size)
+        xs = np.empty(off.size)
+        for t in range(k):
+            for j in range(p):
+                rate, length, st = packed[t, j, 6], packed[t, j, 7], packed[t, j, 8]
+                scale = math.sqrt(np.pi / abs(rate))
+                for i in range(n1):
+                    s_local = length * lin[i]
+                    sigma = length - s_local if rate < 0 else s_local
+                    _FRESNEL(sigma / scale, sc[0:].ctypes, sc[1:].ctypes)
+                    fc, fs = scale * sc[1], scale * sc[0]
+                    x = packed[t, j, 0] + fc * packed[t, j, 2] + fs * packed[t, j, 4]
+                    y = packed[t, j, 1] + fc * packed[t, j, 3] + fs * packed[t, j, 5]
+                    dev[j * n1 + i] = _distance(x, y, x <= 0, r_in[t], r_out[t],
+                                                centre_out[t])
+                    sv[j * n1 + i] = st + s_local
+            i = _argmax(dev)
+            best[t], at[t] = dev[i], sv[i]
+            h0[t] = packed[t, min(i // n1, p - 1), 7] / samples
+            h[t] = h0[t]
+            for _ in range(scan):
+                for q in range(off.size):
+                    xq = _clip(at[t] + h[t] * off[q], 0.0, total[t])
+                    _point(packed, t, xq, sc, buf, False)
+                    xs[q] = xq
+                    d[q] = _distance(buf[0], buf[1], buf[0] <= 0, r_in[t], r_out[t],
+                                     centre_out[t])
+                j = _argmax(d)
+                if d[j] > best[t]:
+                    best[t], at[t] = d[j], xs[j]
+                h[t] = h[t] / REFINE_SHRINK
+    else:
+        for t in range(k):
+            at[t] = _clip(near[t], 0.0, total[t])
+            piece, run = 0, 0.0
+            for j in range(p - 1):
+                run = packed[t, j, 7] if j == 0 else run + packed[t, j, 7]
+                if at[t] >= run:
+                    piece += 1
+            h0[t] = packed[t, piece, 7] / DEV_SAMPLES
+            h[t] = h0[t] / REFINE_SHRINK
+            best[t] = -np.inf
+    where = at.copy()
+    lo = np.empty(k)
+    hi = np.empty(k)
+    x_lo = np.empty(k)
+    x_hi = np.empty(k)
+    for t in range(k):
+        lo[t] = _max(at[t] - h[t], 0.0)
+        hi[t] = _min(at[t] + h[t], total[t])
+        _point(packed, t, lo[t], sc, buf, False)
+        x_lo[t] = buf[0]
+        _point(packed, t, hi[t], sc, buf, False)
+        x_hi[t] = buf[0]
+    split = np.flatnonzero((x_lo <= 0) & (x_hi > 0))
+    cross = _crossing(packed, split, lo[split], hi[split], x_lo[split], x_hi[split])
+    mid = hi.copy()
+    mid[split] = cross
+    rows = np.concatenate((np.arange(k), split))
+    a = np.concatenate((lo, cross))
+    b = np.concatenate((mid, hi[split]))
+    first = np.concatenate((x_lo <= 0, np.zeros(split.size, dtype=np.bool_)))
+    value, done, at_value = _bracket_max(packed, rows, a, b, first, at[rows], r_in, r_out,
+                                         centre_out)
+    # the window's part with the larger value (the first part where they tie)
+    for i in range(rows.size):
+        t = rows[i]
+        if value[i] > best[t]:
+            where[t] = at_value[i]
+            best[t] = value[i]
+    ok = np.ones(k, dtype=np.bool_)
+    for i in range(rows.size):
+        ok[rows[i]] = ok[rows[i]] and done[i]
+    return best, where, at, h0, lo, hi, ok
+
+
+def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
+                    scan=SCAN_ROUNDS):
+    """:func:`reference.core.transition_sbend._deviation_where` by the compiled
+    :func:`search` (the same arguments and results, bit for bit)."""
+    lengths = pieces[4]
+    k = lengths.shape[0]
+    f64 = np.float64
+    total = lengths.sum(axis=1)
+    packed = np.ascontiguousarray(_packed(pieces), f64)
+    r_in, r_out, centre_out = (np.ascontiguousarray(v, f64) for v in (r_in, r_out,
+                                                                        centre_out))
+    use_near = near is not None
+    near_arr = np.ascontiguousarray(near, f64) if use_near else np.zeros(k)
+    off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
+    best, where, at, h0, win_lo, win_hi, ok = search(
+        packed, np.ascontiguousarray(total, f64), r_in, r_out, centre_out, near_arr,
+        use_near, int(samples), int(scan), np.linspace(0.0, 1.0, int(samples) + 1), off)
+    if not ok.all():
+        rest = np.flatnonzero(~ok)
+        best[rest] = np.maximum(best[rest], _refine_sampled(
+            packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
+            centre_out[rest]))
+    return best, where, (where > win_lo) & (where < win_hi)
+
+
+# ----------------------------------------------------------------- same-way landing
+@njit(cache=True, nogil=True, error_model="numpy")
+def _landing(t1, p2, r_in, r_out, rate, xq1, yq1, xq2, yq2, th, sc,
+             out):  # pragma: no cover - compiled
+    """``transition_samedir._landing`` of one transition: ``out[0:2]`` the miss,
+    ``out[2:6]`` the Jacobian ``j00, j01, j10, j11``; ``th = tan(h / 2)`` computed by
+    numpy (:func:`samedir_newton`)."""
+    b = -t1
+    uax, uay = math.cos(b), math.sin(b)
+    nax, nay = -uay, uax
+    ubx, uby = math.cos(p2), math.sin(p2)
+    nbx, nby = -uby, ubx
+    s1 = math.sin(0.5 * t1)
+    p1x, p1y = -r_in * math.sin(t1), 2.0 * r_in * (s1 * s1)
+    s2 = math.sin(0.5 * p2)
+    p2x, p2y = r_out * math.sin(p2), 2.0 * r_out * (s2 * s2)
+    q1x, q1y = p1x - xq1 * uax + yq1 * nax, p1y - xq1 * uay + yq1 * nay
+    q2x, q2y = p2x + xq2 * ubx + yq2 * nbx, p2y + xq2 * uby + yq2 * nby
+    d1x, d1y = (yq1 - r_in) * uax + xq1 * nax, (yq1 - r_in) * uay + xq1 * nay
+    d2x, d2y = (r_out - yq2) * ubx + xq2 * nbx, (r_out - yq2) * uby + xq2 * nby
+    h = t1 + p2
+    l_p = np.sqrt(h / rate)
+    # clothoid_pair_shape(h), its tan(h/2) = th
+    scale = np.sqrt(np.pi / h)
+    _FRESNEL(1.0 / scale, sc[0:].ctypes, sc[1:].ctypes)
+    big_x, big_y = scale * sc[1], scale * sc[0]
+    d_1 = big_x + big_y * th
+    half = h / 2.0
+    e_1 = big_y / math.cos(half)
+    d_p = l_p * d_1
+    wx, wy = uax + ubx, uay + uby
+    out[0] = q2x - q1x - d_p * wx
+    out[1] = q2y - q1y - d_p * wy
+    ch, sh = math.cos(0.5 * h), math.sin(0.5 * h)
+    y = e_1 * ch
+    x = d_1 - y * th
+    dd1 = (ch - x) / (2.0 * h) + (sh - y) / (2.0 * h) * th + 0.5 * y / (ch * ch)
+    dd = 0.5 * d_p / h + l_p * dd1
+    out[2] = -d1x - dd * wx + d_p * nax
+    out[3] = d2x - dd * wx - d_p * nbx
+    out[4] = -d1y - dd * wy + d_p * nay
+    out[5] = d2y - dd * wy - d_p * nby
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _newton_step(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, tol, theta_max,
+                 halvings):  # pragma: no cover - compiled
+    """One step of ``transition_samedir._newton`` for every transition still iterating
+    (shape (m,) each): whether it lands at ``(a1, a2)``, whether it steps, and the
+    iterates after the step (``_halved`` included)."""
+    m = a1.size
+    ok = np.empty(m, dtype=np.bool_)
+    step = np.empty(m, dtype=np.bool_)
+    n1 = a1.copy()
+    n2 = a2.copy()
+    sc = np.empty(2)
+    out = np.empty(6)
+    for i in range(m):
+        _landing(a1[i], a2[i], r1[i], r2[i], c[i], xq1[i], yq1[i], xq2[i], yq2[i], th[i],
+                 sc, out)
+        g0, g1 = out[0], out[1]
+        ok[i] = abs(g0) <= tol and abs(g1) <= tol
+        j00, j01, j10, j11 = out[2], out[3], out[4], out[5]
+        det = j00 * j11 - j01 * j10
+        dt = -(j11 * g0 - j01 * g1) / det
+        dp = -(j00 * g1 - j10 * g0) / det
+        a, b = a1[i] + dt, a2[i] + dp
+        if not (a + a2[i] + dp > 0 and abs(a) < theta_max and abs(b) < theta_max):
+            # the halvings dt 2^-k, the first allowed, else the last
+            ct, cp = dt, dp
+            for k in range(halvings + 1):
+                if k > 0:
+                    ct, cp = ct * 0.5, cp * 0.5
+                a, b = a1[i] + ct, a2[i] + cp
+                if k == halvings or (a + a2[i] + cp > 0 and abs(a) < theta_max
+                                     and abs(b) < theta_max):
+                    break
+            dt, dp = ct, cp
+        step[i] = (not ok[i]) and np.isfinite(dt) and np.isfinite(dp)
+        if step[i]:
+            n1[i] = a1[i] + dt
+            n2[i] = a2[i] + dp
+    return ok, step, n1, n2
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _lands(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, tol):  # pragma: no cover
+    """Whether each transition's landing misses by at most ``tol`` at ``(a1, a2)``."""
+    out = np.empty(6)
+    sc = np.empty(2)
+    res = np.empty(a1.size, dtype=np.bool_)
+    for i in range(a1.size):
+        _landing(a1[i], a2[i], r1[i], r2[i], c[i], xq1[i], yq1[i], xq2[i], yq2[i], th[i],
+                 sc, out)
+        res[i] = abs(out[0]) <= tol and abs(out[1]) <= tol
+    return res
+
+
+def samedir_newton(r_in, r_out, ramp, rate, off, flat_out):
+    """:func:`reference.core.transition_samedir._newton` with each step compiled
+    (:func:`_newton_step`; the same arguments and results, bit for bit). ``tan(h/2)``
+    is numpy's, computed here over the transitions still iterating as ``_landing``
+    computes it (numpy's float64 ``tan`` is vectorised, SVML on AVX-512, and differs
+    from the C library's in the last bit); every other operation the C library's, which
+    numpy's float64 loops match."""
+    t1, p2 = _start(r_in, r_out, ramp, rate, flat_out)
+    lands = np.zeros(t1.shape, bool)
+    act = np.arange(t1.size)
+    a1, a2 = t1, p2
+    r1, r2, c, o = r_in, r_out, rate, off
+    for _ in range(NEWTON_MAX_ITER_SAMEDIR):
+        if not act.size:
+            break
+        with np.errstate(invalid="ignore", divide="ignore"):
+            th = np.tan(0.5 * (a1 + a2))
+        ok, step, a1, a2 = _newton_step(a1, a2, r1, r2, c, *o, th, LANDING_TOL_MM,
+                                        THETA_MAX, STEP_HALVINGS)
+        lands[act[ok]] = True
+        if not step.all():                    # some stop: write back, compact the rest
+            t1[act], p2[act] = a1, a2
+            act, a1, a2 = act[step], a1[step], a2[step]
+            r1, r2, c, o = r1[step], r2[step], c[step], tuple(x[step] for x in o)
+    if act.size:                              # still iterating: the miss after the last step
+        t1[act], p2[act] = a1, a2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            th = np.tan(0.5 * (a1 + a2))
+        lands[act] = _lands(a1, a2, r1, r2, c, *o, th, LANDING_TOL_MM)
+    lands &= t1 + p2 > 0
+    return np.where(lands, t1, np.nan), np.where(lands, p2, np.nan)
