@@ -14,9 +14,9 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each; for
    ``jerk+freq`` where these leave the bracket open, the jerk optimum re-solved under caps
    adapted to its own short phases, :mod:`optimal.freq.jerk_adapted`), and the fastest
-   candidate per rest-to-rest piece, joined, the ramp plan of every straight piece among
-   them (:mod:`optimal.freq.ramps`: humps of ramps of at least ``1/f`` per segment,
-   S-curves for ``jerk+freq``);
+   candidate per rest-to-rest piece, joined, the ramp plan of every piece among them
+   (:mod:`optimal.freq.ramps`: humps of ramps of at least ``1/f`` per segment, S-curves
+   for ``jerk+freq``, budgets that leave curves their centripetal part);
 4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -177,7 +177,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                                   progress=(lambda msg: progress(msg, 0.85))
                                   if progress else None)
     # pieces start and end at rest: the fastest candidate on each, joined, the ramp plan
-    # of every straight piece among them (optimal.freq.ramps: S-curve ramps for jerk+freq)
+    # of every piece among them (optimal.freq.ramps: S-curve ramps for jerk+freq)
     joined = pieced(path, cands, ramp_plan(path, limits, jerk=base == "jerk"))
     if joined is not None:
         c = verified("fastest per piece", path, limits, joined, name)

@@ -234,6 +234,89 @@ def test_ramp_plan_s_curves_keep_the_corner_times_where_1_f_binds():
     assert check_profile(path, lim, soft).ok(BOUND_SETS["jerk+freq"])
 
 
+def _sampled_axis_derivatives(path, prof, order, dt=2e-4, skip_s=None):
+    """Largest ``|d^order q_i / dt^order|`` per axis by finite differences of the axis
+    positions sampled every ``dt`` (an independent judge, not the checker); differences
+    touching a sample within ``skip_s`` mm of an inner segment break are left out (steps
+    the rulebook spreads over one IPO cycle)."""
+    t = np.arange(0.0, prof.duration, dt)
+    s, _, _, _ = prof.state(t)
+    d = np.diff(path.evaluate(s)[0], order, axis=0) / dt ** order
+    if skip_s is not None and path.n_segments > 1:
+        gap = np.min(np.abs(s[:, None] - path.s_breaks[None, 1:-1]), axis=1)
+        near = np.convolve(gap <= skip_s, np.ones(order + 1), "valid") > 0
+        d = d[~near]
+    return np.max(np.abs(d), axis=0)
+
+
+def test_ramp_plan_on_a_wide_arc_is_the_closed_form():
+    """Rest to rest on a half circle of R = 200 mm at F100 (A = 2000 mm/s^2, 10 Hz): the
+    centripetal 100^2 / 200 = 50 mm/s^2 leaves the ramps 1950 mm/s^2, more than the
+    1000 mm/s^2 of a ramp to 100 mm/s in 1/f, so DESIGN 6's closed form L/v + 1/f holds
+    on the curve too; the axis accelerations, by second differences of the sampled
+    positions, stay within A."""
+    from oracle_cases import semicircle
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    R, F = 200.0, 100.0
+    path = semicircle(R, feed=F)
+    lim = _xyz(a=2000.0, f=10.0)
+    prof = ramp_plan(path, lim)[0]
+    assert prof.duration == pytest.approx(np.pi * R / F + 0.1, rel=1e-12)
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["acc+freq"])
+    assert np.all(_sampled_axis_derivatives(path, prof, 2)[:2] <= 2000.0 * (1 + 1e-3))
+
+
+def test_ramp_plan_crosses_a_tight_arc_at_its_curvature_limit():
+    """Line, half circle of R = 5 mm, line (50 mm each) at F200, A = 2000 mm/s^2, 10 Hz:
+    the arc's centripetal limit sqrt(A R) = 100 mm/s leaves no room to ramp on it, so the
+    fastest plan crosses it at exactly 100 mm/s, and the lines ramp by hand: rest to 200
+    mm/s in 1/f (10 mm), 25 mm at 200, down to 100 in 1/f (15 mm), i.e. 0.325 s each,
+    plus pi R / 100 on the arc."""
+    from oracle_cases import line_arc_line
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    path = line_arc_line(5.0, 50.0, feed=200.0)
+    lim = _xyz(a=2000.0, f=10.0)
+    prof = ramp_plan(path, lim)[0]
+    assert prof.duration == pytest.approx(2 * 0.325 + np.pi * 5.0 / 100.0, rel=1e-9)
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["acc+freq"])
+    on_arc = (prof.s[:-1] >= 50.0) & (prof.s[1:] <= 50.0 + np.pi * 5.0)
+    assert np.any(on_arc)
+    np.testing.assert_allclose(prof.v[:-1][on_arc], 100.0, rtol=1e-12)
+
+
+def test_ramp_plan_s_curves_on_arcs_keep_the_axis_jerk():
+    """``jerk+freq`` on the half circle of R = 200 mm at F100 (J = 1e5 mm/s^3, 10 Hz):
+    the curve's jerk terms (``3 |q''| v s''`` and ``|q'''| v^3``) leave the S-curve more
+    than the jerk of a ramp to 100 mm/s in 1/f, so L/v + 1/f holds. On the line-arc-line
+    of R = 5 mm the break where the curvature jumps is crossed at most at sqrt(J t_ipo R)
+    (the centripetal step over one IPO cycle, by hand). The axis jerks by third
+    differences stay within J away from the breaks, and the checker accepts both."""
+    from oracle_cases import line_arc_line, semicircle
+    from optimal.freq.ramps import ramp_plan
+    from reference.core import AxisLimits, MachineLimits
+    from reference.core.constraints import BOUND_SETS, check_profile
+
+    J = 1e5
+    lim = MachineLimits(tuple(AxisLimits(n, 500.0, 2000.0, J, 1.2, 10.0) for n in "XYZ"),
+                        0.004)
+    arc = semicircle(200.0, feed=100.0)
+    prof = ramp_plan(arc, lim, jerk=True)[0]
+    assert prof.duration == pytest.approx(np.pi * 200.0 / 100.0 + 0.1, rel=1e-12)
+    assert check_profile(arc, lim, prof).ok(BOUND_SETS["jerk+freq"])
+    assert np.all(_sampled_axis_derivatives(arc, prof, 3)[:2] <= J * (1 + 1e-2))
+    path = line_arc_line(5.0, 50.0, feed=200.0)
+    prof = ramp_plan(path, lim, jerk=True)[0]
+    assert check_profile(path, lim, prof).ok(BOUND_SETS["jerk+freq"])
+    v_break = prof.state(np.interp(50.0, prof.s, prof.t))[1]
+    assert v_break <= np.sqrt(J * 0.004 * 5.0) * (1 + 1e-9)
+    jerk_away = _sampled_axis_derivatives(path, prof, 3, skip_s=0.5)
+    assert np.all(jerk_away[:2] <= J * (1 + 1e-2))
+
+
 def test_pieced_takes_the_faster_motion_on_each_piece():
     """Two pieces (an exact stop between), two hand motions each faster on one piece: the
     joined motion takes the sum of the faster halves and is accepted."""
@@ -268,3 +351,32 @@ def test_pieced_takes_the_faster_motion_on_each_piece():
     assert check_profile(path, lim, out).ok(BOUND_SETS["acc+freq"])
     # one motion fastest everywhere: nothing to join
     assert pieced(path, cands[:1]) is None
+
+
+@pytest.mark.parametrize("machine_name", [None, "linuxcnc_xyz"])
+@pytest.mark.parametrize("jerk", [False, True])
+def test_ramp_plan_is_accepted_as_built_on_blended_polylines(machine_name, jerk):
+    """Random polylines with circular blends (segments of 0.05-30 mm, blends of 0.01-1 mm
+    deviation, feeds of 20-200 mm/s) on both bundled machines: the checker accepts every
+    ramp plan as it is built (no time scaling), under the plan's own bound set. Found
+    two round-off holes before they were closed: a curve crossed at its curvature limit
+    left a budget of 1e-14 mm/s^2 (ramps of ~1e14 s, position lost), and an S-curve's
+    constant part of ~1e-17 s did not advance the position, so the checker cut the
+    phase in two there."""
+    from dataclasses import replace
+
+    from oracle_cases import random_blended_polyline
+    from optimal.freq.ramps import ramp_plan
+    from reference.core.constraints import BOUND_SETS, check_profile
+    from reference.machine import load_machine
+
+    m = load_machine(machine_name)
+    cons = BOUND_SETS["jerk+freq" if jerk else "acc+freq"]
+    for seed in range(24):
+        rng = np.random.default_rng(seed + 1000)
+        step = [(0.1, 20.0), (2.0, 30.0), (0.05, 2.0)][seed % 3]
+        path = random_blended_polyline(int(rng.integers(2, 12)), seed, step=step,
+                                       max_deviation=[0.01, 0.1, 1.0][seed % 3])
+        path = replace(path, feed=np.full(path.n_segments, float(rng.uniform(20, 200))))
+        prof = ramp_plan(path, m.limits, jerk=jerk)[0]
+        assert check_profile(path, m.limits, prof).ok(cons), (machine_name, jerk, seed)
