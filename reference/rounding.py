@@ -398,11 +398,17 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         decide(sub, "rounding would slow the program down (between two very short blocks)")
         sub[:] = False
         # what the window leaves of the blocks it cuts (the corner's own two, or the
-        # first and last block it touches across short blocks)
+        # first and last block it touches across short blocks), with every open corner
+        # counted as rounded: a block rounded at both ends keeps one IPO cycle for what
+        # is left between the two roundings (5.3), so each is judged with that cap
+        # (errs toward a short leftover, as the tangential transitions' estimate)
         sb = path.s_breaks
         s_c = sb[a[o] + 1]
-        left_in = (s_c - d[o]) - sb[first[o]]
-        left_out = sb[last[o] + 1] - (s_c + d[o])
+        w_lo, w_hi = sb.copy(), sb.copy()
+        np.minimum.at(w_lo, a[o] + 1, s_c - d[o])
+        np.maximum.at(w_hi, a[o] + 1, s_c + d[o])
+        left_in = np.maximum((s_c - d[o]) - w_hi[first[o]], 0.0)
+        left_out = np.maximum(w_lo[last[o] + 1] - (s_c + d[o]), 0.0)
         sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
                                     shape.length[o], d[o], None, left_in, left_out,
                                     machine.limits.t_ipo_s)
@@ -418,9 +424,15 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     clamped, g2_out = clamped & ins, g2 & ins
     tr = None
     if trans.size:
+        # where the corner roundings decided so far start and end, per break
+        s_c = path.s_breaks[a + 1]
+        w_lo, w_hi = path.s_breaks.copy(), path.s_breaks.copy()
+        np.minimum.at(w_lo, a + 1, s_c - dist)
+        np.maximum.at(w_hi, a + 1, s_c + dist)
         tr = tangential_transitions(path, machine, a[trans], ka[trans],
                                     attrs["accel"][ka[trans]], CENTRIPETAL_SHARE,
-                                    JERK_VELOCITY_SHARE, corner_time_loss)
+                                    JERK_VELOCITY_SHARE, corner_time_loss,
+                                    windows=(w_lo, w_hi))
         reason[trans] = tr.reason
         dist[trans] = np.maximum(tr.trim_in, tr.trim_out)
         length[trans], dev[trans], rad[trans] = tr.length, tr.deviation, tr.radius

@@ -348,3 +348,21 @@ def test_g645_is_not_slower_on_a_seeded_line_arc_chain(mfile):
     assert out["G645"][1] <= out["G64"][1] * (1 + 1e-9)
     if mfile == "default":
         assert out["G645"][0].rounding.inserted.sum() > 50
+
+
+@pytest.mark.parametrize("n, seed, kink, feed", [(120, 1, 0.0, 6000)])
+def test_g645_judges_a_line_cut_from_both_ends_with_its_ipo_cycle(n, seed, kink, feed):
+    """spec 5.3 ("every block ... needs at least one interpolation point") with 5.2
+    group 2 ("rounding would slow the program down"): on this seeded chain two G645
+    transitions each paid when judged alone, but together left of a 4.28 mm line (block
+    30) a piece of 0.066 mm, whose one-IPO-cycle cap (16.5 mm/s at 4 ms) held the path
+    there where G64 passes at 51..58 mm/s: the program was 0.29 % slower than under G64. The estimate now
+    judges what the transitions leave of a segment with every rounding beside it in,
+    and the program is not slower than under G64 (the heuristic's own plan of it)."""
+    mach = load_machine("default")
+    body = line_arc_chain(n, seed, kink_deg=kink)
+    times = {}
+    for mode in ("G64", "G645"):
+        prog = parse_text(f"G17 G90 {mode} SOFT F{feed}\nG1 X0 Y0\n" + body)
+        times[mode] = plan(prog, mach, check=False).time_s
+    assert times["G645"] <= times["G64"] * (1 + 1e-12)
