@@ -59,6 +59,9 @@ def print_comparison(c: Comparison, max_gap: float | None, out: TextIO,
         out.write(f"    ORACLE VIOLATION {describe_violation(item, c)}\n")
     if c.certified:
         valid = "" if c.gap_lower_valid else "   (lower end: gap to the relaxation only)"
+        if c.stricter_violations:
+            valid = (f"   (against the stricter {c.oracle.bounds} optimum, whose "
+                     f"{c.stricter_violations[0].constraint} limit the planner breaks)")
         if c.hold_s > 0:
             out.write(f"  {'holds':<10} {c.hold_s:10.4f} s   dwell and exact-stop settle, the "
                       f"same on both sides: not counted in the gap\n")

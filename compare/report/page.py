@@ -144,6 +144,8 @@ def banner(c: Comparison, v: Verdict) -> tuple[str, str]:
     A passing program is green only when the oracle reached its tolerance; otherwise
     (status ``gap_not_met``, ...) the banner is amber, names the status and says how wide
     the bracket ``UB/LB − 1`` is, since the gap interval is then only as tight as that.
+    It is amber too where the oracle solved a stricter bound set than the planner keeps
+    and the planner breaks what it adds (:attr:`Comparison.stricter_violations`).
 
     Returns
     -------
@@ -162,6 +164,9 @@ def banner(c: Comparison, v: Verdict) -> tuple[str, str]:
                                                        c.certified else "")
     if loose:
         return "warn", f"⚠ {v.status}, with a wide bracket: {loose}; {v.text}"
+    if c.stricter_violations:
+        # not like with like: the gap is to an optimum the planner is not held to
+        return "warn", f"⚠ {v.status}, against a stricter bound set: {v.text}"
     return "ok", f"✔ {v.status}: {v.text}"
 
 
@@ -173,6 +178,8 @@ def _short_verdict(c: Comparison, v: Verdict) -> str:
         b = bracket(c)
         width = f"{100 * b:.1f} %" if math.isfinite(b) else "unknown"
         return f"⚠ ok, bracket {width} ({c.oracle.status})"
+    if c.stricter_violations:
+        return f"⚠ ok, against stricter {c.oracle.bounds}"
     return "✔ ok"
 
 
@@ -370,6 +377,9 @@ def render_report(c: Comparison, *, max_gap: float | None = None,
              f"motion times: (t_ref − H)/(UB − H) − 1 … (t_ref − H)/(LB − H) − 1, "
              f"H = {c.hold_s:.4f} s of dwell and exact-stop settle on both sides") + (
         "" if c.gap_lower_valid else " (lower end: vs. the relaxation)") + (
+        f" (against the stricter {o.bounds} optimum, whose "
+        f"{c.stricter_violations[0].constraint} limit the {w} breaks)"
+        if c.certified and c.stricter_violations else "") + (
         f"; the {w}'s own motion meets the same limits and is faster than the oracle's, "
         "so the gap is at least 0" if c.certified and c.reference_bounds_optimum else "")
     cards = "".join([

@@ -209,3 +209,42 @@ def test_a_planner_faster_than_the_oracles_verified_motion_is_said_so(small, mac
     assert not broken.reference_bounds_optimum
     # an upper bound below the plan's time: nothing to say either
     assert "at least 0" not in compare(plan, sol, program=program).verdict(None).text
+
+
+def test_a_stricter_oracle_set_the_planner_breaks_is_named_in_the_verdict(small, machine):
+    """``--bounds acc+freq`` for a planner that declares ``acc``: the oracle's set adds
+    the frequency rule, which the (fake) plan breaks, so the plan can be faster than the
+    certified lower bound without a broken certificate. The verdict names the rule it
+    breaks and says the interval is not its gap to an optimum it is held to; against an
+    ``acc`` oracle it reads as before."""
+    from reference.core.constraints import time_scale_factor
+    program, path, _, _ = small
+    # every axis at 2 Hz: phases of at least 0.5 s, which the fake plan's ramps are not
+    lim = replace(machine.limits, axes=tuple(replace(a, frequency_hz=2.0)
+                                             for a in machine.limits.axes))
+    plan, sol = fake_plan(path, lim), fake_solution(path, lim)
+    freq = BOUND_SETS["acc+freq"]
+    # precondition: the plan breaks the frequency rule and nothing of its own set
+    assert plan.report.violations(("frequency",)) and not plan.report.violations(
+        BOUND_SETS["acc"])
+    # a stricter "optimum": the oracle's motion slowed down until the rule holds, its
+    # lower bound above the plan's time (as the frequency rule allows)
+    rep = check_profile(path, lim, sol.profile)
+    slow = scale_time(sol.profile, time_scale_factor(rep, freq) * (1 + 1e-6))
+    assert check_profile(path, lim, slow).ok(freq)
+    lb = 1.05 * plan.profile.duration
+    strict = FakeSolution(SolveStatus.OPTIMAL, slow, lb, max(slow.duration, lb),
+                          bounds="acc+freq")
+    c = compare(plan, strict, program=program)
+    assert c.gap_upper < 0 and [v.constraint for v in c.stricter_violations] == ["frequency"]
+    v = c.verdict(None)
+    assert v.ok and "not the stricter acc+freq set" in v.text and "frequency" in v.text
+    assert "not its gap to an optimum it is held to" in v.text
+    # the report's banner is amber, not green: the numbers are not its optimality gap
+    from compare.report.page import banner
+    assert banner(c, v)[0] == "warn" and "stricter bound set" in banner(c, v)[1]
+    # the same planner against an acc oracle (below its time, as a certificate must be)
+    same = compare(plan, replace(strict, bounds="acc", lower_bound_s=0.99 * plan.profile
+                                 .duration), program=program)
+    assert not same.stricter_violations
+    assert "slower than the time-optimal motion" in same.verdict(None).text
