@@ -116,8 +116,8 @@ from .core.geometry import KIND_CODES, Path, clothoid_pair_shape, clothoid_piece
 from .core.limits import AxisArrays
 from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
                             RoundingTable, always_rounds, axis_deviation_limit,
-                            deflection_angle, distance_for_deviation, fillet_pieces,
-                            very_short_blocks)
+                            break_windows, deflection_angle, distance_for_deviation,
+                            fillet_pieces, very_short_blocks)
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential, junction_speed_cap
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .machine import Machine
@@ -404,9 +404,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         # (errs toward a short leftover, as the tangential transitions' estimate)
         sb = path.s_breaks
         s_c = sb[a[o] + 1]
-        w_lo, w_hi = sb.copy(), sb.copy()
-        np.minimum.at(w_lo, a[o] + 1, s_c - d[o])
-        np.maximum.at(w_hi, a[o] + 1, s_c + d[o])
+        w_lo, w_hi = break_windows(sb, a[o] + 1, d[o], d[o])
         left_in = np.maximum((s_c - d[o]) - w_hi[first[o]], 0.0)
         left_out = np.maximum(w_lo[last[o] + 1] - (s_c + d[o]), 0.0)
         sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
@@ -424,15 +422,11 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     clamped, g2_out = clamped & ins, g2 & ins
     tr = None
     if trans.size:
-        # where the corner roundings decided so far start and end, per break
-        s_c = path.s_breaks[a + 1]
-        w_lo, w_hi = path.s_breaks.copy(), path.s_breaks.copy()
-        np.minimum.at(w_lo, a + 1, s_c - dist)
-        np.maximum.at(w_hi, a + 1, s_c + dist)
+        # with where the corner roundings decided so far start and end, per break
         tr = tangential_transitions(path, machine, a[trans], ka[trans],
                                     attrs["accel"][ka[trans]], CENTRIPETAL_SHARE,
                                     JERK_VELOCITY_SHARE, corner_time_loss,
-                                    windows=(w_lo, w_hi))
+                                    windows=break_windows(path.s_breaks, a + 1, dist, dist))
         reason[trans] = tr.reason
         dist[trans] = np.maximum(tr.trim_in, tr.trim_out)
         length[trans], dev[trans], rad[trans] = tr.length, tr.deviation, tr.radius

@@ -57,7 +57,7 @@ import numpy as np
 from .core.arrays import row_min
 from .core.geometry import KIND_CODES, Path
 from .core.limits import AxisArrays
-from .core.rounding import REASON_CODE
+from .core.rounding import REASON_CODE, break_windows, leftovers
 from .core.rules import FEASIBLE, curvature_jump_speed_cap, is_tangential
 from .core.tolerances import MIN_SEGMENT_LENGTH_MM, MOVING_AXIS_TOL
 from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
@@ -480,13 +480,7 @@ def _leftovers(path: Path, a: np.ndarray, b: np.ndarray, cut_in: np.ndarray,
     short for its IPO cycle (5.3) are both judged with that cap (a seeded line-arc chain
     under G645 SOFT was 0.3 % slower than under G64 where each was judged alone).
     """
-    sb = path.s_breaks
-    lo = sb.copy() if windows is None else np.minimum(sb, windows[0])
-    hi = sb.copy() if windows is None else np.maximum(sb, windows[1])
-    j = a + 1
-    np.minimum.at(lo, j, sb[j] - cut_in)
-    np.maximum.at(hi, j, sb[j] + cut_out)
-    left = np.maximum(lo[1:] - hi[:-1], 0.0)            # per segment, (m,)
+    left = leftovers(*break_windows(path.s_breaks, a + 1, cut_in, cut_out, windows))
     return left[a], left[b]
 
 

@@ -117,6 +117,44 @@ def very_short_blocks(l_in: np.ndarray, l_out: np.ndarray, v: np.ndarray,
     return (l_in <= v * t_ipo) & (l_out <= v * t_ipo)
 
 
+def break_windows(s_breaks: np.ndarray, at: np.ndarray, before: np.ndarray,
+                  after: np.ndarray, windows: tuple[np.ndarray, np.ndarray] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Per segment break, the path positions where the roundings at it start and end.
+
+    The one record the rounding decisions share of what the roundings cut (the corner
+    estimate, the G645 transitions' estimate and the hand-over between them), so that
+    what a block keeps between two roundings (:func:`leftovers`) is judged alike.
+
+    Parameters
+    ----------
+    s_breaks : numpy.ndarray, shape (m + 1,)
+        Break positions, mm.
+    at : numpy.ndarray of int, shape (k,)
+        Breaks with a rounding (a break may repeat: the widest counts).
+    before, after : numpy.ndarray, shape (k,)
+        Length each rounding replaces before and after its break, mm.
+    windows : tuple of numpy.ndarray, shape (m + 1,) each, optional
+        Windows known already (of an earlier decision), widened by these.
+
+    Returns
+    -------
+    lo, hi : numpy.ndarray, shape (m + 1,)
+        Start and end of the window at every break (the break itself where none), mm.
+    """
+    lo = s_breaks.copy() if windows is None else np.minimum(s_breaks, windows[0])
+    hi = s_breaks.copy() if windows is None else np.maximum(s_breaks, windows[1])
+    np.minimum.at(lo, at, s_breaks[at] - before)
+    np.maximum.at(hi, at, s_breaks[at] + after)
+    return lo, hi
+
+
+def leftovers(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Length of every segment left between the windows at its two ends, mm, shape (m,)
+    (0 where they meet or overlap; ``lo``, ``hi`` of :func:`break_windows`)."""
+    return np.maximum(lo[1:] - hi[:-1], 0.0)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class RoundingTable:
     """What the rounding stage decided at every corner whose first block is in a
@@ -817,9 +855,10 @@ def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray
 
 __all__ = ["ArcFillet", "CircleFillet", "INTERNAL_MODES", "OVERLOAD_CHECKED_MODES",
            "REASON_CODE", "ROUNDING_REASONS", "RoundingTable", "always_rounds",
-           "axis_deviation_limit", "circle_circle_fillet", "circle_fillet_deviation",
+           "axis_deviation_limit", "break_windows", "circle_circle_fillet", "circle_fillet_deviation",
            "circle_fillet_largest_radius", "circle_fillet_radius_for_deviation",
            "fillet_radius_for_deviation", "circle_fillet_radius_for_trim",
            "circle_fillet_radius_within", "deflection_angle", "distance_for_deviation",
            "fillet_deviation", "fillet_pieces", "fillet_radius_for_arc_trim",
-           "fillet_radius_for_line_trim", "line_circle_fillet", "very_short_blocks"]
+           "fillet_radius_for_line_trim", "leftovers", "line_circle_fillet",
+           "very_short_blocks"]

@@ -196,3 +196,19 @@ def ruckig_line_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) -
     inp.current_acceleration, inp.target_acceleration = [a_s], [-a_s]
     otg.calculate(inp, traj)
     return traj.duration
+
+
+def largest_accepted(path, lim, hand, lo_v: float, hi_v: float,
+                     bounds: str = "acc+freq") -> float:
+    """The largest speed ``v`` in ``[lo_v, hi_v]`` whose hand motion ``hand(v)`` (a
+    :class:`~reference.core.profile.Profile`) the checker accepts under ``bounds``, by
+    bisection (50 halvings), mm/s: the corner speed of a hand reference, found by the
+    judge rather than by the construction under test."""
+    from reference.core.constraints import BOUND_SETS, check_profile
+    for _ in range(50):
+        mid = 0.5 * (lo_v + hi_v)
+        if check_profile(path, lim, hand(mid)).ok(BOUND_SETS[bounds]):
+            lo_v = mid
+        else:
+            hi_v = mid
+    return lo_v

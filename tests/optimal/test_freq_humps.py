@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import optimal
-from oracle_cases import XYZ, line_path
+from oracle_cases import XYZ, largest_accepted, line_path
 from optimal.freq.humps import Envelope, hump_lower_bound, hump_plan, humps_bound
 from optimal.grid import grid_on
 from reference.core import AxisLimits, MachineLimits
@@ -152,18 +152,6 @@ def test_flat_envelope_closed_form(L, V, N, m):
     assert plan.time_s <= N * tau
 
 
-def _largest_accepted(path, lim, hand, lo_v: float, hi_v: float) -> float:
-    """The largest speed ``v`` in ``[lo_v, hi_v]`` whose hand motion ``hand(v)`` the
-    checker accepts under ``acc+freq``, by bisection (50 halvings), mm/s."""
-    for _ in range(50):
-        mid = 0.5 * (lo_v + hi_v)
-        if check_profile(path, lim, hand(mid)).ok(BOUND_SETS["acc+freq"]):
-            lo_v = mid
-        else:
-            hi_v = mid
-    return lo_v
-
-
 def _zigzag(n=60, h=0.3, w=0.3):
     x = np.arange(n + 1) * h
     y = np.where(np.arange(n + 1) % 2 == 0, 0.0, w)
@@ -186,7 +174,7 @@ def test_zigzag_bound_is_sound_and_above_acc():
         ramp = vc / (2 * f)
         return Profile.from_path_velocity([0.0, ramp, L - ramp, L], [0.0, vc, vc, 0.0])
 
-    t_hand = hand(_largest_accepted(path, lim, hand, 1e-3, 200.0)).duration
+    t_hand = hand(largest_accepted(path, lim, hand, 1e-3, 200.0)).duration
     acc = optimal.solve(path, lim, bounds="acc")
     T = humps_bound(path, lim.for_axes(path.axes), grid_on(path, acc.grid), t_hand)
     assert T <= t_hand
@@ -217,7 +205,7 @@ def test_single_corner_bound_is_sound_and_within_a_percent_of_a_hand_motion():
         return Profile.from_path_velocity([0.0, up, corner - dn, corner, corner + dn,
                                            L - up, L], [0.0, F, F, vc, F, F, 0.0])
 
-    vc = _largest_accepted(path, lim, hand, 0.0, F)
+    vc = largest_accepted(path, lim, hand, 0.0, F)
     assert check_profile(path, lim, hand(vc)).ok(BOUND_SETS["acc+freq"])
     t_hand = hand(vc).duration
     acc = optimal.solve(path, lim, bounds="acc")

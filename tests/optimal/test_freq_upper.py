@@ -162,7 +162,7 @@ def test_ramp_plan_on_a_corner_is_the_hand_motion(F, L1, L2):
     (v_c + P) / (2 f) + P / (2 f)), up to the plateau ``P = f L2 - v_c / 2`` and straight
     down. ``v_c`` is the largest corner speed the checker accepts (bisection); the plan,
     at the junction rule's cap, is that motion to 1e-8. The checker accepts the plan."""
-    from oracle_cases import line_path
+    from oracle_cases import largest_accepted, line_path
     from optimal.freq.ramps import ramp_plan
     from reference.core.constraints import BOUND_SETS, check_profile
 
@@ -181,14 +181,8 @@ def test_ramp_plan_on_a_corner_is_the_hand_motion(F, L1, L2):
         return Profile.from_path_velocity([0.0, up, L1 - dn, L1, L1 + (vc + P) / (2 * f),
                                            L1 + L2], [0.0, F, F, vc, P, 0.0])
 
-    lo_v, hi_v = 0.0, min(F, 10.0)
-    for _ in range(50):
-        mid = 0.5 * (lo_v + hi_v)
-        if check_profile(path, lim, hand(mid)).ok(BOUND_SETS["acc+freq"]):
-            lo_v = mid
-        else:
-            hi_v = mid
-    assert prof.duration == pytest.approx(hand(lo_v).duration, rel=1e-8)
+    vc = largest_accepted(path, lim, hand, 0.0, min(F, 10.0))
+    assert prof.duration == pytest.approx(hand(vc).duration, rel=1e-8)
 
 
 @pytest.mark.parametrize("J, expected", [
