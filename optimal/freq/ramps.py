@@ -444,9 +444,10 @@ def ramp_plan(path: Path, limits: MachineLimits, jerk: bool = False
             k_in, k_out, np.maximum(lim.path_trans_jerk, lim.j_max), limits.t_ipo_s))
     L_all = work.length
     # the caps and budgets of every share, for the whole path at once (a share changes
-    # nothing on lines, and the pieces only take their rows)
+    # nothing on lines: a path without curves takes the first alone; the pieces only
+    # take their rows)
     budgets = []
-    for share in RAMP_CURVE_SHARES:
+    for share in (RAMP_CURVE_SHARES if np.any(curved) else RAMP_CURVE_SHARES[:1]):
         F = np.minimum(cap, share * v_curve)
         budgets.append((F, *_budgets(kin, lim, F, jerk)))
     for k, (lo, hi) in enumerate(rest_pieces(work)):
