@@ -9,7 +9,9 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
    (proof there), plus the holds;
 3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
-   (the base optimum slowed down, the filtered acc optimum, the motion under the caps
+   (the base optimum slowed down, the filtered acc optimum, for ``acc+freq`` the acc
+   optimum with its rises and falls capped per hump (:mod:`optimal.freq.capped`), the
+   motion under the caps
    adapted to the rule: unfiltered for ``acc+freq``, and filtered with the windows of
    :func:`~optimal.freq.upper.candidate_windows`, its caps eroded for each; for
    ``jerk+freq`` where these leave the bracket open, the jerk optimum re-solved under caps
@@ -42,6 +44,7 @@ from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from ..grid import grid_on
 from ..jerk.oracle import jerk_grid
+from .capped import capped_optimum
 from .humps import humps_bound
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .lower import freq_lower_bound, rest_pieces, segment_periods
@@ -130,6 +133,15 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                      fir_filtered(path, limits, prof, base == "jerk"), name)
         if c is not None:
             cands.append(c)
+        if base == "acc":
+            # the acc optimum with each hump's rise and fall rates capped until its phases
+            # pass the rule (optimal.freq.capped): on curves it keeps the axes' budget
+            # where the ramps of one constant cannot
+            capped = capped_optimum(path, limits, prof)
+            c = verified("capped acc optimum", path, limits, capped, name) \
+                if capped is not None else None
+            if c is not None:
+                cands.append(c)
     # motions under the caps, adapted to the rule (optimal.freq.upper.eroded_plans):
     # unfiltered for acc+freq, and through moving averages of a few windows (caps eroded
     # for each, so that the filtered motion keeps them where it arrives)
