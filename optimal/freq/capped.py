@@ -26,7 +26,7 @@ On a line the rise is a constant ``alpha`` up to the cap, so a rest-to-rest line
 the rise keeps ``alpha`` while the axes allow it and then follows their budget, which
 the ramp plan of :mod:`optimal.freq.ramps` (one constant per segment, taken at its top
 speed) cannot: measured on ``lcnc_arc_arc_sawtooth`` (48 arcs of R 5.08 mm between cusps,
-default machine) 5.284 s against the ramp plan's 6.09 s and the NLP candidates' 5.313 s.
+default machine) 5.282 s against the ramp plan's 6.09 s and the NLP candidates' 5.313 s.
 Where the acc optimum has many short humps (short segments between slow corners) the
 capped hump is no better than the ramps, and the oracle keeps whichever is fastest per
 piece.
@@ -60,8 +60,9 @@ CAPPED_BISECTIONS = 30
 #: by :data:`CAPPED_SHRINK` at most this many times.
 CAPPED_FIX_ROUNDS = 40
 CAPPED_SHRINK = 0.995
-#: Grid nodes beyond which no capped optimum is built: each bisection step is a pass
-#: over the nodes and a cut into phases (``O(N)``, about 3 ms per 10^4 nodes).
+#: Grid nodes beyond which no capped optimum is built: each of the up to 70 bisection
+#: and shrink steps is a pass over the nodes and a cut into phases (``O(N)`` time, and
+#: ``O(N n)`` memory for the interval ends' derivatives: 2e6 nodes, 3 axes, ~200 MB).
 CAPPED_MAX_NODES = 2_000_000
 #: The passes keep each axis acceleration within ``(1 - CAPPED_ACCEL_MARGIN) A_i`` at
 #: both ends of every grid interval: inside an interval on a curve the axis acceleration
