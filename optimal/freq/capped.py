@@ -79,6 +79,17 @@ CAPPED_RULE_MARGIN = 1e-9
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _rate_cap(cap: float, g: float, c: float, a_lim: float) -> float:  # pragma: no cover
+    """``cap`` lowered to the upper end of the rates ``x`` with ``|g x + c| <= a_lim``
+    (unchanged where ``g = 0``: the rate does not enter)."""
+    if g > 0.0:
+        return min(cap, (a_lim - c) / g)
+    if g < 0.0:
+        return min(cap, (-a_lim - c) / g)
+    return cap
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def _passes(b: np.ndarray, ds: np.ndarray, first: np.ndarray, hump: np.ndarray,
             alpha: np.ndarray, beta: np.ndarray, dq0: np.ndarray, ddq0: np.ndarray,
             dq1: np.ndarray, ddq1: np.ndarray, A: np.ndarray) -> np.ndarray:  # pragma: no cover
@@ -100,12 +111,8 @@ def _passes(b: np.ndarray, ds: np.ndarray, first: np.ndarray, hump: np.ndarray,
         for i in range(n_ax):
             # |dq0 a + ddq0 cur| <= A at the start, |(dq1 + 2 h ddq1) a + ddq1 cur| <= A
             # at the end (b there = cur + 2 h a): the upper end of each interval of a
-            g, c = dq0[k, i], ddq0[k, i] * cur
-            if g != 0.0:
-                cap = min(cap, (A[i] - c) / g if g > 0 else (-A[i] - c) / g)
-            g, c = dq1[k, i] + 2.0 * h * ddq1[k, i], ddq1[k, i] * cur
-            if g != 0.0:
-                cap = min(cap, (A[i] - c) / g if g > 0 else (-A[i] - c) / g)
+            cap = _rate_cap(cap, dq0[k, i], ddq0[k, i] * cur, A[i])
+            cap = _rate_cap(cap, dq1[k, i] + 2.0 * h * ddq1[k, i], ddq1[k, i] * cur, A[i])
         a = min(alpha[hump[k]], max(cap, 0.0))
         cur = min(cur + 2.0 * h * a, b[k + 1])
         fwd[k + 1] = cur
@@ -119,12 +126,8 @@ def _passes(b: np.ndarray, ds: np.ndarray, first: np.ndarray, hump: np.ndarray,
         for i in range(n_ax):
             # s'' = -d: |-dq1 d + ddq1 cur| <= A at the end, |(-dq0 + 2 h ddq0) d + ddq0
             # cur| <= A at the start (b there = cur + 2 h d)
-            g, c = -dq1[k, i], ddq1[k, i] * cur
-            if g != 0.0:
-                cap = min(cap, (A[i] - c) / g if g > 0 else (-A[i] - c) / g)
-            g, c = -dq0[k, i] + 2.0 * h * ddq0[k, i], ddq0[k, i] * cur
-            if g != 0.0:
-                cap = min(cap, (A[i] - c) / g if g > 0 else (-A[i] - c) / g)
+            cap = _rate_cap(cap, -dq1[k, i], ddq1[k, i] * cur, A[i])
+            cap = _rate_cap(cap, -dq0[k, i] + 2.0 * h * ddq0[k, i], ddq0[k, i] * cur, A[i])
         d = min(beta[hump[k]], max(cap, 0.0))
         cur = min(cur + 2.0 * h * d, b[k])
         out[k] = min(cur, fwd[k])
@@ -186,8 +189,9 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
         rise, fall = np.zeros(H, bool), np.zeros(H, bool)
         if ph.n == 0:
             return rise, fall
-        mid = 0.5 * (prof.s[:-1] + prof.s[1:])
-        f, _ = phase_frequencies(work, lim, ph, work.segment_index(mid))
+        # the motion's intervals are the grid's (its nodes, none repeated): their
+        # segments are ``seg``
+        f, _ = phase_frequencies(work, lim, ph, seg)
         bad = ph.effective_duration < min_phase_duration(f) * (1.0 + CAPPED_RULE_MARGIN)
         s0 = prof.state(ph.start_t)[0]
         s1 = prof.state(ph.end_t)[0]
