@@ -629,7 +629,12 @@ def _circle_pair_terms(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray, c2: np.nd
     use, shape (k,) each: ``X = u_1 x u_2``, ``P = |u_2 + iota_1 iota_2 u_1|^2``,
     ``m = c / R_1 - 1 / R_2`` (``c = u_1 . u_2``) and ``K = iota_1 / R_1 - 2 iota_2 m / P``.
     """
-    u1, u2, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    return _terms_of(_circle_pair_frame(c1, r1, s1, c2, r2, s2), r1, r2)
+
+
+def _terms_of(frame: tuple, r1: np.ndarray, r2: np.ndarray):
+    """:func:`_circle_pair_terms` from the pair's :func:`_circle_pair_frame`."""
+    u1, u2, _, iota1, iota2 = frame
     x = _cross2(u1, u2)
     plus = u2 + (iota1 * iota2)[:, None] * u1
     p2 = row_dots(plus, plus)
@@ -794,7 +799,13 @@ def circle_fillet_radius_for_trim(trim: np.ndarray, c1: np.ndarray, r1: np.ndarr
     u_02)`` and twice the denominator ``iota_1 R_1 |du|^2 - iota_2 R_2 |u_02 - iota_1
     iota_2 u|^2``.
     """
-    u01, u02, _, iota1, iota2 = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    return _radius_for_trim(trim, _circle_pair_frame(c1, r1, s1, c2, r2, s2), r1, s1, r2)
+
+
+def _radius_for_trim(trim: np.ndarray, frame: tuple, r1: np.ndarray, s1: np.ndarray,
+                     r2: np.ndarray) -> np.ndarray:
+    """:func:`circle_fillet_radius_for_trim` from the pair's :func:`_circle_pair_frame`."""
+    u01, u02, _, iota1, iota2 = frame
     a = -s1 * trim / r1
     du = (-2.0 * np.sin(a / 2.0) ** 2)[:, None] * u01 + np.sin(a)[:, None] * _perp(u01)
     T = r1[:, None] * du
@@ -819,7 +830,12 @@ def circle_fillet_largest_radius(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray,
     u_1|^2``) the ``X`` cancel: ``k = iota_1 / R_1 - 2 iota_2 (c / R_1 - 1 / R_2) / P``,
     ``|V| |a| = 2 sqrt(X^2 / R_1^2 + (c / R_1 - 1 / R_2)^2) / P``.
     """
-    x, p2, m, k = _circle_pair_terms(c1, r1, s1, c2, r2, s2)
+    return _largest_radius(_circle_pair_terms(c1, r1, s1, c2, r2, s2), r1)
+
+
+def _largest_radius(terms: tuple, r1: np.ndarray) -> np.ndarray:
+    """:func:`circle_fillet_largest_radius` from the pair's :func:`_circle_pair_terms`."""
+    x, p2, m, k = terms
     den = k + 2.0 * np.sqrt(x * x / (r1 * r1) + m * m) / p2
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(den > 0, 1.0 / den, np.inf)
@@ -839,17 +855,26 @@ def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray
     0 where the circles cross a second time. So: the closed form where ``trim`` is
     below the length the largest fillet replaces, that radius where it is not.
     """
-    r = circle_fillet_radius_for_trim(trim, c1, r1, s1, c2, r2, s2)
-    top = circle_fillet_largest_radius(c1, r1, s1, c2, r2, s2)
-    fin = np.isfinite(top)
+    # one frame for the closed form, the largest radius and the length it replaces
+    # (the same expressions as the public functions: the same numbers)
+    frame = _circle_pair_frame(c1, r1, s1, c2, r2, s2)
+    r = _radius_for_trim(trim, frame, r1, s1, r2)
+    top = _largest_radius(_terms_of(frame, r1, r2), r1)
+    fin = np.flatnonzero(np.isfinite(top))
     reach = np.full(trim.shape, np.inf)
-    if fin.any():
+    if fin.size:
         # just inside the largest radius, where the fillet still exists (its replaced
         # length changes like the root of the distance to it: 1e-12 relative moves it
-        # by about 1e-6 relative, on the closed form's side of the comparison)
-        f = circle_circle_fillet(np.where(fin, top, 1.0) * (1.0 - 1e-12), c1, r1, s1,
-                                 c2, r2, s2)
-        reach = np.where(fin, f.trim_in, np.inf)
+        # by about 1e-6 relative, on the closed form's side of the comparison); only
+        # the first circle's replaced length is needed, the trim_in of
+        # circle_circle_fillet: its centre and angle, not the whole fillet
+        u01, u02, _, iota1, iota2 = frame
+        r1f = r1[fin]
+        on1, ot1, _, _, _ = _circle_fillet_centre(
+            top[fin] * (1.0 - 1e-12), u01[fin], r1f, u02[fin], r2[fin], iota1[fin],
+            iota2[fin])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            reach[fin] = r1f * (-s1[fin] * np.arctan2(ot1, r1f + on1))
     return np.where(trim < reach, r, top)
 
 
