@@ -122,3 +122,30 @@ def test_capped_optimum_on_sawtooth_arcs_keeps_the_axes_and_the_rule():
     plan = ramp_plan(path, lim)
     assert sum(p.duration for p in plan.values()) > 1.05 * prof.duration
     assert prof.duration > acc.profile.duration
+
+
+def test_growing_rates_are_faster_on_sawtooth_arcs_and_keep_every_arc_no_slower(
+        monkeypatch):
+    """The rates growing from each valley (CAPPED_GROWTH) against the constant rate
+    alone on the same eight arcs: every arc no slower (each hump takes the faster shape
+    that passes), the whole faster, and the motion still within the axes and the rule by
+    sampled positions (the checks of the test above)."""
+    import optimal.freq.capped as capped
+
+    m = load_machine()
+    path = build_path(parse_text(_sawtooth(8), "saw.ngc", dialect="ngc"), m)
+    lim = m.limits
+    acc, prof = _capped(path, lim)
+    monkeypatch.setattr(capped, "CAPPED_GROWTH", (0.0,))
+    flat = capped.capped_optimum(path, lim, acc.profile)
+    assert prof is not None and flat is not None
+    sb = path.s_breaks
+    t_arc = np.diff(np.interp(sb, prof.s, prof.t))
+    t_flat = np.diff(np.interp(sb, flat.s, flat.t))
+    assert np.all(t_arc <= t_flat * (1 + 1e-12))
+    # measured 0.11003 -> 0.10978 s on the inner arcs, 0.9814 -> 0.9791 s in all (0.23 %)
+    assert prof.duration < flat.duration * (1 - 1e-3)
+    dt = 1e-4
+    d_eff = _sampled_phases(prof, dt)
+    sub = lim.for_axes(path.axes)
+    assert np.min(d_eff) >= (1.0 / float(np.min(sub.frequency_hz[:2]))) * (1 - 1e-2)
