@@ -69,11 +69,16 @@ def test_compiled_search_equals_the_vectorised_search(kind, seed):
     # near: where the full search found its maximum, and elsewhere (other maxima, ends)
     total = pieces[4].sum(axis=1)
     rng = np.random.default_rng(seed)
+    inside = []
     for near in (full[1], rng.uniform(-0.1, 1.1, total.size) * total):
         got = deviation_where(pieces, r1, r2, centre, near=near)
         _same(sbend._deviation_where(pieces, r1, r2, centre, near=near), got)
-    # not vacuous: windows cut at the crossing and maxima outside a window
-    assert (~got[2]).any() and got[2].any()
+        inside.append(got[2])
+    # not vacuous: the compared searches hold maxima inside their window (near the full
+    # search's: every one) and outside it (random starts: all but a few of ~300, and
+    # some seeds' shapes have none inside, so the two kinds are counted over both)
+    inside = np.concatenate(inside)
+    assert inside.any() and (~inside).any()
 
 
 @pytest.mark.parametrize("seed", range(3))
