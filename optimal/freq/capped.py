@@ -220,7 +220,7 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
     # segments): the growth rates of CAPPED_GROWTH are shares of it
     period = np.zeros(H)
     np.maximum.at(period, hump, segment_periods(work, lim)[seg])
-    dt_scale = np.where(period > 0, period, np.inf)
+    period = np.where(period > 0, period, np.inf)      # no rule: no growth
 
     def motion(alpha, beta, grow):
         bn = np.maximum(_passes(b, ds, first, hump, alpha, beta, grow, dq0, ddq0, dq1,
@@ -277,10 +277,12 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
     try:
         # each growth share in turn; per hump the fastest that passes (the passes
         # restart at every valley, so the humps do not interact: a hump's motion under
-        # one share joins its neighbours' under another at the valleys' b*)
+        # one share joins its neighbours' under another at the valleys' b*; where a
+        # pass arrives below b* at a valley the joined node takes the chosen hump's
+        # value, and the checker judges the whole motion as every candidate)
         best_b, best_t, best_ok = None, None, None
         for share in CAPPED_GROWTH:
-            bn, ok = rated(share / dt_scale)
+            bn, ok = rated(share / period)
             v = np.sqrt(bn)
             with np.errstate(divide="ignore"):
                 t_h = np.bincount(hump, weights=2.0 * ds / (v[:-1] + v[1:]), minlength=H)
