@@ -246,8 +246,8 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
         return rise, fall
 
     def rated(grow):
-        """``v^2`` at the nodes with the largest rates that pass, shape (N,), and per
-        hump whether its phases pass, shape (H,)."""
+        """``v^2`` at the nodes with the largest rates that pass, shape (N,), its
+        motion, and per hump whether its phases pass, shape (H,)."""
         top = 2.0 * float(np.max(np.abs(acc_profile.a), initial=0.0)) + 1.0
         hi_a, hi_b = np.full(H, top), np.full(H, top)
         lo_a, lo_b = np.full(H, top), np.full(H, top)
@@ -272,7 +272,7 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
             lo_a = np.where(rise, lo_a * CAPPED_SHRINK, lo_a)
             lo_b = np.where(fall, lo_b * CAPPED_SHRINK, lo_b)
             bn, prof = motion(lo_a, lo_b, grow)
-        return bn, ~(rise | fall)
+        return bn, prof, ~(rise | fall)
 
     try:
         # each growth share in turn; per hump the fastest that passes (the passes
@@ -282,10 +282,9 @@ def capped_optimum(path: Path, limits: MachineLimits, acc_profile: Profile
         # value, and the checker judges the whole motion as every candidate)
         best_b, best_t, best_ok = None, None, None
         for share in CAPPED_GROWTH:
-            bn, ok = rated(share / period)
-            v = np.sqrt(bn)
-            with np.errstate(divide="ignore"):
-                t_h = np.bincount(hump, weights=2.0 * ds / (v[:-1] + v[1:]), minlength=H)
+            bn, prof, ok = rated(share / period)
+            # the motion's intervals are the grid's: each hump's time from its own
+            t_h = np.bincount(hump, weights=np.diff(prof.t), minlength=H)
             if best_b is None:
                 best_b, best_t, best_ok = bn, t_h, ok
                 continue

@@ -698,6 +698,14 @@ def _circle_fillet_centre(r, u1, r1, u2, r2, iota1, iota2):
     return -iota1 * r - g / r1, at1 + g * vt1, -iota2 * r - g / r2, at2 + g * vt2, disc
 
 
+def _first_angle(on1: np.ndarray, ot1: np.ndarray, r1: np.ndarray,
+                 s1: np.ndarray) -> np.ndarray:
+    """Angle of the first circle the fillet replaces, from the radial at the corner to
+    the one through its centre ``O`` (``O - c_1`` has the components ``R_1 + O.u_01``
+    and ``O.perp(u_01)``): exact relative to the angle, rad, shape (k,)."""
+    return -s1 * np.arctan2(ot1, r1 + on1)
+
+
 def _rotated(u: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``u`` turned by ``a`` (counter-clockwise) and the change ``rot(a) u - u``, written
     without cancellation, shape (k, 2) each."""
@@ -746,7 +754,7 @@ def circle_circle_fillet(r: np.ndarray, c1: np.ndarray, r1: np.ndarray, s1: np.n
         O = on1[:, None] * u01 + ot1[:, None] * _perp(u01)
         # the angles replaced, from the radials at C to those through O (O - c_j has
         # the components R_j + O.u_0j and O.perp(u_0j)): exact relative to the angle
-        ang1 = -s1 * np.arctan2(ot1, r1 + on1)
+        ang1 = _first_angle(on1, ot1, r1, s1)
         ang2 = s2 * np.arctan2(ot2, r2 + on2)
         u1, du1 = _rotated(u01, -s1 * ang1)
         u2, du2 = _rotated(u02, s2 * ang2)
@@ -874,7 +882,7 @@ def circle_fillet_radius_within(trim: np.ndarray, c1: np.ndarray, r1: np.ndarray
             top[fin] * (1.0 - 1e-12), u01[fin], r1f, u02[fin], r2[fin], iota1[fin],
             iota2[fin])
         with np.errstate(invalid="ignore", divide="ignore"):
-            reach[fin] = r1f * (-s1[fin] * np.arctan2(ot1, r1f + on1))
+            reach[fin] = r1f * _first_angle(on1, ot1, r1f, s1[fin])
     return np.where(trim < reach, r, top)
 
 
