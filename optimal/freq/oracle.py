@@ -215,8 +215,12 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             plan = ramp_plan(path, limits)
             if plan and len(plan) == rest_pieces(work).shape[0]:
                 t_up = min(t_up, sum(p.duration for p in plan.values()))
+        # the bound that meets the bracket (holds excluded): where the programme comes
+        # near it, it cuts its cells finer where its motion turns (the turn run)
+        enough = (min(c.duration for c in cands) + hold_t) / (1.0 + tol) - hold_t
         lb_humps = min(humps_bound(work, sub_lim, grid_on(work, acc.grid), t_up,
-                                   lb - hold_t, base_sol.segment_lower_bounds_s), t_up)
+                                   lb - hold_t, base_sol.segment_lower_bounds_s,
+                                   enough=enough), t_up)
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

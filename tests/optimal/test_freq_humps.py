@@ -219,3 +219,66 @@ def test_single_corner_bound_is_sound_and_within_a_percent_of_a_hand_motion():
     # and the oracle's verified motion is as fast as the hand one to 0.1 % (measured:
     # 0.02 % slower: its adapted caps are not exactly the ramps of 1/f)
     assert sol.upper_bound_s <= t_hand * 1.001
+
+
+def _sawtooth(n_arcs: int) -> str:
+    """Arcs of 0.2 in alternating G2/G3 between cusps (lcnc_arc_arc_sawtooth's pattern),
+    F1000 in/min."""
+    lines = ["G90 G20 G64 F1000", "G0 X0 Y0 Z0", "G2 X0 Y0.1 R0.2"]
+    for k in range(n_arcs):
+        lines.append(f"{'G3' if k % 2 == 0 else 'G2'} X{0.1 * (k + 1):.1f} "
+                     f"Y{-0.1 if k % 2 == 0 else 0.1} R0.2")
+    return "\n".join(lines) + "\nM2\n"
+
+
+@pytest.mark.slow
+def test_turn_run_raises_the_bound_on_arcs_and_stays_below_a_checked_motion():
+    """The turn run (HUMP_TURN_WIDTH, HUMP_TURN_SPLIT): cells at the fine run's turns cut
+    finer. On 25 sawtooth arcs (default machine) it raises the bound, runs only where the
+    fine bound comes within HUMP_TURN_MARGIN of ``enough`` and not once that is reached,
+    and the bound stays below an accepted motion: the capped acc optimum, judged by the
+    checker and, independently, by the phases of its sampled positions (as in
+    test_freq_capped)."""
+    from optimal.freq.capped import capped_optimum
+    from optimal.freq.humps import HUMP_TURN_MARGIN
+    from reference.machine import load_machine
+    from reference.nc import parse_text
+    from reference.prepare import build_path
+    from test_freq_capped import _sampled_phases
+
+    m = load_machine()
+    path = build_path(parse_text(_sawtooth(24), "saw.ngc", dialect="ngc"), m)
+    lim = m.limits
+    sub = lim.for_axes(path.axes)
+    acc = optimal.solve(path, lim, bounds="acc")
+    motion = capped_optimum(path, lim, acc.profile)
+    assert check_profile(path, lim, motion).ok(BOUND_SETS["acc+freq"])
+    d_eff = _sampled_phases(motion, 1e-4)
+    assert np.min(d_eff) >= (1.0 / float(np.min(sub.frequency_hz[:2]))) * (1 - 1e-2)
+    t_up = motion.duration
+    grid = grid_on(path, acc.grid)
+    fine = humps_bound(path, sub, grid, t_up)
+    # a caller needing a little more than the fine run gives: the turn run follows
+    turned = humps_bound(path, sub, grid, t_up, enough=fine * (1 + HUMP_TURN_MARGIN / 2))
+    # measured: 2.6899 -> 2.6951 s (0.19 %), below the motion's 2.7424 s
+    assert turned >= fine * (1 + 1e-3)
+    assert turned <= t_up
+
+
+def test_turn_run_follows_only_near_enough():
+    """HUMP_TURN_MARGIN: on the single corner of the test above (where the turn run
+    moves the bound by a few 1e-6 only), ``enough`` further above the fine bound than
+    the margin, or below it, gives the fine bound exactly; within the margin the run
+    follows (another number, still below the hand motion's 2.0960 s)."""
+    from optimal.freq.humps import HUMP_TURN_MARGIN
+
+    f, F = 20.0, 20.0
+    lim = MachineLimits(tuple(AxisLimits(n, 500.0, 2000.0, 4e4, 1.2, f) for n in XYZ), 0.004)
+    path = line_path(np.array([[0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [20.0, 20.0, 0.0]]), feed=F)
+    acc = optimal.solve(path, lim, bounds="acc")
+    sub, grid, t_up = lim.for_axes(path.axes), grid_on(path, acc.grid), 2.096
+    fine = humps_bound(path, sub, grid, t_up)
+    assert humps_bound(path, sub, grid, t_up, enough=fine / (1 - 1.5 * HUMP_TURN_MARGIN)) == fine
+    assert humps_bound(path, sub, grid, t_up, enough=0.5 * fine) == fine
+    near = humps_bound(path, sub, grid, t_up, enough=fine * (1 + HUMP_TURN_MARGIN / 2))
+    assert near != fine and near <= t_up
