@@ -111,7 +111,8 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
 What it does not know: the acceleration inside a stretch beyond the envelope, the
 time a phase adds where its lost time and the envelope's overlap, and a quarter of a
 turn cell's time at most per turn (step 4b's rounding; :data:`HUMP_CELL_TIME_REL` keeps a
-cell a few per cent of a period). Measured on single corners (two lines at F1200 on the
+cell a few per cent of a period, and where the bound is near what the oracle needs, the
+turn run of :func:`humps_bound` cuts the cells at the turns four times finer). Measured on single corners (two lines at F1200 on the
 default machine) it comes within 0.7 % of the verified motion; on paths of many short
 segments at low speed (lcnc_sam_tolerance_issue) it is still some 20 % below it.
 
