@@ -112,9 +112,10 @@ What it does not know: the acceleration inside a stretch beyond the envelope, th
 time a phase adds where its lost time and the envelope's overlap, and a quarter of a
 turn cell's time at most per turn (step 4b's rounding; :data:`HUMP_CELL_TIME_REL` keeps a
 cell a few per cent of a period, and where the bound is near what the oracle needs, the
-turn run of :func:`humps_bound` cuts the cells at the turns four times finer). Measured on single corners (two lines at F1200 on the
-default machine) it comes within 0.7 % of the verified motion; on paths of many short
-segments at low speed (lcnc_sam_tolerance_issue) it is still some 20 % below it.
+turn run of :func:`humps_bound` cuts the cells at the turns four times finer).
+Measured on single corners (two lines at F1200 on the default machine) it comes within
+0.7 % of the verified motion; on paths of many short segments at low speed
+(lcnc_sam_tolerance_issue) it is still some 20 % below it.
 
 Units: mm, s, mm/s.
 """
@@ -379,9 +380,9 @@ def _merge_starts(env: Envelope, cell_time_rel: float) -> np.ndarray:
 def _merged(env: Envelope, cell_time_rel: float,
             starts: np.ndarray | None = None) -> Envelope:
     """Runs of cells shorter together than ``HUMP_MERGE_SHARE * cell_time_rel`` periods at
-    speed ``hi``, each made one cell (short segments make many tiny cells, and the programme's work grows
-    with the cells in reach); ``starts``: the runs' first cells where known
-    (:func:`_merge_starts`). Valid: the merged cell's ``hi`` is the largest of its parts'
+    speed ``hi``, each made one cell (short segments make many tiny cells, and the
+    programme's work grows with the cells in reach); ``starts``: the runs' first cells
+    where known (:func:`_merge_starts`). Valid: the merged cell's ``hi`` is the largest of its parts'
     (a bound everywhere in it), its ``lo`` the least (the least bound over the cell), its
     period the least."""
     if starts is None:
@@ -630,9 +631,9 @@ def _run_pieces(env: Envelope, ends: np.ndarray, todo: np.ndarray, rel: float,
             continue
         dp[k] = max(dp[k], x)
         # the merged cells c - w .. c + w of each turn c, as cells of env
-        bounds_ = np.concatenate((starts, [b - a]))
+        edges = np.concatenate((starts, [b - a]))
         c = np.concatenate((plan.valleys[1:-1], plan.peaks))
-        for c0, c1 in zip(bounds_[np.maximum(c - w, 0)],
-                          bounds_[np.minimum(c + w + 1, starts.size)]):
+        for c0, c1 in zip(edges[np.maximum(c - w, 0)],
+                          edges[np.minimum(c + w + 1, starts.size)]):
             near[a + c0:a + c1] = True
     return near
