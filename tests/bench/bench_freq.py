@@ -10,6 +10,11 @@ the frequency solve's wall time between the two sizes. A last row runs ``jerk+fr
 its default gap (2 %) from 1,000 intervals: the jerk solve then refines its grid and the
 oracle re-solves the jerk NLP where the rule finds phases short
 (:mod:`optimal.freq.jerk_adapted`), against the one-round jerk solve of the first row.
+Then the turn run of the frequency bound (:func:`optimal.freq.humps.humps_bound`, where
+its bound comes within HUMP_TURN_MARGIN of the bracket) on
+``../shared/corpus/lcnc_arc_arc_sawtooth.ngc`` (``acc+freq``, default gap): the oracle's
+wall time and the bound's time with the run and without it (the margin set to 0), and
+both brackets; left out where ``../shared`` is absent.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from pathlib import Path as FsPath
 HERE = FsPath(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent))    # tests/: shared_inputs (where ../shared is)
 
 import optimal  # noqa: E402
 from bench_jerk import stadium_gcode  # noqa: E402
@@ -68,7 +74,36 @@ def main() -> int:
           f"{(t2 - t1) / (t1 - t0):>10.2f}  [{j.lower_bound_s:.4f}, {j.upper_bound_s:.4f}] | "
           f"[{f.lower_bound_s:.4f}, {f.upper_bound_s:.4f}] at the default gap "
           f"({f.status}, {f.gap:.2%})", flush=True)
+    turn_run_row(machine)
     return 0
+
+
+def turn_run_row(machine) -> None:
+    """The turn run's cost and effect on the 48 sawtooth arcs (see the module docstring)."""
+    from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
+    import optimal.freq.humps as humps
+    from reference.nc import parse_file
+
+    if not CORPUS_PRESENT:
+        print(f"{'turn run':>9} skipped: {NO_CORPUS}")
+        return
+    path = build_path(parse_file(CORPUS / "lcnc_arc_arc_sawtooth.ngc"), machine)
+    res = {}
+    margin = humps.HUMP_TURN_MARGIN
+    try:
+        for label, m in (("without", 0.0), ("with", margin)):
+            humps.HUMP_TURN_MARGIN = m
+            t0 = time.perf_counter()
+            sol = optimal.solve(path, machine.limits, bounds="acc+freq")
+            res[label] = (time.perf_counter() - t0, sol)
+    finally:
+        humps.HUMP_TURN_MARGIN = margin
+    (w0, a), (w1, b) = res["without"], res["with"]
+    print(f"{'turn run':>9} sawtooth acc+freq: oracle {w0:.1f} -> {w1:.1f} s "
+          f"(x{w1 / w0:.2f}), bound {a.bound_time_s:.1f} -> {b.bound_time_s:.1f} s "
+          f"(x{b.bound_time_s / a.bound_time_s:.2f}); bracket [{a.lower_bound_s:.4f}, "
+          f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
+          f"{b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})", flush=True)
 
 
 if __name__ == "__main__":
