@@ -176,6 +176,15 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
         n_mark = int(mark.sum())
         if grid_u.n_intervals + n_mark * (pieces - 1) > max_grid:
             pieces = 2
+        # near the cap, the largest carriers that still fit are halved rather than none:
+        # the last round uses the grid's budget (lcnc_arc_arc_sawtooth, default machine:
+        # it stopped at 7,439 intervals with 1.85 %; filling the 10,000 gives 1.05 %)
+        room = max_grid - grid_u.n_intervals
+        if n_mark > room > 0:
+            fits = np.argsort(-np.where(mark, d, -np.inf), kind="stable")[:room]
+            mark = np.zeros_like(mark)
+            mark[fits] = True
+            n_mark = room
         if n_mark == 0 or grid_u.n_intervals + n_mark > max_grid:
             break
         grid_u = subdivide(grid_u, path, mark, pieces)
