@@ -382,9 +382,9 @@ def _merged(env: Envelope, cell_time_rel: float,
     """Runs of cells shorter together than ``HUMP_MERGE_SHARE * cell_time_rel`` periods at
     speed ``hi``, each made one cell (short segments make many tiny cells, and the
     programme's work grows with the cells in reach); ``starts``: the runs' first cells
-    where known (:func:`_merge_starts`). Valid: the merged cell's ``hi`` is the largest of its parts'
-    (a bound everywhere in it), its ``lo`` the least (the least bound over the cell), its
-    period the least."""
+    where known (:func:`_merge_starts`). Valid: the merged cell's ``hi`` is the largest
+    of its parts' (a bound everywhere in it), its ``lo`` the least (the least bound over
+    the cell), its period the least."""
     if starts is None:
         starts = _merge_starts(env, cell_time_rel)
     if starts.size == env.hi.size:
@@ -602,9 +602,20 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     cut = np.where(turns, HUMP_TURN_SPLIT, 1)
     if int(cut.sum()) > HUMP_MAX_CELLS:
         return T
+    # only the pieces with a cell cut run again (the others' cells are the same)
+    lo, hi = _piece_cells(env, ends)
+    n_cut = np.concatenate(([0], np.cumsum(turns)))
+    again = np.flatnonzero(todo & (n_cut[hi] > n_cut[lo]))
     env = _split(t, env.interval, env.s[:-1], env.s[1:], cut)
-    _run_pieces(env, ends, np.flatnonzero(todo), HUMP_CELL_TIME_REL, drift, dp)
+    _run_pieces(env, ends, again, HUMP_CELL_TIME_REL, drift, dp)
     return float(np.sum(np.maximum(acc, dp)))
+
+
+def _piece_cells(env: Envelope, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and end cell of each piece (its first and end grid intervals ``ends``,
+    shape (P, 2)), shape (P,) each: cells never straddle intervals."""
+    return (np.searchsorted(env.interval, ends[:, 0], side="left"),
+            np.searchsorted(env.interval, ends[:, 1], side="left"))
 
 
 def _run_pieces(env: Envelope, ends: np.ndarray, todo: np.ndarray, rel: float,
@@ -615,10 +626,9 @@ def _run_pieces(env: Envelope, ends: np.ndarray, todo: np.ndarray, rel: float,
     the round-off of the programme's sums (as the relaxation's own times). Returns, per
     cell of ``env``, whether it lies within :data:`HUMP_TURN_WIDTH` merged cells of a
     turn of a shortest path (its inner valleys and peaks), shape (N,) of bool."""
-    # cells of each piece: those of its intervals (cells never straddle intervals)
-    lo = np.searchsorted(env.interval, ends[:, 0], side="left")
-    hi = np.searchsorted(env.interval, ends[:, 1], side="left")
-    near = np.zeros(env.hi.size, bool)
+    lo, hi = _piece_cells(env, ends)
+    # +1 where a turn's neighbourhood starts, -1 where it ends: marked where the sum > 0
+    depth = np.zeros(env.hi.size + 1, np.int64)
     w = HUMP_TURN_WIDTH
     for k in todo:
         a, b = lo[k], hi[k]
@@ -633,7 +643,6 @@ def _run_pieces(env: Envelope, ends: np.ndarray, todo: np.ndarray, rel: float,
         # the merged cells c - w .. c + w of each turn c, as cells of env
         edges = np.concatenate((starts, [b - a]))
         c = np.concatenate((plan.valleys[1:-1], plan.peaks))
-        for c0, c1 in zip(edges[np.maximum(c - w, 0)],
-                          edges[np.minimum(c + w + 1, starts.size)]):
-            near[a + c0:a + c1] = True
-    return near
+        np.add.at(depth, a + edges[np.maximum(c - w, 0)], 1)
+        np.add.at(depth, a + edges[np.minimum(c + w + 1, starts.size)], -1)
+    return np.cumsum(depth[:-1]) > 0
