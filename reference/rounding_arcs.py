@@ -102,6 +102,8 @@ SECANT_STEPS = 5
 SETTLED = ROOT_XATOL / 8.0
 #: A closed-form start is used where it lies at least this far below the clamp in
 #: ``log r`` (relative 1e-6): there the clamp does not bind and its ratio is not needed.
+#: The fillet at the start is kept without the clamp's closed forms where both its
+#: trims lie this far (relative) inside their limits (:func:`_radius_by_mode`).
 GUESS_BELOW_CAP = 1e-6
 #: ``log`` of the tolerance ratio where the fillet does not exist (larger radii): far
 #: above 0, so the root search stays below it.
@@ -231,7 +233,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     v_round = np.full(k, np.nan)
     r = np.zeros(k)
     o = np.flatnonzero(reason < 0)
-    fil = _empty_fillet(o.size)
+    fil = None                 # the fillets of the corners o, in their order
     clamped = np.zeros(k, bool)
     # per corner: its family's geometry, as 1-d columns (:class:`_Family`)
     fams = []
@@ -246,13 +248,25 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                      _circle_pair(path, a[i], b[i], E1[i], E2[i], R[i], radial[i])))
     for sub_o, fam, cols in fams:
         i = o[sub_o]
-        ro, r_cap, tol_ok = _radius_by_mode(
+        ro, r_cap, tol_ok, (known, f_known) = _radius_by_mode(
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
             targets["dyn_length"][i], t1[i], t2[i], targets["dyn_cap"][i])
         clamped[i] = ro >= r_cap
-        f = fam.fillet(np.where(ro > 0, ro, 1.0), *cols)
+        # the fillet at the radius found: the tolerance search's own where it kept the
+        # fillet it judged, else built here
+        if known.size == ro.size:
+            f = f_known
+        else:
+            f = _empty_fillet(ro.size)
+            todo = np.ones(ro.size, bool)
+            todo[known] = False
+            todo = np.flatnonzero(todo)
+            _put(f, todo, fam.fillet(np.where(ro[todo] > 0, ro[todo], 1.0),
+                                     *(col[todo] for col in cols)))
+            if known.size:
+                _put(f, known, f_known)
         r[i] = ro
         length = ro * f.sweep
         # the closed forms assume the branch that shrinks to the corner: the fillet
@@ -265,14 +279,19 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         sub[i] = (~keeps | ~f.valid | ~(length > MIN_SEGMENT_LENGTH_MM)
                   | ~(ro > R_MIN_MM * 2))
         decide(sub, "rounding distance too small")
-        _put(fil, sub_o, f)
+        if sub_o.size == o.size:
+            fil = f
+        else:
+            if fil is None:
+                fil = _empty_fillet(o.size)
+            _put(fil, sub_o, f)
 
     o2 = np.flatnonzero(reason < 0)
     lim = machine.limits.for_axes(path.axes)
     t_ipo = machine.limits.t_ipo_s
     sel = np.searchsorted(o, o2) if o.size else np.zeros(0, np.int64)
     if o2.size:
-        f = _take(fil, sel)
+        f = fil if sel.size == o.size else _take(fil, sel)
         ro = r[o2]
         E1o, E2o = E1[o2], E2[o2]
         rho = np.sqrt(E1o ** 2 + E2o ** 2)             # each axis' weight in the plane
@@ -509,63 +528,97 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
                     cap_second: np.ndarray, dyn_radius: np.ndarray,
                     dyn_length: np.ndarray, t1: np.ndarray, t2: np.ndarray,
-                    dyn_cap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    dyn_cap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
     dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
     and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
-    the tolerance holds at the radius found (True where no tolerance applies).
+    the tolerance holds at the radius found (True where no tolerance applies); and the
+    corners (indices, shape (q,)) whose fillet at that radius the tolerance search
+    built and judged, with those fillets (:class:`_Fillet`), so that they are not built
+    again.
     ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
     start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
     but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
+    k = how.size
+    tol_ok = np.ones(k, bool)
+    n_ax = E1.shape[1]
+    n_geo = len(cols)
+    ro = np.where(how == HOW_RADIUS, rad, np.inf)
+    # tolerances: where the contour tolerance decides, the closed form for the contour
+    # deviation (the radius of the deviation the tolerances allow in the direction C - M
+    # of the line-line corner between the tangents) is the root itself. The fillet half
+    # ROOT_XATOL inside it (in log r) is built and judged once, and kept, with that same
+    # fillet as the rounding, where its ratio lies in [-2 ROOT_XATOL, 0] (the acceptance
+    # of every result of the search, _secant_root) and both its trims lie clearly
+    # within the block-length clamp (GUESS_BELOW_CAP, relative): the trims grow with r
+    # on the branch that shrinks to the corner, so the clamp does not bind there and
+    # its closed forms are not needed. The other corners search below the clamp.
+    tl = np.flatnonzero(how == HOW_TOL)
+    r_guess = np.zeros(0)
+    known = np.zeros(0, np.int64)
+    f_known = _empty_fillet(0)
+    if tl.size:
+        e = np.fmin(cont[tl] * g0[tl], axis_deviation_limit(t1[tl], t2[tl],
+                                                              tol[tl] * g0[tl, None]))
+        r_guess = fam.r_deviation(e, *(col[tl] for col in cols))
+        g = np.flatnonzero((r_guess > R_MIN_MM) & np.isfinite(r_guess) & ~dyn_cap[tl])
+        if g.size:
+            tg = tl[g]
+            r_g = np.exp(np.log(r_guess[g]) - ROOT_XATOL / 2.0)
+            f_g = fam.fillet(r_g, *(col[tg] for col in cols))
+            lr = _tol_log_ratio(f_g.deviation, f_g.valid, E1[tg], E2[tg],
+                                tol[tg] * g0[tg, None], cont[tg] * g0[tg])
+            inside = 1.0 - GUESS_BELOW_CAP
+            with np.errstate(invalid="ignore"):
+                hit = ((lr <= 0.0) & (lr >= -2.0 * ROOT_XATOL) & f_g.valid
+                       & (f_g.trim_first <= inside * cap_first[tg])
+                       & (f_g.trim_second <= inside * cap_second[tg]))
+            known = tg[hit]
+            f_known = f_g if hit.all() else _take(f_g, np.flatnonzero(hit))
+            ro[known] = r_g[hit]
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
     # (ADIS only where it applies; both lengths of a side in one call: the same
-    # elementwise numbers, half the calls)
-    k = how.size
-    adis = np.flatnonzero(how == HOW_ADIS)
-    both = np.concatenate((np.arange(k), adis))
-    cb = tuple(col[both] for col in cols)
-    with np.errstate(invalid="ignore"):
-        r_both = np.fmin(
-            _positive(fam.r_first(np.concatenate((cap_first, dist[adis])), *cb)),
-            _positive(fam.r_second(np.concatenate((cap_second, dist[adis])), *cb)))
-    r_both *= 1.0 - CLOSED_FORM_MARGIN
-    r_cap = r_both[:k]
-    r_adis = np.full(k, np.inf)
-    r_adis[adis] = r_both[k:]
-    ro = np.select([how == HOW_ADIS, how == HOW_RADIUS], [r_adis, rad], np.inf)
-    ro = np.fmin(ro, r_cap)
-    tol_ok = np.ones(k, bool)
-    # tolerances: the root of log(ratio) in log r below the clamp (the deviation
-    # grows with r), bracketed (Chandrupatla's method, scipy)
-    tl = np.flatnonzero(how == HOW_TOL)
-    if tl.size:
-        n_ax = E1.shape[1]
-        n_geo = len(cols)
-        tc = (*(col[tl] for col in cols), *E1[tl].T, *E2[tl].T,
-              *(tol[tl] * g0[tl, None]).T, cont[tl] * g0[tl])
-
+    # elementwise numbers, half the calls); inf where the guess was kept
+    r_cap = np.full(k, np.inf)
+    rest = np.ones(k, bool)
+    rest[known] = False
+    rest = np.flatnonzero(rest)
+    if rest.size:
+        adis = rest[how[rest] == HOW_ADIS]
+        both = np.concatenate((rest, adis))
+        cb = tuple(col[both] for col in cols)
+        with np.errstate(invalid="ignore"):
+            r_both = np.fmin(
+                _positive(fam.r_first(np.concatenate((cap_first[rest], dist[adis])), *cb)),
+                _positive(fam.r_second(np.concatenate((cap_second[rest], dist[adis])),
+                                       *cb)))
+        r_both *= 1.0 - CLOSED_FORM_MARGIN
+        r_cap[rest] = r_both[:rest.size]
+        ro[adis] = r_both[rest.size:]
+        ro[rest] = np.fmin(ro[rest], r_cap[rest])
+    ts = tl[~np.isin(tl, known)] if known.size else tl
+    if ts.size:
+        # the others: the root of log(ratio) in log r below the clamp (the deviation
+        # grows with r), from the guess where it lies clearly below the clamp, else
+        # bracketed (Chandrupatla's method, scipy)
         def ratio(x, *c):
             return _log_tol_ratio(x, *c, n_axes=n_ax, n_geo=n_geo, dev_fn=fam.deviation)
 
-        # the start: the radius of the contour deviation that the tolerances allow in
-        # the direction C - M of the line-line corner between the tangents (where the
-        # contour tolerance decides and M lies on the radius towards C, the root)
-        e = np.fmin(cont[tl] * g0[tl], axis_deviation_limit(t1[tl], t2[tl],
-                                                              tol[tl] * g0[tl, None]))
-        ro[tl], f_ro = _tolerance_radius(ratio, tc, r_cap[tl],
-                                         fam.r_deviation(e, *(col[tl] for col in cols)))
+        tc = (*(col[ts] for col in cols), *E1[ts].T, *E2[ts].T,
+              *(tol[ts] * g0[ts, None]).T, cont[ts] * g0[ts])
+        ro[ts], f_ro = _tolerance_radius(ratio, tc, r_cap[ts],
+                                         r_guess[np.searchsorted(tl, ts)])
         # where no radius was found (0, or no clamp and the whole family within) the
         # corner is too small anyway
-        tol_ok[tl] = f_ro <= 0.0
+        tol_ok[ts] = f_ro <= 0.0
     # G644 2xxx/3xxx: the radius whose fillet has the dynamic length (the length grows
     # about like r: the same search, the largest r not longer), at least dyn_radius,
-    # then clamped
+    # then clamped (dyn_cap corners were not kept at the guess: their clamp is known)
     dy = np.flatnonzero((how == HOW_FREQ) | (how == HOW_DYN) | dyn_cap)
     if dy.size:
-        n_geo = len(cols)
         dc = (*(col[dy] for col in cols), dyn_length[dy])
 
         def too_long(x, *c):
@@ -575,7 +628,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
         r_dyn = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
         ro[dy] = np.where(dyn_cap[dy], np.fmin(ro[dy], r_dyn), r_dyn)
     ro = np.where(np.isfinite(ro), ro, 0.0)
-    return ro, r_cap, tol_ok
+    return ro, r_cap, tol_ok, (known, f_known)
 
 
 def _tolerance_radius(ratio: Callable, cols: tuple, r_cap: np.ndarray,
@@ -715,11 +768,19 @@ def _log_tol_ratio(x: np.ndarray, *cols, n_axes: int, n_geo: int,
     per-axis and the contour tolerance; :data:`NO_FILLET_LOG_RATIO` where the fillet
     does not exist."""
     rest = cols[n_geo:]
-    e1 = np.stack(rest[:n_axes], axis=1)
-    e2 = np.stack(rest[n_axes:2 * n_axes], axis=1)
-    tol = np.stack(rest[2 * n_axes:3 * n_axes], axis=1)
-    cont = rest[3 * n_axes]
     dev2, ok = dev_fn(np.exp(x), *cols[:n_geo])
+    return _tol_log_ratio(dev2, ok, np.stack(rest[:n_axes], axis=1),
+                          np.stack(rest[n_axes:2 * n_axes], axis=1),
+                          np.stack(rest[2 * n_axes:3 * n_axes], axis=1), rest[3 * n_axes])
+
+
+def _tol_log_ratio(dev2: np.ndarray, ok: np.ndarray, e1: np.ndarray, e2: np.ndarray,
+                   tol: np.ndarray, cont: np.ndarray) -> np.ndarray:
+    """``log`` of the largest tolerance ratio of fillets whose deviation ``C - M`` in
+    plane coordinates is ``dev2`` (shape (k, 2)): per axis ``|C_i - M_i| / tol_i`` (plane
+    vectors ``e1``, ``e2`` and tolerances ``tol``, shape (k, n)), contour ``|C - M| /
+    cont`` (shape (k,)); :data:`NO_FILLET_LOG_RATIO` where the fillet does not exist
+    (``ok`` False)."""
     dev = e1 * dev2[:, :1] + e2 * dev2[:, 1:]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.maximum(row_norms(dev) / cont, row_max_safe(np.abs(dev) / tol))

@@ -45,6 +45,7 @@ from reference.machine import load_machine, machine_from_dict
 from reference.nc import parse_text
 from reference.planner import plan
 from reference.prepare import build_path
+from rounding_machines import rounding_machine
 from test_rounding_arcs import machine, reasons
 
 ROUNDING = KIND_CODES.index("rounding")
@@ -209,6 +210,34 @@ def test_tolerance_modes_keep_every_axis_within_compress_pos_tol(mode):
     np.testing.assert_allclose(q[0], C + ind["start"], atol=1e-10)
     np.testing.assert_allclose(q[-1], C + ind["end"], atol=1e-10)
     assert_tangent_everywhere(path)
+
+
+@pytest.mark.parametrize("case", ["inside", "outside"])
+@pytest.mark.parametrize("ctol", [0.01, 0.05])
+def test_the_contour_tolerance_radius_is_the_hand_root(case, ctol):
+    """spec 5.7: CTOL is the contour tolerance of G642/G645 (COMPRESS_POS_TOL 1 mm per
+    axis here, so the contour decides). The fillet kept is the largest within it: its
+    hand deviation ``sqrt(2) mu - r`` (module docstring) lies within 3e-11 below CTOL
+    (the radius half ROOT_XATOL inside the root in log r, accepted down to two), the
+    hand radius of deviation CTOL (by root finding on the hand formula, no code of the
+    stage) is its radius to 1e-10, the clamp does not decide, and the inserted segment
+    comes no nearer the corner than that deviation."""
+    text = f"G17 G90 G642 CTOL={ctol} BRISK F600\n" + (INSIDE if case == "inside"
+                                                        else OUTSIDE).format(w="")
+    path = build_path(parse_text(text), rounding_machine(tol=1.0))
+    assert reasons(path)[-1] == "rounded"
+    t = path.rounding
+    r = float(t.radius_mm[-1])
+    assert not bool(t.clamped[-1])
+    dev = hand(case, r)["deviation"]
+    assert ctol * (1.0 - 3e-11) <= dev <= ctol
+    r_hand = brentq(lambda x: hand(case, x)["deviation"] - ctol, 1e-6, 1.0, xtol=1e-15,
+                    rtol=1e-15)
+    assert r == pytest.approx(r_hand, rel=1e-10)
+    # the corner's fillet is the last rounding (the first corner, into the first
+    # arc, is rounded too)
+    q = samples(path, int(np.flatnonzero(path.kind == ROUNDING)[-1]))
+    assert np.linalg.norm(q - C, axis=1).min() >= dev * (1.0 - 1e-9)
 
 
 def test_the_block_length_clamp_limits_rnd_between_arcs():

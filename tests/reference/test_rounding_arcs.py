@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 from reference.core.constraints import BOUND_SETS, check_profile
 from reference.core.geometry import KIND_CODES
@@ -141,6 +142,23 @@ def test_g642_keeps_every_axis_within_compress_pos_tol():
     q = path.evaluate(s, segment=np.full(s.size, k))[0][:, :2]
     assert np.linalg.norm(q - C, axis=1).min() == pytest.approx(
         path.rounding.deviation_mm[0], rel=1e-6)
+
+
+@pytest.mark.parametrize("ctol", [0.01, 0.05])
+def test_the_contour_tolerance_radius_at_a_line_arc_corner_is_the_hand_root(ctol):
+    """spec 5.7: CTOL is the contour tolerance of G642/G645 (COMPRESS_POS_TOL 1 mm per
+    axis here, so the contour decides). The fillet kept is the largest within it: its
+    hand deviation (module docstring) lies within 3e-11 below CTOL, its radius is the
+    hand root to 1e-10 (brentq on the hand formula), and the clamp does not decide."""
+    path = build_path(parse_text(f"G17 G90 G642 CTOL={ctol} BRISK F600\n" + LINE_ARC),
+                      rounding_machine(tol=1.0))
+    assert reasons(path) == ["rounded"]
+    r = float(path.rounding.radius_mm[0])
+    assert not bool(path.rounding.clamped[0])
+    assert ctol * (1.0 - 3e-11) <= hand(r)["deviation"] <= ctol
+    r_hand = brentq(lambda x: hand(x)["deviation"] - ctol, 1e-6, 1.0, xtol=1e-15,
+                    rtol=1e-15)
+    assert r == pytest.approx(r_hand, rel=1e-10)
 
 
 def test_the_block_length_clamp_limits_rnd():
