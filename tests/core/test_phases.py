@@ -190,6 +190,38 @@ def test_a_long_but_front_loaded_ramp_is_judged_by_its_effective_duration():
     assert ph.effective_duration[0] < T
 
 
+def test_two_abrupt_changes_joined_by_a_creep_are_one_accepted_phase():
+    """What the rule still accepts (reference.core.phases docstring): a fall that does
+    half its change at full A, creeps (1e-4 A, above FREQ_ACCEL_TOL_REL) for 1/f and
+    does the other half at full A again is one phase, and its effective duration (by
+    hand: the two halves weigh about alike, so ``t_c`` lies near the middle of the creep
+    and ``D_eff`` near ``T_creep + dv / (2 A)``) passes 1/f, although each real speed
+    change lasts ``dv / (2 A) = 1 / (4 f)``. This is the motion that keeps the
+    bracket of lcnc_test_12mmflat open: the corner's low cap is passed in the creep,
+    and each fall is shorter than a ramp of 1/f could be."""
+    T, A, v = 0.1, 2000.0, 100.0
+    h = (v / 2) / A                          # each abrupt half, s
+    c = 1e-4 * A
+    assert c > FREQ_ACCEL_TOL_REL * A and h == pytest.approx(T / 4)
+    # cruise at v, fall v -> v/2 at A, creep for T, fall the rest at A, cruise on
+    dv_creep = c * T
+    h2 = (v / 2 - dv_creep) / A
+    prof = Profile.from_phases([0.2, h, T, h2, 0.2], [0.0, -A, -c, -A, 0.0],
+                               [0.0] * 5, v0=v)
+    ph = acceleration_phases(prof)
+    assert ph.n == 1 and ph.sign[0] == -1
+    assert ph.duration[0] == pytest.approx(h + T + h2, rel=1e-12)
+    dv1, dv2 = A * h, A * h2
+    tc = (dv1 * h / 2 + dv_creep * (h + T / 2) + dv2 * (h + T + h2 / 2)) / (
+        dv1 + dv_creep + dv2)
+    d_eff = 2 * min(tc, h + T + h2 - tc)
+    assert ph.effective_duration[0] == pytest.approx(d_eff, rel=1e-9)
+    assert d_eff >= T
+    rep = check_profile(line([0, 0, 0], [float(prof.s[-1]), 0, 0]),
+                        machine((10.0, 10.0, 10.0), a=A), prof)
+    assert rep.worst("frequency").ratio <= 1.0
+
+
 def _mirror_a0(d, a0, jj):
     """Start accelerations of the time-reversed (deceleration) copy of a rise."""
     a_end = [a + j * h for a, j, h in zip(a0, jj, d)]
