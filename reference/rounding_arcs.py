@@ -532,7 +532,9 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
     dynamic size (:func:`reference.rounding._dynamic_distance`: at least ``dyn_radius``
-    and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius; and whether
+    and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius (``inf`` at
+    the corners whose fillet was kept at the tolerance search's start: its trims show
+    that the clamp does not bind there, see the comment below); and whether
     the tolerance holds at the radius found (True where no tolerance applies); and the
     corners (indices, shape (q,)) whose fillet at that radius the tolerance search
     built and judged, with those fillets (:class:`_Fillet`), so that they are not built
