@@ -248,7 +248,7 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
                      _circle_pair(path, a[i], b[i], E1[i], E2[i], R[i], radial[i])))
     for sub_o, fam, cols in fams:
         i = o[sub_o]
-        ro, r_cap, tol_ok, (known, f_known) = _radius_by_mode(
+        ro, r_cap, tol_ok, (kept, f_kept) = _radius_by_mode(
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
@@ -256,17 +256,15 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         clamped[i] = ro >= r_cap
         # the fillet at the radius found: the tolerance search's own where it kept the
         # fillet it judged, else built here
-        if known.size == ro.size:
-            f = f_known
+        if kept.all():
+            f = f_kept
         else:
             f = _empty_fillet(ro.size)
-            todo = np.ones(ro.size, bool)
-            todo[known] = False
-            todo = np.flatnonzero(todo)
+            todo = np.flatnonzero(~kept)
             _put(f, todo, fam.fillet(np.where(ro[todo] > 0, ro[todo], 1.0),
                                      *(col[todo] for col in cols)))
-            if known.size:
-                _put(f, known, f_known)
+            if kept.any():
+                _put(f, np.flatnonzero(kept), f_kept)
         r[i] = ro
         length = ro * f.sweep
         # the closed forms assume the branch that shrinks to the corner: the fillet
@@ -535,10 +533,10 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     and at least ``dyn_length`` long, ``r sweep(r)``); the clamp's radius (``inf`` at
     the corners whose fillet was kept at the tolerance search's start: its trims show
     that the clamp does not bind there, see the comment below); and whether
-    the tolerance holds at the radius found (True where no tolerance applies); and the
-    corners (indices, shape (q,)) whose fillet at that radius the tolerance search
-    built and judged, with those fillets (:class:`_Fillet`), so that they are not built
-    again.
+    the tolerance holds at the radius found (True where no tolerance applies); and
+    whether the tolerance search built and judged the fillet at that radius (bool,
+    shape (k,)), with those fillets in corner order (:class:`_Fillet`), so that they
+    are not built again.
     ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
     start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
     but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
@@ -558,8 +556,8 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     # its closed forms are not needed. The other corners search below the clamp.
     tl = np.flatnonzero(how == HOW_TOL)
     r_guess = np.zeros(0)
-    known = np.zeros(0, np.int64)
-    f_known = _empty_fillet(0)
+    kept = np.zeros(k, bool)
+    f_kept = _empty_fillet(0)
     if tl.size:
         e = np.fmin(cont[tl] * g0[tl], axis_deviation_limit(t1[tl], t2[tl],
                                                               tol[tl] * g0[tl, None]))
@@ -576,18 +574,16 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                 hit = ((lr <= 0.0) & (lr >= -2.0 * ROOT_XATOL) & f_g.valid
                        & (f_g.trim_first <= inside * cap_first[tg])
                        & (f_g.trim_second <= inside * cap_second[tg]))
-            known = tg[hit]
-            f_known = f_g if hit.all() else _take(f_g, np.flatnonzero(hit))
-            ro[known] = r_g[hit]
+            kept[tg[hit]] = True
+            f_kept = f_g if hit.all() else _take(f_g, np.flatnonzero(hit))
+            ro[tg[hit]] = r_g[hit]
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
     # (ADIS only where it applies; both lengths of a side in one call: the same
     # elementwise numbers, half the calls); inf where the guess was kept
     r_cap = np.full(k, np.inf)
-    rest = np.ones(k, bool)
-    rest[known] = False
-    rest = np.flatnonzero(rest)
+    rest = np.flatnonzero(~kept)
     if rest.size:
         adis = rest[how[rest] == HOW_ADIS]
         both = np.concatenate((rest, adis))
@@ -601,7 +597,8 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
         r_cap[rest] = r_both[:rest.size]
         ro[adis] = r_both[rest.size:]
         ro[rest] = np.fmin(ro[rest], r_cap[rest])
-    ts = tl[~np.isin(tl, known)] if known.size else tl
+    search = np.flatnonzero(~kept[tl])
+    ts = tl[search]
     if ts.size:
         # the others: the root of log(ratio) in log r below the clamp (the deviation
         # grows with r), from the guess where it lies clearly below the clamp, else
@@ -611,8 +608,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
 
         tc = (*(col[ts] for col in cols), *E1[ts].T, *E2[ts].T,
               *(tol[ts] * g0[ts, None]).T, cont[ts] * g0[ts])
-        ro[ts], f_ro = _tolerance_radius(ratio, tc, r_cap[ts],
-                                         r_guess[np.searchsorted(tl, ts)])
+        ro[ts], f_ro = _tolerance_radius(ratio, tc, r_cap[ts], r_guess[search])
         # where no radius was found (0, or no clamp and the whole family within) the
         # corner is too small anyway
         tol_ok[ts] = f_ro <= 0.0
@@ -630,7 +626,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
         r_dyn = np.fmin(np.maximum(r_len, dyn_radius[dy]), r_cap[dy])
         ro[dy] = np.where(dyn_cap[dy], np.fmin(ro[dy], r_dyn), r_dyn)
     ro = np.where(np.isfinite(ro), ro, 0.0)
-    return ro, r_cap, tol_ok, (known, f_known)
+    return ro, r_cap, tol_ok, (kept, f_kept)
 
 
 def _tolerance_radius(ratio: Callable, cols: tuple, r_cap: np.ndarray,
