@@ -302,7 +302,12 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     near_arc = np.flatnonzero(~is_line & (reason < 0))
     if near_arc.size:
         # the arcs' tangents at the corners: evaluated once, used for both tests below
-        t1_arc, t2_arc = _junction_tangents(path, a[near_arc])
+        # at the global break position, as the arcs' rows evaluate it (not
+        # Path.junction_tangents, which takes the segment's own length: the two
+        # differ by round-off)
+        s_c = path.s_breaks[a[near_arc] + 1]
+        t1_arc = path.tangents(s_c, segment=a[near_arc])
+        t2_arc = path.tangents(s_c, segment=a[near_arc] + 1)
         tang_arc[near_arc] = is_tangential(t1_arc, t2_arc, FEASIBLE)
     other = np.zeros(a.size, bool)
     if not geo.all():
@@ -336,7 +341,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     theta = deflection_angle(t1, t2)
     g2 = (accel_id[ka] == soft_id) & _is_in(mode_id, names, ROUNDING_MODES)
     d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_id, t1, t2, theta,
-                                   g2, decide)
+                                   g2, is_line, decide)
     # corners next to arcs: decided and sized apart (reference.rounding_arcs), after the
     # mode's parameters were checked above
     arcc = np.flatnonzero(arc_corner & (reason < 0))
@@ -436,7 +441,8 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     ac = None
     if arcc.size:
         ac = arc_corners(path, machine, a[arcc], ka[arcc], mode_arr[arcc], t1[arcc],
-                         t2[arcc], {key: val[arcc] for key, val in targets.items()},
+                         t2[arcc], targets if arcc.size == a.size else
+                         {key: val[arcc] for key, val in targets.items()},
                          attrs["accel"][ka[arcc]], CENTRIPETAL_SHARE, JERK_VELOCITY_SHARE,
                          corner_time_loss)
         reason[arcc] = ac.reason
@@ -476,17 +482,21 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
-               t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, decide
-               ) -> tuple[np.ndarray, np.ndarray, dict]:
+               t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, lines: np.ndarray,
+               decide) -> tuple[np.ndarray, np.ndarray, dict]:
     """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
     whether the corner's window may reach across short blocks (G642/G645 with a
     tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
     the corners next to arcs (:func:`reference.rounding_arcs.arc_corners`): ``how``
     (the HOW_ codes there), ``dist`` (ADIS/ADISPOS), ``contour`` and ``axis_tol`` (shape
-    (k, n)) tolerances, ``g0`` (their factor), ``radius`` (RND/RNDM), ``dyn_radius``
+    (k, n)) tolerances, ``g0`` (their factor), ``deviation`` (the contour deviation the
+    tolerances allow between the tangents, times ``g0``; ``nan`` where no corner is of
+    the tolerance type), ``radius`` (RND/RNDM), ``dyn_radius``
     and ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap,
     :func:`_dynamic_distance`), mm, ``dyn_cap`` (bool: G644 0xxx/1xxx). ``mode``:
-    each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,)."""
+    each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,);
+    ``lines`` (bool, shape (k,)): the corner lies between two lines (elsewhere the
+    distance is not used, and the clothoid pair's is not computed)."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -534,6 +544,7 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     is_tol = how == TOL
     tol_k = np.full((k, path.n_axes), np.inf)
     g0 = np.where(ra & rb, ch.g0_tolerance_factor, 1.0)
+    dev = np.full(k, np.nan)
     if is_tol.any():
         tol = np.array([machine.settings_of(ax).compress_pos_tol_mm for ax in path.axes])
         tol_k = np.where(use_axis_tol[:, None] | ~path.geometry[None, :], tol[None, :], np.inf)
@@ -541,7 +552,7 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
         dev0 = np.maximum(dev, 0.0)
         d_dev = np.array(distance_for_deviation(theta, dev0), dtype=np.float64)
-        c = np.flatnonzero(g2)
+        c = np.flatnonzero(g2 & lines)
         if c.size:
             d_dev[c] = _clothoid_distance(theta[c], dev0[c])
         d = np.where(is_tol & (dev > 0), d_dev, d)
@@ -560,16 +571,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length,
+               "deviation": dev, "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length,
                "dyn_cap": dyn_cap}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
-
-
-def _junction_tangents(path: Path, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tangents at the end of segments ``a`` and at the start of ``a + 1``, shape (k, n)
-    each (arcs included)."""
-    s = path.s_breaks[a + 1]
-    return path.evaluate(s, segment=a)[1], path.evaluate(s, segment=a + 1)[1]
 
 
 def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
@@ -950,9 +954,9 @@ def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) 
     ok = open_ & (d > 0)
     # the pair's shape where it is one (elementwise: the same numbers as on all rows)
     d_1, e_1 = np.ones_like(d), np.ones_like(d)
-    c = np.flatnonzero(g2)
+    c = np.flatnonzero(g2 & ok)           # the other rows read neither
     if c.size:
-        d_1[c], e_1[c] = clothoid_pair_shape(np.where(ok[c], theta[c], 1.0))
+        d_1[c], e_1[c] = clothoid_pair_shape(theta[c])
     with np.errstate(divide="ignore", invalid="ignore"):
         r_arc = d / np.tan(theta / 2.0)
         piece_c = d / d_1

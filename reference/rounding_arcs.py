@@ -64,7 +64,7 @@ from scipy.optimize.elementwise import find_root
 from .core.arrays import row_dots, row_min, row_norms
 from .core.geometry import KIND_CODES, Path
 from .core.rounding import (INTERNAL_MODES, OVERLOAD_CHECKED_MODES, REASON_CODE,
-                            always_rounds, axis_deviation_limit, circle_circle_fillet,
+                            always_rounds, circle_circle_fillet,
                             circle_fillet_deviation, circle_fillet_radius_for_deviation,
                             circle_fillet_radius_within, fillet_deviation,
                             fillet_radius_for_arc_trim, fillet_radius_for_deviation,
@@ -245,26 +245,24 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     if aa_o.size:
         i = o[aa_o]
         fams.append((aa_o, _CIRCLE_CIRCLE,
-                     _circle_pair(path, a[i], b[i], E1[i], E2[i], R[i], radial[i])))
+                     _circle_pair(path, a[i], b[i], E1[i], E2[i], E1b[i], E2b[i], R[i],
+                                  radial[i])))
     for sub_o, fam, cols in fams:
         i = o[sub_o]
         ro, r_cap, tol_ok, (kept, f_kept) = _radius_by_mode(
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
             cap_first[i], cap_second[i], targets["dyn_radius"][i],
-            targets["dyn_length"][i], t1[i], t2[i], targets["dyn_cap"][i])
+            targets["dyn_length"][i], targets["deviation"][i], targets["dyn_cap"][i])
         clamped[i] = ro >= r_cap
         # the fillet at the radius found: the tolerance search's own where it kept the
         # fillet it judged, else built here
-        if kept.all():
-            f = f_kept
-        else:
-            f = _empty_fillet(ro.size)
+        # (its rows outside ``kept`` are overwritten here: the fillets are new arrays)
+        f = f_kept if f_kept is not None else _empty_fillet(ro.size)
+        if not kept.all():
             todo = np.flatnonzero(~kept)
             _put(f, todo, fam.fillet(np.where(ro[todo] > 0, ro[todo], 1.0),
                                      *(col[todo] for col in cols)))
-            if kept.any():
-                _put(f, np.flatnonzero(kept), f_kept)
         r[i] = ro
         length = ro * f.sweep
         # the closed forms assume the branch that shrinks to the corner: the fillet
@@ -295,24 +293,31 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         rho = np.sqrt(E1o ** 2 + E2o ** 2)             # each axis' weight in the plane
         moving = rho > 0
         wr = np.where(moving, rho, 1.0)
-        v_g64[o2] = junction_speed_cap(t1[o2], t2[o2], lim.jump, FEASIBLE)[0]
+        t1o, t2o = t1[o2], t2[o2]
+        a1, a2 = np.abs(t1o), np.abs(t2o)
+        # not tangential: round_corners sent only the corners its test (the same rule,
+        # the same tangents) found not tangential
+        v_g64[o2] = junction_speed_cap(t1o, t2o, lim.jump, FEASIBLE,
+                                       np.zeros(o2.size, bool))[0]
         aa = arc_arc[o2]
         soft = accel[o2] == "SOFT"
         # the elements' own radii in the construction's order (inf: the line)
         R_first = np.where(aa, R[o2], np.inf)
         R_second = np.where(aa, path.radius[b[o2]], R[o2])
         with np.errstate(divide="ignore", invalid="ignore"):
-            v_axis = np.minimum(row_min(lim.v_max[None, :] / np.abs(t1[o2])),
-                                row_min(lim.v_max[None, :] / np.abs(t2[o2])))
+            v_axis = np.minimum(row_min(lim.v_max[None, :] / a1),
+                                row_min(lim.v_max[None, :] / a2))
             v_prog = np.minimum(np.minimum(path.feed[a[o2]], path.feed[b[o2]]), v_axis)
             # at most one segment per IPO cycle on either side (5.3), as the heuristic
             # caps them: the speed each side runs at beside the corner
             # (reference.rounding._line_speeds)
             ipo_in, ipo_out = path.length[a[o2]] / t_ipo, path.length[b[o2]] / t_ipo
-            v_c = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
-                                                   * ro[:, None] / wr), np.inf))
-            v_j = row_min(np.where(moving, np.cbrt(jerk_share * lim.j_max[None, :]
-                                                   * (ro * ro)[:, None] / wr), np.inf))
+            # the root of the smallest axis term (the roots grow with their argument:
+            # the same minimum, one root per corner instead of one per axis)
+            v_c = np.sqrt(row_min(np.where(moving, centripetal_share * lim.a_max[None, :]
+                                           * ro[:, None] / wr, np.inf)))
+            v_j = np.cbrt(row_min(np.where(moving, jerk_share * lim.j_max[None, :]
+                                           * (ro * ro)[:, None] / wr, np.inf)))
         v_arc = _arc_speed(lim, R_second, moving, wr, soft, centripetal_share, jerk_share)
         v_arc_first = np.full(o2.size, np.inf)
         if aa.any():
@@ -362,10 +367,10 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         v_in = np.minimum(np.where(forward, v_first, v_second), ipo_in)
         v_out = np.minimum(np.where(forward, v_second, v_first), ipo_out)
         with np.errstate(divide="ignore"):
-            acc_in = row_min(lim.a_max[None, :] / np.abs(t1[o2]))
-            acc_out = row_min(lim.a_max[None, :] / np.abs(t2[o2]))
-            j_in = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t1[o2])), np.inf)
-            j_out = np.where(soft, row_min(lim.j_max[None, :] / np.abs(t2[o2])), np.inf)
+            acc_in = row_min(lim.a_max[None, :] / a1)
+            acc_out = row_min(lim.a_max[None, :] / a2)
+            j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
+            j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
         cut_in = np.where(forward, f.trim_first, f.trim_second)
         cut_out = np.where(forward, f.trim_second, f.trim_first)
         radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
@@ -401,8 +406,10 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
 
 
 def _circle_pair(path: Path, a: np.ndarray, b: np.ndarray, E1: np.ndarray, E2: np.ndarray,
-                 R1: np.ndarray, radial1: np.ndarray) -> tuple:
-    """The columns of :data:`_CIRCLE_CIRCLE` at corners between arcs ``a`` and ``b``:
+                 E1b: np.ndarray, E2b: np.ndarray, R1: np.ndarray, radial1: np.ndarray
+                 ) -> tuple:
+    """The columns of :data:`_CIRCLE_CIRCLE` at corners between arcs ``a`` and ``b``
+    (``E1``, ``E2`` the plane vectors of ``a``, ``E1b``, ``E2b`` those of ``b``):
     both circles in the first arc's plane coordinates with the corner (the first arc's
     end, ``radial1`` its unit radial there) at the origin, ``c_j = -R_j u_j``. The
     second circle is taken through that point with its own radial at its start (the
@@ -410,11 +417,9 @@ def _circle_pair(path: Path, a: np.ndarray, b: np.ndarray, E1: np.ndarray, E2: n
     arc's shortened start as the arcs met). Its sense in the first's plane: its own
     (``sign omega``) times the orientation of its plane vectors in the first's."""
     phi2 = path.theta0[b]
-    rad2 = (path.e1.take(b, axis=0) * np.cos(phi2)[:, None]
-            + path.e2.take(b, axis=0) * np.sin(phi2)[:, None])
+    rad2 = E1b * np.cos(phi2)[:, None] + E2b * np.sin(phi2)[:, None]
     u2 = np.column_stack((row_dots(rad2, E1), row_dots(rad2, E2)))
     u2 /= row_norms(u2)[:, None]
-    E1b, E2b = path.e1.take(b, axis=0), path.e2.take(b, axis=0)
     orient = np.sign(row_dots(E1b, E1) * row_dots(E2b, E2)
                      - row_dots(E1b, E2) * row_dots(E2b, E1))
     R2 = path.radius[b]
@@ -525,7 +530,7 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                     rad: np.ndarray, tol: np.ndarray, cont: np.ndarray, g0: np.ndarray,
                     E1: np.ndarray, E2: np.ndarray, cap_first: np.ndarray,
                     cap_second: np.ndarray, dyn_radius: np.ndarray,
-                    dyn_length: np.ndarray, t1: np.ndarray, t2: np.ndarray,
+                    dyn_length: np.ndarray, dev: np.ndarray,
                     dyn_cap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
     """The fillet radius by mode within the block-length clamp, mm, shape (k,) (0: none):
     the largest within the mode's limits, or for G644 2xxx/3xxx the smallest of the
@@ -535,10 +540,12 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     that the clamp does not bind there, see the comment below); and whether
     the tolerance holds at the radius found (True where no tolerance applies); and
     whether the tolerance search built and judged the fillet at that radius (bool,
-    shape (k,)), with those fillets in corner order (:class:`_Fillet`), so that they
-    are not built again.
-    ``t1``, ``t2`` (shape (k, n)): the tangents at the corners (the tolerance search's
-    start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
+    shape (k,)), with those fillets as rows of one :class:`_Fillet` of k rows (``None``
+    where none was kept; its other rows are not used), so that they are not built
+    again.
+    ``dev`` (shape (k,), mm): the contour deviation the tolerances allow in the
+    direction ``C - M`` of the line-line corner between the tangents
+    (:func:`reference.rounding._distances`; the tolerance search's start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
     but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
     k = how.size
     tol_ok = np.ones(k, bool)
@@ -557,11 +564,9 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     tl = np.flatnonzero(how == HOW_TOL)
     r_guess = np.zeros(0)
     kept = np.zeros(k, bool)
-    f_kept = _empty_fillet(0)
+    f_kept = None
     if tl.size:
-        e = np.fmin(cont[tl] * g0[tl], axis_deviation_limit(t1[tl], t2[tl],
-                                                              tol[tl] * g0[tl, None]))
-        r_guess = fam.r_deviation(e, *(col[tl] for col in cols))
+        r_guess = fam.r_deviation(dev[tl], *(col[tl] for col in cols))
         g = np.flatnonzero((r_guess > R_MIN_MM) & np.isfinite(r_guess) & ~dyn_cap[tl])
         if g.size:
             tg = tl[g]
@@ -575,8 +580,14 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
                        & (f_g.trim_first <= inside * cap_first[tg])
                        & (f_g.trim_second <= inside * cap_second[tg]))
             kept[tg[hit]] = True
-            f_kept = f_g if hit.all() else _take(f_g, np.flatnonzero(hit))
             ro[tg[hit]] = r_g[hit]
+            # in corner order, without copying where every corner was judged (the
+            # common case: one contour tolerance); rows outside ``kept`` are not used
+            if tg.size == k:
+                f_kept = f_g
+            elif hit.any():
+                f_kept = _empty_fillet(k)
+                _put(f_kept, tg, f_g)
     # the replaced lengths grow with r: the largest r within a length on each side
     # in closed form (the clamp; ADIS), shrunk by CLOSED_FORM_MARGIN so that the
     # round-off of the closed form cannot put a trim above its limit
@@ -739,11 +750,12 @@ def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,
     """What the heuristic grants an arc of ``radius`` in the fillet's plane: centripetal,
     under SOFT also the path jerk ``rho_i v^3 / R^2``, mm/s, shape (k,)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        v_arc = row_min(np.where(moving, np.sqrt(centripetal_share * lim.a_max[None, :]
-                                                 * radius[:, None] / wr), np.inf))
-        return np.where(soft, np.minimum(v_arc, row_min(np.where(
-            moving, np.cbrt(jerk_share * lim.j_max[None, :] * (radius * radius)[:, None]
-                            / wr), np.inf))), v_arc)
+        # as v_c, v_j in arc_corners: the root of the smallest axis term
+        v_arc = np.sqrt(row_min(np.where(moving, centripetal_share * lim.a_max[None, :]
+                                         * radius[:, None] / wr, np.inf)))
+        return np.where(soft, np.minimum(v_arc, np.cbrt(row_min(np.where(
+            moving, jerk_share * lim.j_max[None, :] * (radius * radius)[:, None] / wr,
+            np.inf)))), v_arc)
 
 
 def _log_length_ratio(x: np.ndarray, *cols, n_geo: int, fillet: Callable) -> np.ndarray:

@@ -169,12 +169,14 @@ class HelicalSegment:
 
 
 def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None,
-                  length=None, sharpness=None):
+                  length=None, sharpness=None, tangent_only=False):
     """Vectorised kernel: rows ``idx`` of the packed arrays at local positions ``s``.
 
     ``dradius`` and ``length`` (shape ``(m,)``) are needed only when some row is a
     spiral, ``sharpness`` and ``length`` when some row is a clothoid; without them the
-    circle/line closed forms run alone, as fast as before.
+    circle/line closed forms run alone, as fast as before. ``tangent_only``: where every
+    row is a circle or a line, only ``dq`` is computed (the others are ``None``; the
+    same ``dq``, by the same expressions), for callers that need the tangents alone.
     """
     cl = np.flatnonzero(sharpness[idx]) if sharpness is not None else np.zeros(0, np.intp)
     if cl.size:
@@ -204,8 +206,10 @@ def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None
         rc, wc = r[:, None], w[:, None]
         phi = theta0[idx][:, None] + wc * s[:, None]
         c, sn = np.cos(phi), np.sin(phi)
-        radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
         along = E2 * c - E1 * sn           # unit tangential direction of the circle
+        if tangent_only:
+            return None, (rc * wc) * along + DL, None, None
+        radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
         q = origin.take(idx, axis=0) + rc * radial + DL * s[:, None]
         dq = (rc * wc) * along + DL
         ddq = -(rc * wc * wc) * radial
@@ -1169,6 +1173,18 @@ class Path:
                     source=self.source, dradius=self.dradius, rounding=self.rounding,
                     sharpness=self.sharpness)
 
+    def tangents(self, s: np.ndarray | float, side: Literal["left", "right"] = "right",
+                 segment: np.ndarray | None = None) -> np.ndarray:
+        """Exact tangents ``dq/ds`` at global path positions, shape (N, n): the
+        second output of :meth:`evaluate` (the same numbers), without the others where
+        every row is a circle or a line."""
+        s = np.atleast_1d(np.asarray(s, dtype=np.float64))
+        idx = self.segment_index(s, side) if segment is None else np.asarray(segment)
+        return _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
+                             self.omega, self.theta0, idx, s - self.s_breaks[idx],
+                             self.dradius, self.length, self.sharpness,
+                             tangent_only=True)[1]
+
     def junction_tangents(self, lo: int = 0, hi: int | None = None
                           ) -> tuple[np.ndarray, np.ndarray]:
         """Tangents on both sides of every interior break (or of breaks ``lo + 1`` to
@@ -1192,13 +1208,14 @@ class Path:
             z = np.zeros((0, self.n_axes))
             return z, z
         idx_in = np.arange(lo, hi)
-        idx_out = idx_in + 1
         _, t_in, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
                                       self.omega, self.theta0, idx_in, self.length[lo:hi],
-                                      self.dradius, self.length, self.sharpness)
+                                      self.dradius, self.length, self.sharpness,
+                                      tangent_only=True)
         _, t_out, _, _ = _eval_helical(self.origin, self.e1, self.e2, self.d, self.radius,
-                                       self.omega, self.theta0, idx_out, np.zeros(hi - lo),
-                                       self.dradius, self.length, self.sharpness)
+                                       self.omega, self.theta0, idx_in + 1,
+                                       np.zeros(hi - lo), self.dradius, self.length,
+                                       self.sharpness, tangent_only=True)
         return t_in, t_out
 
     def junction_curvatures(self) -> tuple[np.ndarray, np.ndarray]:

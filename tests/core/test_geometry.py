@@ -126,6 +126,40 @@ def test_path_evaluate_sides_at_breaks_and_junction_tangents():
     assert p.block_of(np.array([5.0, 15.0])).tolist() == [0, 1]
 
 
+def test_tangents_alone_are_the_tangents_of_evaluate_and_the_finite_differences():
+    """Path.tangents (the tangent without the other derivatives, as the rounding stage
+    and junction_tangents ask for it) on lines, arcs, helices and a spiral: bit for bit
+    evaluate's second output, and the central difference of the positions (an
+    independent check of the formula)."""
+    rng = np.random.default_rng(11)
+    pieces = []
+    for k in range(6):
+        start, end, c, pl, cw, turns = random_arc(rng, "G17", bool(k % 2), 0,
+                                                  helix=k < 3)
+        if k == 5:                       # a spiral: the end radius 0.3 mm off
+            end = end + 0.3 * (end - c) / np.linalg.norm((end - c)[:2]) * GEO
+        pieces.append(arc_segment(start, end, c, pl, cw, turns, GEO, k, 1.0))
+    pts = rng.uniform(-20, 20, (4, 5))
+    pieces.append(line_segments(pts[:-1], pts[1:], GEO, np.arange(6, 9)))
+    p = path_from_pieces(AX, pieces)
+    assert (p.dradius != 0).any() and (p.kind == p.kind[-1]).sum() == 3
+    s = np.sort(rng.uniform(0.0, p.total_length, 400))
+    for side in ("left", "right"):
+        assert np.array_equal(p.tangents(s, side), p.evaluate(s, side)[1])
+    h = 1e-6
+    inner = s[(s > h) & (s < p.total_length - h)]
+    seg = p.segment_index(inner)
+    keep = (p.segment_index(inner - h) == seg) & (p.segment_index(inner + h) == seg)
+    fd = (p.evaluate(inner[keep] + h)[0] - p.evaluate(inner[keep] - h)[0]) / (2 * h)
+    np.testing.assert_allclose(p.tangents(inner[keep]), fd, atol=1e-6)
+    # at the breaks: junction_tangents are the tangents at each segment's two ends
+    t_in, t_out = p.junction_tangents()
+    at = np.arange(p.n_segments - 1)
+    ends = p.s_breaks[1:-1]
+    np.testing.assert_allclose(t_in, p.tangents(ends, segment=at), atol=1e-12)
+    assert np.array_equal(t_out, p.tangents(ends, segment=at + 1))
+
+
 def test_restricted_path_keeps_the_moving_axes_exactly():
     """A 2-D contour on an XYZ path: ``moving_axes`` names X and Y (Z never moves),
     and the restricted path has the same lengths, breaks and the very same X/Y values
