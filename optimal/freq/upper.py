@@ -67,7 +67,7 @@ from reference.core.rules import curvature_jump_speed_cap
 from .lower import path_rate_bounds, rest_pieces, segment_periods
 
 __all__ = ["Candidate", "ErodedPlan", "candidate_windows", "eroded_plans", "fir_filtered",
-           "pieced", "scaled", "verified", "window_caps"]
+           "piece_times", "pieced", "scaled", "verified", "window_caps"]
 
 
 
@@ -153,8 +153,23 @@ def _scale_pieces(path: Path, prof: Profile, pieces: np.ndarray, lam_k: np.ndarr
                    block=prof.block)
 
 
+def piece_times(path: Path, candidates: list[Candidate],
+                local: dict[int, Profile] | None = None) -> np.ndarray:
+    """Time of each candidate on each rest-to-rest piece, s, shape (C + 1, P): row ``C``
+    the ``local`` motion of the piece (``inf`` where it has none)."""
+    pieces = rest_pieces(path)
+    local = local or {}
+    seg_t = np.stack([c.profile.segment_times(path) for c in candidates])
+    out = np.full((len(candidates) + 1, pieces.shape[0]), np.inf)
+    out[:-1] = np.add.reduceat(seg_t, pieces[:, 0], axis=1)
+    for k, prof in local.items():
+        out[-1, k] = prof.duration
+    return out
+
+
 def pieced(path: Path, candidates: list[Candidate],
-           local: dict[int, Profile] | None = None) -> Profile | None:
+           local: dict[int, Profile] | None = None,
+           choice: np.ndarray | None = None) -> Profile | None:
     """The fastest candidate on each rest-to-rest piece, joined at the stops.
 
     Pieces start and end at rest, so a motion may take each piece from a different
@@ -173,22 +188,25 @@ def pieced(path: Path, candidates: list[Candidate],
         Motions of single pieces (piece index to profile over that piece alone, path
         positions absolute), e.g. :func:`optimal.freq.ramps.ramp_plan`; they take
         part on their piece.
+    choice : numpy.ndarray of int, shape (P,), optional
+        The motion of each piece instead of the fastest: a candidate's index, or
+        ``len(candidates)`` for the piece's ``local`` motion (rows of
+        :func:`piece_times`).
 
     Returns
     -------
     Profile or None
-        ``None`` when one candidate is the fastest on every piece.
+        ``None`` when one candidate is the fastest (or chosen) on every piece.
     """
     pieces = rest_pieces(path)
     local = local or {}
     if not candidates:
         return None
     lo_s = path.s_breaks[pieces[:, 0]]
-    seg_t = np.stack([c.profile.segment_times(path) for c in candidates])
-    piece_t = np.add.reduceat(seg_t, pieces[:, 0], axis=1)
-    best = np.argmin(piece_t, axis=0)
-    use_local = np.array([k in local and local[k].duration < piece_t[best[k], k]
-                          for k in range(pieces.shape[0])])
+    if choice is None:
+        choice = np.argmin(piece_times(path, candidates, local), axis=0)
+    use_local = np.asarray(choice) == len(candidates)
+    best = np.where(use_local, 0, choice)
     if not np.any(use_local) and np.all(best == best[0]):
         return None
     cuts = path.s_breaks[pieces[1:, 0]]

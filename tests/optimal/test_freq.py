@@ -176,3 +176,41 @@ def test_dip_at_a_curvature_jump_beats_the_hand_plateau(bounds):
     assert adapted and min(c.report.worst("frequency").ratio for c in adapted) <= 1.001
     assert min(c.duration for c in adapted) >= base.lower_bound_s
     assert sol.upper_bound_s <= min(c.duration for c in adapted) * (1 + 1e-12)
+
+
+def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
+    # on the default machine (X, Y: A = 2 m/s^2, J = 40 m/s^3, f = 20 Hz, T = 50 ms): a
+    # 20 mm line at F6000 to a dwell, then six 1.02 mm steps of a zig-zag (kinks of
+    # 2 x 11.3 degrees, as in examples/slot.ngc) at F3000. A hand motion: the line as
+    # the S-curve of the closed form, L/v + v/A + A/J = 0.3 s (each ramp 0.1 s >= T);
+    # the zig-zag at its corner cap v_c (the rulebook's velocity-jump cap) with one rise
+    # and one fall of T (S-curves: peak acceleration 2 v_c/T, jerk 4 v_c/T^2, within A
+    # and J), L/v_c + T: the upper bound must be no slower.
+    # Before, the fastest motions of the two pieces joined at the stop with an
+    # acceleration step the checker refuses (the NLP's line reaches rest decelerating,
+    # the ramps start at zero acceleration), and the turn programme was cut at the
+    # acc+freq ramps' time: LB 0.9500 s, UB 1.0190 s (7.3 %); now the pieces beside such
+    # a stop come from one motion and the programme runs again up to the verified
+    # motion: 0.9794 / 1.0000 s
+    from reference.core.rules import FEASIBLE, junction_speed_cap
+    from reference.machine import load_machine
+    from reference.nc import parse_text
+    from reference.prepare import build_path
+    text = "G21 G90 G17 G64 P0.05\nG1 X20 F6000\nG4 P0.1\nG1 X19 Y-0.2 F3000\n" + "".join(
+        f"G1 X{19 - i} Y{-0.2 * ((i + 1) % 2):.1f}\n" for i in range(1, 6)) + "M2\n"
+    mach = load_machine()
+    path = build_path(parse_text(text, dialect="ngc"), mach)
+    lim = mach.limits
+    ax = lim.for_axes(path.axes)
+    sol = optimal.solve(path, lim, bounds="jerk+freq")
+    assert check_profile(path, lim, sol.profile).ok(BOUND_SETS["jerk+freq"])
+    T = 1.0 / float(np.min(ax.frequency_hz[:2]))
+    t_in, t_out = path.junction_tangents()
+    v_c = float(np.min(junction_speed_cap(t_in[1:], t_out[1:], ax.jump, FEASIBLE)[0]))
+    A, J = float(ax.a_max[0]), float(ax.j_max[0])
+    assert 2 * v_c / T <= A and 4 * v_c / T ** 2 <= J
+    hand = (20.0 / 100.0 + 100.0 / A + A / J) + 0.1 + (float(np.sum(path.length[1:])) / v_c
+                                                        + T)
+    assert sol.upper_bound_s <= hand
+    assert sol.lower_bound_s <= sol.upper_bound_s
+    assert sol.upper_bound_s / sol.lower_bound_s - 1.0 < 0.025
