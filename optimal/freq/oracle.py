@@ -68,8 +68,9 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
     piece. Two motions meet at a stop at rest, but not always at the same acceleration:
     under ``jerk+freq`` the NLP's motions reach rest with some deceleration that their
     own next piece takes up in one IPO cycle, where a ramp plan starts at zero
-    acceleration (two lines and a zig-zag: an acceleration step of twice the jerk
-    limit at the stop, the joined motion then slowed by 1.48). A motion joins its own
+    acceleration (examples/slot.ngc's zig-zag after a rapid move, cut out: an
+    acceleration step of twice the jerk limit at the stop, the joined motion then
+    slowed by 1.48). A motion joins its own
     pieces within the limits, and the ramp plans start and end at zero acceleration.
     Returns the fastest accepted join (``None`` if none is new)."""
     times = piece_times(path, cands, local)
@@ -271,8 +272,9 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             # the stand-in motion capped the bound (every motion no slower than it is
             # slower than the bound, so none is faster than it): the programme again
             # for the motions no slower than the verified one, min(bound, t) being a
-            # bound for any t (slotted zig-zag of 1 mm steps under jerk+freq: the acc+freq
-            # ramps take 0.96 s, the jerk+freq ones 1.00 s, and the programme shows 1.00 s)
+            # bound for any t (examples/slot.ngc's zig-zag after a rapid move, cut out:
+            # the programme reached the acc+freq ramps' 1.374 s; for the motions up to the
+            # verified 1.467 s it shows 1.414 s, the zig-zag's own ramps)
             raw = humps_bound(work, sub_lim, env_grid, t_best,
                               max(lb - hold_t, lb_humps), base_sol.segment_lower_bounds_s,
                               enough=enough)
