@@ -571,8 +571,8 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     decide(how == NONE, "G644 SMOOTHING_MODE digit not documented")
     multi = _is_in(mode, names, _ACROSS_BLOCKS) & (how == TOL)
     targets = {"how": how, "dist": dist, "contour": contour, "axis_tol": tol_k, "g0": g0,
-               "deviation": dev, "radius": radius, "dyn_radius": dyn_radius, "dyn_length": dyn_length,
-               "dyn_cap": dyn_cap}
+               "deviation": dev, "radius": radius, "dyn_radius": dyn_radius,
+               "dyn_length": dyn_length, "dyn_cap": dyn_cap}
     return np.where(np.isfinite(d), d, 0.0), multi, targets
 
 

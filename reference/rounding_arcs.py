@@ -312,24 +312,18 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             # caps them: the speed each side runs at beside the corner
             # (reference.rounding._line_speeds)
             ipo_in, ipo_out = path.length[a[o2]] / t_ipo, path.length[b[o2]] / t_ipo
-            # the root of the smallest axis term (the roots grow with their argument:
-            # the same minimum, one root per corner instead of one per axis)
-            v_c = np.sqrt(row_min(np.where(moving, centripetal_share * lim.a_max[None, :]
-                                           * ro[:, None] / wr, np.inf)))
-            v_j = np.cbrt(row_min(np.where(moving, jerk_share * lim.j_max[None, :]
-                                           * (ro * ro)[:, None] / wr, np.inf)))
         v_arc = _arc_speed(lim, R_second, moving, wr, soft, centripetal_share, jerk_share)
         v_arc_first = np.full(o2.size, np.inf)
         if aa.any():
             v_arc_first[aa] = _arc_speed(lim, R_first[aa], moving[aa], wr[aa], soft[aa],
                                          centripetal_share, jerk_share)
         length = ro * f.sweep
-        # centripetal, one IPO cycle per inserted block (5.3), the feed; under SOFT the
-        # path jerk on the fillet (third path derivative 1/r^2) and the curvature jumps
-        # at its ends
-        vr = np.minimum(np.minimum(v_prog, v_c), length / t_ipo)
+        # centripetal and, under SOFT, the path jerk on the fillet (third path
+        # derivative 1/r^2), as on any arc; one IPO cycle per inserted block (5.3), the
+        # feed; under SOFT the curvature jumps at its ends
+        vr = np.minimum(np.minimum(v_prog, length / t_ipo),
+                        _arc_speed(lim, ro, moving, wr, soft, centripetal_share, jerk_share))
         if soft.any():
-            vr = np.where(soft, np.minimum(vr, v_j), vr)
             # 6.3: the fillet's curvature vector jumps from the first element's (the
             # line's 0) at one end and to the second's at the other (q'' = (centre -
             # P) / radius^2)
@@ -545,7 +539,8 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     again.
     ``dev`` (shape (k,), mm): the contour deviation the tolerances allow in the
     direction ``C - M`` of the line-line corner between the tangents
-    (:func:`reference.rounding._distances`; the tolerance search's start). ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
+    (:func:`reference.rounding._distances`; the tolerance search's start).
+    ``dyn_cap`` (bool, shape (k,)): G644 0xxx/1xxx, the tolerance or ADIS radius
     but at most the 3xxx one (spec 5.6: not fully used "if the dynamics allow")."""
     k = how.size
     tol_ok = np.ones(k, bool)
@@ -750,7 +745,8 @@ def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,
     """What the heuristic grants an arc of ``radius`` in the fillet's plane: centripetal,
     under SOFT also the path jerk ``rho_i v^3 / R^2``, mm/s, shape (k,)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        # as v_c, v_j in arc_corners: the root of the smallest axis term
+        # the root of the smallest axis term (the roots grow with their argument: the
+        # same minimum, one root per corner instead of one per axis)
         v_arc = np.sqrt(row_min(np.where(moving, centripetal_share * lim.a_max[None, :]
                                          * radius[:, None] / wr, np.inf)))
         return np.where(soft, np.minimum(v_arc, np.cbrt(row_min(np.where(
