@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from reference.core.errors import FeedOracleError
+from reference.core.errors import FeedOracleError, InternalError, ProfileError
 from reference.core.geometry import Path
 from reference.core.limits import MachineLimits
 from reference.machine import Machine
@@ -108,8 +108,13 @@ def run_oracle(path: Path, limits: MachineLimits, bounds: str,
     options = {} if tol is None else {"tol": tol}
     if max_grid is not None:
         options["max_grid"] = max(int(max_grid), 2)
-    return optimal.solve(path, limits, bounds=bounds, progress=progress, holds=holds,
-                         **options)
+    try:
+        return optimal.solve(path, limits, bounds=bounds, progress=progress, holds=holds,
+                             **options)
+    except ProfileError as exc:
+        # the oracle builds every profile it judges from the validated path and limits:
+        # one that is no motion is its own bug (exit 3), not bad input (exit 2)
+        raise InternalError(f"the {bounds} oracle built an invalid motion: {exc}") from exc
 
 
 def oracle_json(solution) -> dict:

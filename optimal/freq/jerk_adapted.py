@@ -60,6 +60,7 @@ import numpy as np
 
 from reference.core.errors import ProfileError
 from reference.core.geometry import Path
+from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
 from reference.core.phases import acceleration_phases, min_phase_duration, phase_frequencies
 from reference.core.profile import Profile
@@ -118,7 +119,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
                  rounds: int = JERK_ADAPT_ROUNDS,
                  progress: Callable[[str], object] | None = None,
                  bounds: str = "jerk+freq", widen: bool = False,
-                 asymmetric: bool = True) -> list[Candidate]:
+                 asymmetric: bool = True, holds: Holds = NO_HOLDS) -> list[Candidate]:
     """The jerk optimum adapted to the frequency rule (see the module docstring).
 
     Parameters
@@ -156,6 +157,10 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         on ``lcnc_arc_arc_sawtooth`` 5.59 against 5.31 s, but on the line-arc-line of the
         tests 0.742 against 0.750 s), so the oracle runs both, under ``acc+freq`` with and
         without ``widen``.
+    holds : Holds
+        The holds of the reported motion: the NLP arrives at and leaves their breaks as
+        at the path ends (:func:`optimal.jerk.transcription.build_jerk_problem`), and
+        each round is judged with them inserted (:func:`optimal.freq.upper.verified`).
 
     Returns
     -------
@@ -175,7 +180,8 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         # the jerk oracle's own largest NLP: beyond it a round would cost more than the
         # base solve, and the other candidates stand
         return []
-    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
+    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s,
+                                 holds.break_index if holds.n else None)
     jerk_rows = bounds != "acc+freq"
     if not jerk_rows:
         problem = _without_jerk(problem)
@@ -233,7 +239,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
             break      # an NLP answer that is no motion: the rounds so far stand
         tags = ", ".join(t for t, on in (("wide", widen), ("D_eff/D", asymmetric)) if on)
         c = verified(f"{bounds.split('+')[0]} NLP adapted{f' ({tags})' if tags else ''}, "
-                     f"round {r + 1}", path, limits, prof, bounds)
+                     f"round {r + 1}", path, limits, prof, bounds, holds=holds)
         if c is not None:
             out.append(c)
             if c.time_scale <= 1.0 + JERK_ADAPT_DONE_REL:

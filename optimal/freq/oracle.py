@@ -4,7 +4,11 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
 
 1. the ``base`` oracle and the ``acc`` oracle on the same path, without the imposed
    holds (they are a constant added to both bounds and inserted at the end, as the other
-   bound sets do; a motion with its holds cannot be time-scaled);
+   bound sets do; a motion with its holds cannot be time-scaled); every candidate is
+   judged with the holds inserted (:func:`optimal.freq.upper.verified`: a hold rests at
+   zero acceleration, which a motion crossing the stop decelerating on one side and
+   accelerating the other way on the other breaks), and the jerk-adapted NLP arrives
+   at and leaves each hold as at the path ends;
 2. lower bound: ``max`` of the base oracle's certified bound (``base`` is a relaxation
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
    (proof there), plus the holds;
@@ -60,7 +64,7 @@ DEFAULT_FREQ_GAP_TOL = 2e-2
 
 
 def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: dict,
-                       name: str):
+                       name: str, holds: Holds = NO_HOLDS):
     """The fastest motion on each rest-to-rest piece, joined (:func:`pieced`) and judged
     (:func:`verified`); where the checker needs it slowed down, the pieces beside each
     piece that breaks a limit are joined from one motion instead (the faster pair of a
@@ -81,14 +85,15 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
         joined = pieced(path, cands, local, choice)
         if joined is None:
             break
-        c = verified("fastest per piece", path, limits, joined, name)
+        c = verified("fastest per piece", path, limits, joined, name, holds=holds)
         if c is not None and (best is None or c.duration < best.duration):
             best = c
         if c is not None and c.time_scale <= 1.0:
             break
         # the pieces whose blocks break a limit, and their joins to a piece of another
         # motion
-        rep = c.report if c is not None else check_profile(path, limits, joined)
+        rep = c.report if c is not None else check_profile(
+            path, limits, with_holds(joined, path, holds) if holds.n else joined)
         per_block = time_scale_factors_by_block(rep, BOUND_SETS[name])
         bad = [k for k, (lo, hi) in enumerate(pieces)
                if np.max(per_block[path.block[lo:hi]], initial=1.0) > 1.0]
@@ -165,7 +170,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         progress("frequency rule: candidate motions", 0.8)
     cands = []
     if base_sol.profile is not None:
-        c = scaled(path, limits, base_sol.profile, name)
+        c = scaled(path, limits, base_sol.profile, name, holds)
         if c is not None:
             cands.append(c)
     if acc.profile is not None:
@@ -176,7 +181,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             # exact integration needs that form; the checker judges the result anyway
             prof = Profile.from_path_velocity(prof.s, prof.v, prof.block)
         c = verified("fir (acc)", path, limits,
-                     fir_filtered(path, limits, prof, base == "jerk"), name)
+                     fir_filtered(path, limits, prof, base == "jerk"), name, holds=holds)
         if c is not None:
             cands.append(c)
         if base == "acc":
@@ -184,7 +189,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             # pass the rule (optimal.freq.capped): on curves it keeps the axes' budget
             # where the ramps of one constant cannot
             capped = capped_optimum(path, limits, prof)
-            c = verified("capped acc optimum", path, limits, capped, name) \
+            c = verified("capped acc optimum", path, limits, capped, name, holds=holds) \
                 if capped is not None else None
             if c is not None:
                 cands.append(c)
@@ -212,7 +217,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             label = (f"fir {W * 1e3:.3g} ms (eroded caps{', jerk reach' if reach else ''}"
                      f"{', slow corners at rest' if rest_share else ''})" if W > 0
                      else f"adapted caps{' (slow corners at rest)' if rest_share else ''}")
-            c = verified(label, path, limits, prof, name, u.rest_breaks)
+            c = verified(label, path, limits, prof, name, u.rest_breaks, holds)
             if c is not None:
                 cands.append(c)
     if (base_sol.profile is not None and cands
@@ -231,13 +236,13 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             if min(c.duration for c in cands) + hold_t - lb <= tol * lb:
                 break      # the bracket is met: the next variants cannot matter
             cands += jerk_adapted(path, limits, grid_s, base_sol.profile, bounds=name,
-                                  widen=widen, asymmetric=asym,
+                                  widen=widen, asymmetric=asym, holds=holds,
                                   progress=(lambda msg: progress(msg, 0.85))
                                   if progress else None)
     # pieces start and end at rest: the fastest candidate on each, joined, the ramp plan
     # of every piece among them (optimal.freq.ramps: S-curve ramps for jerk+freq)
     local = ramp_plan(path, limits, jerk=base == "jerk")
-    c = _fastest_per_piece(path, limits, cands, local, name) if cands else None
+    c = _fastest_per_piece(path, limits, cands, local, name, holds) if cands else None
     if c is not None:
         cands.append(c)
     t_check = time.perf_counter() - tc

@@ -58,11 +58,13 @@ from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_prof
                                         time_scale_factors_by_block)
 from reference.core.geometry import Path
 from reference.core.errors import ProfileError
+from reference.core.holds import NO_HOLDS, Holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.phases import (acceleration_phases, min_phase_duration,
                                    moving_axes_by_segment, phase_frequencies)
 from reference.core.profile import Profile
 from reference.core.rules import curvature_jump_speed_cap
+from reference.core.tolerances import ROUNDOFF_MARGIN_REL
 
 from .lower import path_rate_bounds, rest_pieces, segment_periods
 
@@ -98,9 +100,16 @@ class Candidate:
 
 
 def verified(name: str, path: Path, limits: MachineLimits, prof: Profile,
-             bounds: str = "jerk+freq", rest_breaks: np.ndarray | None = None
-             ) -> Candidate | None:
+             bounds: str = "jerk+freq", rest_breaks: np.ndarray | None = None,
+             holds: Holds = NO_HOLDS) -> Candidate | None:
     """Check ``prof`` and slow it down until ``bounds`` holds; ``None`` if it cannot.
+
+    ``prof`` is the motion without the holds; it is judged as it will be reported, with
+    ``holds`` inserted (:func:`reference.core.holds.with_holds`): a hold's zero
+    acceleration between the arriving and the leaving motion is two acceleration steps
+    the motion alone does not show (a stop crossed decelerating on one side and
+    accelerating the other way on the other). Time scaling applies to the motion; the
+    holds keep their durations.
 
     Each rest-to-rest piece is first slowed down by its own factor (the largest
     :func:`~reference.core.constraints.time_scale_factors_by_block` of its blocks):
@@ -110,7 +119,11 @@ def verified(name: str, path: Path, limits: MachineLimits, prof: Profile,
     ``rest_breaks``: further breaks where ``prof`` is at rest (pieces end there too).
     """
     cons = BOUND_SETS[bounds]
-    rep = check_profile(path, limits, prof)
+
+    def judge(p: Profile) -> ConstraintReport:
+        return check_profile(path, limits, with_holds(p, path, holds) if holds.n else p)
+
+    rep = judge(prof)
     lam = time_scale_factor(rep, cons)
     if not np.isfinite(lam):
         return None
@@ -123,13 +136,13 @@ def verified(name: str, path: Path, limits: MachineLimits, prof: Profile,
                           for lo, hi in pieces])
         if np.all(np.isfinite(lam_k)):
             out = _scale_pieces(path, prof, pieces, lam_k)
-            if check_profile(path, limits, out).ok(cons):
+            if judge(out).ok(cons):
                 return Candidate(name, out, float(np.max(lam_k)), rep)
     out = scale_time(prof, lam)
     # the scaling argument is exact, but round-off at ratio 1 is judged once more
-    if not check_profile(path, limits, out).ok(cons):
+    if not judge(out).ok(cons):
         out = scale_time(out, 1.0 + 1e-9)
-        if not check_profile(path, limits, out).ok(cons):
+        if not judge(out).ok(cons):
             return None
     return Candidate(name, out, lam, rep)
 
@@ -234,9 +247,18 @@ def pieced(path: Path, candidates: list[Candidate],
 
 
 def scaled(path: Path, limits: MachineLimits, base_profile: Profile,
-           bounds: str = "jerk+freq") -> Candidate | None:
+           bounds: str = "jerk+freq", holds: Holds = NO_HOLDS) -> Candidate | None:
     """Candidate 1: the base set's optimum (without holds), slowed down."""
-    return verified(f"{bounds.split('+')[0]} scaled", path, limits, base_profile, bounds)
+    return verified(f"{bounds.split('+')[0]} scaled", path, limits, base_profile, bounds,
+                    holds=holds)
+
+
+#: Windows of :func:`fir_filtered` at most this share of the piece's ``1/f`` are none:
+#: the filter's acceleration ``(v(t) - v(t - W)) / W`` carries the round-off of ``v``
+#: (1e-16 relative) divided by ``W``, 1e-7 relative at this share for a phase of ``1/f``
+#: at the speed it reaches; the phases it would lengthen are that close to ``1/f``
+#: (the checker's ``RATIO_TOL`` is 1e-6).
+FIR_MIN_WINDOW_REL = ROUNDOFF_MARGIN_REL
 
 
 def fir_filtered(path: Path, limits: MachineLimits, acc_profile: Profile,
@@ -298,6 +320,12 @@ def fir_filtered(path: Path, limits: MachineLimits, acc_profile: Profile,
         W = max(T - r, spread) if T > 0 else 0.0
         if window_s is not None:
             W = float(window_s)
+        if W <= FIR_MIN_WINDOW_REL * T:
+            # the phases already last 1/f up to round-off (T - r = 1.4e-17 s on a line
+            # whose acc ramps take exactly 1/f): the moving average's acceleration
+            # (v(t) - v(t - W)) / W would be round-off divided by W (it drove the filtered
+            # motion 30 mm past the path end)
+            W = 0.0
         inner = tk[(tk > t0) & (tk < t1)]
         if W <= 0.0:
             knots = np.concatenate(([t0], inner, [t1]))

@@ -138,7 +138,8 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
     for rounds in range(1, max_rounds + 1):
         tl = time.perf_counter()
         _, t_acc, _, b_hat = lower_bound(work, lim, grid_l)
-        rel = jerk_relaxation(work, lim, t_ipo, grid_l, b_hat, t_acc, floors)
+        rel = jerk_relaxation(work, lim, t_ipo, grid_l, b_hat, t_acc, floors,
+                              holds.break_index)
         t_bound += time.perf_counter() - tl
         if rel.ok:
             lb = max(lb, rel.lower_bound_s + hold_t)
@@ -148,7 +149,7 @@ def solve_jerk(path: Path, limits: MachineLimits, *, acc_solve: Callable[..., Op
             tau_l = t_acc
         tr = time.perf_counter()
         r = upper_bound_round(path, limits, grid_u, None if best is None else best.profile,
-                              nlp_backend)
+                              nlp_backend, holds)
         t_build += r.nlp.build_time_s
         t_solve += r.nlp.solve_time_s
         t_check += time.perf_counter() - tr - r.nlp.build_time_s - r.nlp.solve_time_s

@@ -32,7 +32,10 @@ with the interval's own geometry ``q'_i, q''_i`` at the ends):
 4. *Steps*: at a break node the axis accelerations on both sides differ by at most
    ``max(Jstep_i, J_i) T_ipo`` (the rulebook; the larger of the two limits, because the
    relaxation does not know whether the path moves there); at the path ends the outside
-   rests (``|A_i| <= J_i T_ipo``); inside a segment ``a1_{k-1} = a0_k``, both set to the
+   rests (``|A_i| <= J_i T_ipo``), and so on both sides of a break where a hold (a dwell,
+   an exact-stop settle) keeps the path at rest: the reported motion has the hold's zero
+   acceleration between the arriving and the leaving motion, at speed 0, where the
+   rulebook's step limit is ``J_i`` (:func:`reference.core.holds.with_holds`); inside a segment ``a1_{k-1} = a0_k``, both set to the
    motion's acceleration just *before* node ``k``: a step there is part of the
    segment's budget ``eps_i``, which every row of the interval after it carries
    (rows 3, 5 and 6 bound the variation of ``A_i`` from ``A_i^0`` by ``J_i t + eps_i``).
@@ -258,7 +261,8 @@ class RelaxationProblem:
 
 def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
                              b_hat: np.ndarray, t_acc: np.ndarray,
-                             seg_floor: np.ndarray | None = None) -> RelaxationProblem:
+                             seg_floor: np.ndarray | None = None,
+                             hold_breaks: np.ndarray | None = None) -> RelaxationProblem:
     """Assemble the relaxation of the module docstring on ``grid``.
 
     Parameters
@@ -281,6 +285,10 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
         Lower bounds of the time every jerk-feasible motion spends on each segment, s
         (:func:`optimal.jerk.lower.jerk_lower_bound`'s per-segment bounds): rows
         ``sum_{k on g} tau_k >= seg_floor_g``.
+    hold_breaks : numpy.ndarray of int, optional
+        Path breaks (``0..m``, repeats allowed) where a hold rests the motion
+        (:attr:`reference.core.holds.Holds.break_index`): rows ``|A_i| <= J_i T_ipo`` on
+        both sides, as at the path ends.
 
     Returns
     -------
@@ -394,6 +402,15 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
             t1 = [(np.atleast_1d(c), np.atleast_1d(v)) for c, v in terms]
             lin.add(t1, np.array([J[i] * t_ipo]))
             lin.add(neg(t1), np.array([J[i] * t_ipo]))
+    held = np.unique(np.asarray([] if hold_breaks is None else hold_breaks, np.int64))
+    held = held[(held > 0) & (held < m)]
+    if held.size:
+        hn = grid.break_node[held]
+        for i in used:
+            for terms in ([(ia1 + hn - 1, dq1[hn - 1, i] * As), (ib + hn, ddq1[hn - 1, i] * Bs)],
+                          [(ia0 + hn, dq0[hn, i] * As), (ib + hn, ddq0[hn, i] * Bs)]):
+                lin.add(terms, np.full(hn.size, J[i] * t_ipo))
+                lin.add(neg(terms), np.full(hn.size, J[i] * t_ipo))
     is_break = np.zeros(N + 1, bool)
     is_break[grid.break_node] = True
     inner = np.flatnonzero(~is_break[1:-1]) + 1
@@ -463,7 +480,8 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
 
 def jerk_relaxation(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
                     b_hat: np.ndarray, t_acc: np.ndarray,
-                    seg_floor: np.ndarray | None = None) -> RelaxationResult:
+                    seg_floor: np.ndarray | None = None,
+                    hold_breaks: np.ndarray | None = None) -> RelaxationResult:
     """Build (:func:`build_relaxation_problem`, same parameters) and solve the relaxation.
 
     Returns
@@ -471,7 +489,8 @@ def jerk_relaxation(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
     RelaxationResult
     """
     tb = time.perf_counter()
-    prob = build_relaxation_problem(path, lim, t_ipo, grid, b_hat, t_acc, seg_floor)
+    prob = build_relaxation_problem(path, lim, t_ipo, grid, b_hat, t_acc, seg_floor,
+                                    hold_breaks)
     N = grid.n_intervals
     _, _, Ts = prob.scales
     Bs = prob.scales[0]

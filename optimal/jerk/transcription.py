@@ -32,7 +32,12 @@ Inequalities (formulation note 1.7, with the rulebook's kinematics,
   ``Jstep`` from :func:`reference.core.rules.step_jerk_limit` (PATH_TRANS_JERK_LIM where
   :func:`reference.core.rules.curvature_jumps` says the curvature jumps, MAX_AX_JERK
   elsewhere); at the path start and end the surroundings are at rest, so
-  ``|q'_i a + q''_i c^2| <= J_i T_ipo`` there.
+  ``|q'_i a + q''_i c^2| <= J_i T_ipo`` there, and so at the breaks where a hold (a
+  dwell, an exact-stop settle) keeps the path at rest with zero acceleration between
+  the arriving and the leaving motion: a step row from each side to rest replaces the
+  row across the break (without it the motion may cross such a stop with a continuous
+  axis acceleration, arriving decelerating and leaving the other way, which the hold
+  inserted afterwards breaks into two steps of the full acceleration).
 
 The checker (:func:`reference.core.constraints.check_profile`) judges the same rules
 inside every interval; what the nodes miss is repaired by time scaling.
@@ -249,7 +254,8 @@ def _stack(parts: list[tuple]) -> tuple[np.ndarray, ...]:
     return tuple(np.concatenate([p[i] for p in parts]) for i in range(7))
 
 
-def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) -> JerkProblem:
+def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float,
+                       hold_breaks: np.ndarray | None = None) -> JerkProblem:
     """Transcribe the jerk-limited problem on ``grid``.
 
     Parameters
@@ -262,6 +268,10 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
         Nodes (every segment break is a node).
     t_ipo : float
         IPO cycle, s (acceleration steps are spread over it).
+    hold_breaks : numpy.ndarray of int, optional
+        Path breaks (``0..m``) where a hold rests the motion
+        (:attr:`reference.core.holds.Holds.break_index`; repeats allowed): the motion
+        arrives there and leaves there as at the path ends.
 
     Returns
     -------
@@ -318,7 +328,8 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
                                np.full(cnt, i)))
     acc = _rows(*_stack(acc_parts))
     jerk = _rows(*_stack(jerk_parts))
-    step = _step_rows(path, lim, grid, t_ipo, units, dq0, ddq0, dq1, ddq1, end_index)
+    step = _step_rows(path, lim, grid, t_ipo, units, dq0, ddq0, dq1, ddq1, end_index,
+                      hold_breaks)
     return JerkProblem(units=units, ds=np.diff(grid.s) / L, c_max=c_max, acc=acc,
                        acc_index=acc.interval, jerk=jerk, step=step,
                        end_index=end_index, n_extra=n_extra, grid=grid,
@@ -327,25 +338,38 @@ def build_jerk_problem(path: Path, lim: AxisArrays, grid: Grid, t_ipo: float) ->
 
 
 def _step_rows(path, lim, grid, t_ipo, units, dq0, ddq0, dq1, ddq1,
-               end_index) -> StepRows:
-    """Acceleration-step rows at interior breaks and at the path ends."""
+               end_index, hold_breaks=None) -> StepRows:
+    """Acceleration-step rows at interior breaks, at the path ends and at holds."""
     L, Au = units.length_mm, units.accel
     n = len(path.axes)
     N = grid.n_intervals
     m = path.n_segments
     z = np.zeros(n)
+    jl = lim.j_max * t_ipo / Au
     parts = []         # node, ia_in, ia_out, dq_in, ddq_in, dq_out, ddq_out, limit, axis
     if m >= 2:
+        held = np.zeros(m + 1, bool)
+        if hold_breaks is not None and len(hold_breaks):
+            held[np.asarray(hold_breaks, dtype=np.int64)] = True
+        held = held[1:m]                           # interior breaks with a hold
         bn = grid.break_node[1:m]                  # nodes of the interior breaks
         t_in, t_out = dq1[bn - 1], dq0[bn]
         k_in, k_out = ddq1[bn - 1], ddq0[bn]
         jstep = step_jerk_limit(curvature_jumps(k_in, k_out), lim.j_max, lim.path_trans_jerk)
+        go, hb = ~held, bn[held]
+        zh = np.zeros(hb.size)
         for i in range(n):
-            parts.append((bn, end_index[bn - 1], bn, t_in[:, i], k_in[:, i] * L,
-                          t_out[:, i], k_out[:, i] * L, jstep[:, i] * t_ipo / Au,
-                          np.full(bn.size, i)))
+            parts.append((bn[go], end_index[bn[go] - 1], bn[go], t_in[go, i],
+                          k_in[go, i] * L, t_out[go, i], k_out[go, i] * L,
+                          jstep[go, i] * t_ipo / Au, np.full(int(go.sum()), i)))
+            # a hold between: each side meets rest (the hold's zero acceleration)
+            parts.append((hb, end_index[hb - 1], np.full(hb.size, -1), t_in[held, i],
+                          k_in[held, i] * L, zh, zh, np.full(hb.size, jl[i]),
+                          np.full(hb.size, i)))
+            parts.append((hb, np.full(hb.size, -1), hb, zh, zh, t_out[held, i],
+                          k_out[held, i] * L, np.full(hb.size, jl[i]),
+                          np.full(hb.size, i)))
     # path ends: the surroundings rest with zero acceleration
-    jl = lim.j_max * t_ipo / Au
     ax = np.arange(n)
     parts.append((np.zeros(n, np.int64), np.full(n, -1), np.zeros(n, np.int64), z, z,
                   dq0[0], ddq0[0] * L, jl, ax))

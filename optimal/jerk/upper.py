@@ -8,7 +8,9 @@
    are kept, the jerk of each interval runs its acceleration from one node value to the
    next, so the acceleration is continuous at every knot inside a segment, as the
    rulebook asks (:func:`exact_profile`).
-4. *Verification*: ``check_profile`` judges the profile under ``BOUND_SETS["jerk"]``;
+4. *Verification*: ``check_profile`` judges the profile, with the holds inserted
+   (:func:`reference.core.holds.with_holds`: the motion the oracle reports), under
+   ``BOUND_SETS["jerk"]``;
    what the nodes missed (jerk and acceleration between nodes on arcs, the speed peak
    inside an interval) is repaired by stretching time
    (:func:`reference.core.constraints.time_scale_factor`, the same rule the ``acc``
@@ -26,6 +28,7 @@ import numpy as np
 from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
                                         scale_time, time_scale_factor)
 from reference.core.geometry import Path
+from reference.core.holds import Holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 
@@ -53,7 +56,7 @@ class UpperResult:
     objective_s : float
         Duration of the NLP's profile before scaling, s.
     report : ConstraintReport or None
-        The checker's report on the unscaled profile.
+        The checker's report on the unscaled profile with its holds.
     nlp : NlpResult
         IPOPT's answer.
     problem : JerkProblem
@@ -209,8 +212,8 @@ def profile_times_at(prof: Profile, s: np.ndarray) -> np.ndarray:
 
 
 def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
-                      start: Profile | None = None, nlp_backend: str = "ipopt"
-                      ) -> UpperResult:
+                      start: Profile | None = None, nlp_backend: str = "ipopt",
+                      holds: Holds | None = None) -> UpperResult:
     """Solve the jerk NLP on ``grid`` and verify its profile (see the module docstring).
 
     Parameters
@@ -225,13 +228,18 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
         A verified profile from a coarser grid to start from (see :func:`warm_start`).
     nlp_backend : {"ipopt", "scp"}
         NLP solver (:mod:`optimal.jerk.backends`).
+    holds : Holds, optional
+        The holds the reported motion contains: the NLP arrives at and leaves their
+        breaks as at the path ends, and the profile is judged with them inserted
+        (default: none).
 
     Returns
     -------
     UpperResult
     """
     lim = limits.for_axes(path.axes)
-    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s)
+    held = None if holds is None or holds.n == 0 else holds.break_index
+    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, held)
     c0, a0, dt0 = warm_start(path, lim, grid, problem, start)
     nlp = get_nlp_backend(nlp_backend)(problem, c0, a0, dt0)
     empty = np.zeros(grid.n_intervals)
@@ -240,7 +248,10 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
                            f"{nlp_backend}: {nlp.message} after {nlp.iterations} iterations")
     block = path.block[grid.segment]
     prof = exact_profile(problem, nlp.c, nlp.a, nlp.a_end, nlp.dt, block)
-    report = check_profile(path, limits, prof)
+    # judged as reported: a hold's zero acceleration between the arriving and the
+    # leaving motion is two steps the profile alone does not show
+    report = check_profile(path, limits, prof if held is None else
+                           with_holds(prof, path, holds))
     lam = time_scale_factor(report, BOUND_SETS["jerk"])
     if not np.isfinite(lam):
         bad = [r for r in report.results if not np.isfinite(r.ratio)]

@@ -191,7 +191,9 @@ def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
     # the ramps start at zero acceleration), and the turn programme was cut at the
     # acc+freq ramps' time: LB 0.9500 s, UB 1.0190 s (7.3 %); now the pieces beside such
     # a stop come from one motion and the programme runs again up to the verified
-    # motion: 0.9794 / 1.0000 s
+    # motion: 0.9794 / 1.0000 s (2.1 %); with the dwell's zero acceleration in the NLP's
+    # rows and in the judgement of every candidate (the jerk-adapted NLP then joins the
+    # pieces at rest, where it crossed the stop decelerating): 0.9794 / 0.9925 s (1.3 %)
     from reference.core.rules import FEASIBLE, junction_speed_cap
     from reference.machine import load_machine
     from reference.nc import parse_text
@@ -213,4 +215,4 @@ def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
                                                         + T)
     assert sol.upper_bound_s <= hand
     assert sol.lower_bound_s <= sol.upper_bound_s
-    assert sol.upper_bound_s / sol.lower_bound_s - 1.0 < 0.025
+    assert sol.upper_bound_s / sol.lower_bound_s - 1.0 < 0.02    # the issue's default

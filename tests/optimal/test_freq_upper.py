@@ -375,3 +375,27 @@ def test_ramp_plan_is_accepted_as_built_on_blended_polylines(machine_name, jerk)
         path = replace(path, feed=np.full(path.n_segments, float(rng.uniform(20, 200))))
         prof = ramp_plan(path, m.limits, jerk=jerk)[0]
         assert check_profile(path, m.limits, prof).ok(cons), (machine_name, jerk, seed)
+
+
+def test_fir_window_of_round_off_is_none():
+    """A line whose trapezoid ramps take exactly 1/f (v/A = 100/2000 = 50 ms at 20 Hz)
+    leaves the moving average a window of round-off (1.4e-17 s): its acceleration
+    ``(v(t) - v(t - W)) / W`` was round-off divided by W, and the filtered motion ran
+    30 mm past the end of a 20 mm line. Such a window is none: the filtered motion is
+    the trapezoid itself, the closed form L/v + v/A = 0.25 s, ending at rest at 20 mm."""
+    from optimal.freq.upper import fir_filtered
+
+    lim = _xyz(v=100.0, a=2000.0, f=20.0)
+    import sys
+    from pathlib import Path as FsPath
+    sys.path.insert(0, str(FsPath(__file__).parent))
+    from oracle_cases import line_path
+    path = line_path([[0, 0, 0], [20, 0, 0]])
+    # the trapezoid, with its ramps a hair under 1/f as an optimum's round-off leaves them
+    r = 0.05 - 1.4e-17
+    trap = Profile.from_phases([r, (20.0 - 100.0 * r) / 100.0, r],
+                               [100.0 / r, 0.0, -100.0 / r], [0, 0, 0])
+    out = fir_filtered(path, lim, trap, jerk_limited=False)
+    assert out.s[-1] == pytest.approx(20.0, abs=1e-9)
+    assert out.duration == pytest.approx(20.0 / 100.0 + 100.0 / 2000.0, rel=1e-12)
+    assert abs(out.v[-1]) <= 1e-9 and np.max(out.v) <= 100.0 * (1 + 1e-12)

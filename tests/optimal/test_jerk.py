@@ -196,3 +196,37 @@ def test_last_round_fills_the_grid_budget():
     assert sol.gap < 0.016                                  # measured 1.44 %
     larger = solve_jerk(path, m.limits, acc_solve=optimal.solve, tol=1e-4, max_grid=1000)
     assert sol.lower_bound_s <= larger.upper_bound_s
+
+
+def test_a_dwell_at_a_reversal_rests_at_zero_acceleration():
+    """A collinear reversal (X 0 -> 12 -> 4) with a 0.1 s dwell at the turn. Without the
+    dwell the motion may cross the stop with a continuous X acceleration (decelerating
+    in, accelerating the other way out); the dwell rests at zero acceleration between,
+    so each side meets rest as at the path ends, by the rulebook's one-cycle step
+    ``J T_ipo``. The exact optimum is then two ruckig moves plus the dwell (the bug it
+    guards against: the NLP solved without the hold, which inserted afterwards made two
+    steps of the full deceleration, ratio 6 in the checker)."""
+    from reference.core.holds import DWELL_CAUSE, Holds
+
+    V, A, J, dwell = 150.0, 800.0, 8000.0, 0.1
+    lim = jerk_machine(V, A, J)
+    p = line_path([[0, 0, 0], [12, 0, 0], [4, 0, 0]], stops=("start", "exact", "end"))
+    holds = Holds(np.array([1]), np.array([1]), np.array([dwell]), (DWELL_CAUSE,))
+    sol = optimal.solve(p, lim, bounds="jerk", tol=TOL, initial_intervals=N0, holds=holds)
+    a_s = J * T_IPO
+    exact = ruckig_line_time(12.0, V, A, J, a_s) + ruckig_line_time(8.0, V, A, J, a_s) + dwell
+    assert sol.lower_bound_s <= exact * (1 + BRACKET_SLACK)
+    assert sol.upper_bound_s >= exact * (1 - BRACKET_SLACK)
+    assert sol.status == optimal.SolveStatus.OPTIMAL
+    assert sol.upper_bound_s <= exact * (1 + TOL)
+    # read from the profile: the dwell is one interval at rest, and the accelerations
+    # beside it (the X acceleration is +-s'' on this line) are within one cycle's step
+    prof = sol.profile
+    h = np.diff(prof.t)
+    k = int(np.flatnonzero((prof.v[:-1] == 0) & (prof.v[1:] == 0) & (prof.a == 0)
+                           & np.isclose(h, dwell, rtol=1e-12))[0])
+    a_in = prof.a[k - 1] + prof.j[k - 1] * h[k - 1]
+    assert abs(a_in) <= a_s * (1 + 1e-6) and abs(prof.a[k + 1]) <= a_s * (1 + 1e-6)
+    # without the dwell the turn is crossed faster than the two moves: the rows matter
+    free = optimal.solve(p, lim, bounds="jerk", tol=TOL, initial_intervals=N0)
+    assert free.upper_bound_s < (exact - dwell) * (1 - 2 * TOL)
