@@ -49,6 +49,8 @@ def violation_dict(v: ConstraintResult, path: Path | None = None) -> dict:
     """One violation in the schema's form, plus value, limit, unit, t and line."""
     d = {"constraint": v.constraint, "axis": v.axis, "ratio": v.ratio, "s": v.s,
          "block": int(v.block), "value": v.value, "limit": v.limit, "unit": v.unit, "t": v.t}
+    if v.detail:
+        d["detail"] = v.detail
     if path is not None:
         span = block_span(path, v.block)
         if span is not None:

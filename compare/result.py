@@ -482,8 +482,9 @@ def describe_violation(v: ConstraintResult, c: Comparison) -> str:
                 f"{v.value:.4g} mm/s at {where}")
     axis = f" on {v.axis}" if v.axis else ""
     ratio = "inf" if not math.isfinite(v.ratio) else f"{v.ratio:.3f}"
+    what = f" ({v.detail})" if v.detail else ""
     return (f"{v.constraint}{axis} {v.value:.4g} {v.unit} > limit {v.limit:.4g} {v.unit} "
-            f"(ratio {ratio}) at {where}")
+            f"(ratio {ratio}) at {where}{what}")
 
 
 def block_span(path: Path, block: int) -> BlockSpan | None:

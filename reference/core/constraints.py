@@ -177,6 +177,14 @@ MIN_ARC_SAMPLES = 8
 #: Evaluation points per chunk. 65 536 points of n axes need about 0.5 MB per (N, n)
 #: array and axis; a chunk uses some 20 of them, so a few tens of MB at most.
 CHUNK_SAMPLES = 65_536
+#: :attr:`ConstraintResult.detail` of the jerk row of acceleration steps inside
+#: segments (where the path acceleration must be continuous): a BRISK profile judged
+#: under a jerk set fails there by a ratio of about 1e8, which reads as nonsense beside
+#: the jerk limit unless the line says what is compared.
+CONTINUITY_DETAIL = ("acceleration steps inside a segment, summed per IPO cycle, against "
+                     "the continuity tolerance ACCEL_CONTINUITY_TOL_REL x jerk limit: "
+                     "the acceleration must be continuous there")
+
 #: Items (intervals, arcs, processes) per step where a whole-array formula is only
 #: split to bound its temporaries: the results do not depend on it (unlike
 #: ``CHUNK_SAMPLES``, which also sets how a long arc interval is cut into pieces).
@@ -209,6 +217,10 @@ class ConstraintResult:
     axis : str or None
         Axis name for per-axis constraints (velocity, acceleration, jerk,
         velocity_jump), the deciding axis (smallest f) for frequency, None otherwise.
+    detail : str
+        What ``value`` and ``limit`` measure where that is not the constraint's plain
+        quantity (the jerk row of acceleration steps inside a segment: their sum per
+        IPO cycle against the continuity tolerance, not the jerk limit); ``""`` else.
     """
 
     constraint: str
@@ -220,6 +232,7 @@ class ConstraintResult:
     t: float
     block: int
     axis: str | None
+    detail: str = ""
 
     @property
     def violated(self) -> bool:
@@ -305,18 +318,21 @@ class _Worst:
     chunking or on the order in which interval kinds are processed.
     """
 
-    __slots__ = ("ratio", "value", "limit", "s", "t", "block", "axis", "found", "per_block")
+    __slots__ = ("ratio", "value", "limit", "s", "t", "block", "axis", "found", "per_block",
+                 "detail")
 
     def __init__(self, n_blocks: int) -> None:
         self.ratio = self.value = self.limit = self.s = self.t = 0.0
         self.block, self.axis, self.found = -1, None, False
         self.per_block = np.zeros(n_blocks)
+        self.detail = ""
 
-    def update(self, ratio, value, limit, s, t, block, axes=None) -> None:
+    def update(self, ratio, value, limit, s, t, block, axes=None, detail: str = "") -> None:
         """Fold in candidate places.
 
         ``ratio``, ``value`` shaped ``(N, n)`` (per axis, then ``axes`` names them) or
-        ``(N,)``; ``limit`` broadcastable to that shape; ``s``, ``t``, ``block`` ``(N,)``.
+        ``(N,)``; ``limit`` broadcastable to that shape; ``s``, ``t``, ``block`` ``(N,)``;
+        ``detail``: :attr:`ConstraintResult.detail` of these places.
         """
         N = ratio.shape[0]
         if N == 0:
@@ -339,6 +355,7 @@ class _Worst:
         self.limit = float(np.broadcast_to(limit, ratio.shape).reshape(N, -1)[row, col])
         self.s, self.t, self.block = float(s[row]), float(t[row]), int(block[row])
         self.axis = axes[col] if axes is not None else None
+        self.detail = detail
 
     def merge(self, other: "_Worst") -> None:
         """Fold another accumulator of the same constraint into this one."""
@@ -346,12 +363,13 @@ class _Worst:
             np.maximum(self.per_block, other.per_block, out=self.per_block)
         if other.found and (not self.found or other.ratio > self.ratio or
                             (other.ratio == self.ratio and other.t < self.t)):
-            for name in ("ratio", "value", "limit", "s", "t", "block", "axis", "found"):
+            for name in ("ratio", "value", "limit", "s", "t", "block", "axis", "found",
+                         "detail"):
                 setattr(self, name, getattr(other, name))
 
     def result(self, name: str) -> ConstraintResult:
         return ConstraintResult(name, self.ratio, self.value, self.limit, UNITS[name],
-                                self.s, self.t, self.block, self.axis)
+                                self.s, self.t, self.block, self.axis, self.detail)
 
 
 # ====================================================================== the checker
@@ -856,7 +874,8 @@ def _check_steps(ctx: _Ctx, w: _Worst, steps: str) -> None:
         where_t[idx] = p.t[kn][hit]
     w.update(ratio[segs], inner_sum[segs] / ctx.t_ipo,
              np.broadcast_to(ACCEL_CONTINUITY_TOL_REL * lim.j_max, (segs.size, n)),
-             where_s, where_t, path.block[segs], path.axes)
+             where_s, where_t, path.block[segs], path.axes,
+             detail=CONTINUITY_DETAIL)
 
 
 def _check_breaks(ctx: _Ctx, worst: dict[str, _Worst]) -> None:
