@@ -93,7 +93,12 @@ def run_heuristic(program: Program, machine: Machine, progress: ProgressFn | Non
     """``reference.planner.plan`` (the SINUMERIK-style heuristic) on ``path``, the
     program's :func:`reference.build_path` (built by the planner when ``None``)."""
     from reference.planner import plan
-    return plan(program, machine, path=path, progress=progress)
+    try:
+        return plan(program, machine, path=path, progress=progress)
+    except ProfileError as exc:
+        # the planner's profile comes from the validated program and path: one that is
+        # no motion is its own bug (exit 3), as in run_oracle
+        raise InternalError(f"the heuristic built an invalid motion: {exc}") from exc
 
 
 def run_oracle(path: Path, limits: MachineLimits, bounds: str,

@@ -153,22 +153,27 @@ def test_check_against_a_program_without_motion_is_bad_input(tmp_path, capsys):
     assert err.strip().startswith(f"feedoracle: {prog}: the program has no motion")
 
 
-def test_an_invalid_motion_built_by_the_oracle_is_an_internal_error(tmp_path, capsys,
-                                                                      monkeypatch):
-    """The oracle builds every profile it judges from the validated path and limits, so
-    a ProfileError from inside it is its own bug: exit 3 with a line saying so, not exit
-    2 as if the program were bad (the FIR candidate once ran 30 mm past the path end of
-    a line whose ramps took exactly 1/f, and the CLI blamed the input)."""
-    import optimal
+@pytest.mark.parametrize("command, module, name, who", [
+    ("optimize", "optimal", "solve", "acc oracle"),
+    ("plan", "reference.planner", "plan", "heuristic")])
+def test_an_invalid_motion_built_by_an_engine_is_an_internal_error(tmp_path, capsys,
+                                                                    monkeypatch, command,
+                                                                    module, name, who):
+    """The oracle and the heuristic build every profile from the validated program, path
+    and limits, so a ProfileError from inside them is their own bug: exit 3 with a line
+    saying so, not exit 2 as if the program were bad (the FIR candidate once ran 30 mm
+    past the path end of a line whose ramps took exactly 1/f, and the CLI blamed the
+    input)."""
+    import importlib
     from reference.core.errors import ProfileError
 
     def broken(*args, **kwargs):
         raise ProfileError("profile starts at s = 0 mm and ends at s = 56.5 mm but the "
                            "path is 26.1 mm long")
 
-    monkeypatch.setattr(optimal, "solve", broken)
+    monkeypatch.setattr(importlib.import_module(module), name, broken)
     prog = tmp_path / "line.ngc"
     prog.write_text("G21 G90 G1 X20 F6000\nM2\n")
-    code, out, err = _run(["optimize", str(prog), "--quiet"], capsys)
+    code, out, err = _run([command, str(prog), "--quiet"], capsys)
     assert code == 3
-    assert "acc oracle built an invalid motion" in err and "Traceback" not in err
+    assert f"{who} built an invalid motion" in err and "Traceback" not in err
