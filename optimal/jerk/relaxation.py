@@ -35,10 +35,11 @@ with the interval's own geometry ``q'_i, q''_i`` at the ends):
    rests (``|A_i| <= J_i T_ipo``), and so on both sides of a break where a hold (a dwell,
    an exact-stop settle) keeps the path at rest: the reported motion has the hold's zero
    acceleration between the arriving and the leaving motion, at speed 0, where the
-   rulebook's step limit is ``J_i`` (:func:`reference.core.holds.with_holds`); inside a segment ``a1_{k-1} = a0_k``, both set to the
-   motion's acceleration just *before* node ``k``: a step there is part of the
-   segment's budget ``eps_i``, which every row of the interval after it carries
-   (rows 3, 5 and 6 bound the variation of ``A_i`` from ``A_i^0`` by ``J_i t + eps_i``).
+   rulebook's step limit is ``J_i`` (:func:`reference.core.holds.with_holds`); inside a
+   segment ``a1_{k-1} = a0_k``, both set to the motion's acceleration just *before* node
+   ``k``: a step there is part of the segment's budget ``eps_i``, which every row of the
+   interval after it carries (rows 3, 5 and 6 bound the variation of ``A_i`` from
+   ``A_i^0`` by ``J_i t + eps_i``).
 5. *Energy rows with jerk*: ``(q'_i^2 b)' = 2 q'_i A_i`` along ``s``, so
    ``q'_i(s_{k+1})^2 b_{k+1} - q'_i(s_k)^2 b_k = 2 int q'_i A_i ds``. Inside the
    interval ``A_i`` stays within ``J_i t + eps_i`` of ``A_i^0`` and within
@@ -407,8 +408,9 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
     if held.size:
         hn = grid.break_node[held]
         for i in used:
-            for terms in ([(ia1 + hn - 1, dq1[hn - 1, i] * As), (ib + hn, ddq1[hn - 1, i] * Bs)],
-                          [(ia0 + hn, dq0[hn, i] * As), (ib + hn, ddq0[hn, i] * Bs)]):
+            arrive = [(ia1 + hn - 1, dq1[hn - 1, i] * As), (ib + hn, ddq1[hn - 1, i] * Bs)]
+            leave = [(ia0 + hn, dq0[hn, i] * As), (ib + hn, ddq0[hn, i] * Bs)]
+            for terms in (arrive, leave):
                 lin.add(terms, np.full(hn.size, J[i] * t_ipo))
                 lin.add(neg(terms), np.full(hn.size, J[i] * t_ipo))
     is_break = np.zeros(N + 1, bool)

@@ -24,6 +24,10 @@ OSQP subproblems at 1,000 only, they need thousands of ADMM iterations each).
 
 copp (the ``copp-py`` package, TOPP3-SOCP) has its own rows at equal nodes in
 ``bench_copp.py``.
+
+Last, a dwell at a reversal (:data:`DWELL_GCODE`): the whole path in one solve against
+its two rest-to-rest pieces solved on their own, whose bounds plus the dwell bracket the
+same optimum (the one solve's upper bound may not fall below the pieces' lower bound).
 """
 
 from __future__ import annotations
@@ -154,7 +158,43 @@ def main() -> int:
     print(f"optimal.solve(bounds='jerk', tol=1%): {sol.status}, bracket "
           f"[{sol.lower_bound_s:.5f}, {sol.upper_bound_s:.5f}] s, UB/LB - 1 = "
           f"{sol.gap:.2%}, {sol.grid_points} points, {secs:.2f} s")
+    dwell_rows(machine)
     return 0
+
+
+#: A 20 mm line to a 0.1 s dwell, then six 1.02 mm steps of a zig-zag whose first one
+#: reverses X: the dwell rests at zero acceleration between the two pieces.
+DWELL_GCODE = ("G21 G90 G17 G64 P0.05\nG1 X20 F6000\nG4 P0.1\nG1 X19 Y-0.2 F3000\n"
+               + "".join(f"G1 X{19 - i} Y{-0.2 * ((i + 1) % 2):.1f}\n" for i in range(1, 6))
+               + "M2\n")
+
+
+def dwell_rows(machine) -> None:
+    """The jerk oracle on a path with a dwell at a reversal, against the same two
+    rest-to-rest pieces solved on their own (their optimum is exactly the sum plus the
+    dwell, which nothing in the single solve may beat): wall time ratio, bounds."""
+    from reference.core.holds import NO_HOLDS
+    path = build_path(parse_text(DWELL_GCODE, "dwell.ngc", dialect="ngc"), machine)
+    limits = machine.limits
+    t0 = time.perf_counter()
+    whole = optimal.solve(path, limits, bounds="jerk", tol=1e-2)
+    t_whole = time.perf_counter() - t0
+    line = build_path(parse_text("G21 G90 G17 G64 P0.05\nG1 X20 F6000\nM2\n", "line.ngc",
+                                 dialect="ngc"), machine)
+    zig = build_path(parse_text("G21 G90 G17 G64 P0.05\n" + "".join(
+        f"G1 X{-1 - i} Y{-0.2 * ((i + 1) % 2):.1f} F3000\n" for i in range(6)) + "M2\n",
+        "zig.ngc", dialect="ngc"), machine)
+    t0 = time.perf_counter()
+    parts = [optimal.solve(p, limits, bounds="jerk", tol=1e-2, holds=NO_HOLDS)
+             for p in (line, zig)]
+    t_parts = time.perf_counter() - t0
+    lo = sum(p.lower_bound_s for p in parts) + 0.1
+    hi = sum(p.upper_bound_s for p in parts) + 0.1
+    print(f"dwell at a reversal (line, G4 0.1 s, zig-zag): one solve {t_whole:.2f} s, the "
+          f"two pieces {t_parts:.2f} s, ratio {t_whole / t_parts:.2f}; bracket "
+          f"[{whole.lower_bound_s:.4f}, {whole.upper_bound_s:.4f}] s ({whole.status}) "
+          f"against the pieces' [{lo:.4f}, {hi:.4f}] s (bounds ratio LB "
+          f"{whole.lower_bound_s / lo:.4f}, UB {whole.upper_bound_s / hi:.4f})")
 
 
 if __name__ == "__main__":

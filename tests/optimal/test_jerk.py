@@ -214,7 +214,8 @@ def test_a_dwell_at_a_reversal_rests_at_zero_acceleration():
     holds = Holds(np.array([1]), np.array([1]), np.array([dwell]), (DWELL_CAUSE,))
     sol = optimal.solve(p, lim, bounds="jerk", tol=TOL, initial_intervals=N0, holds=holds)
     a_s = J * T_IPO
-    exact = ruckig_line_time(12.0, V, A, J, a_s) + ruckig_line_time(8.0, V, A, J, a_s) + dwell
+    exact = (ruckig_line_time(12.0, V, A, J, a_s) + ruckig_line_time(8.0, V, A, J, a_s)
+             + dwell)
     assert sol.lower_bound_s <= exact * (1 + BRACKET_SLACK)
     assert sol.upper_bound_s >= exact * (1 - BRACKET_SLACK)
     assert sol.status == optimal.SolveStatus.OPTIMAL
