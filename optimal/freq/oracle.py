@@ -2,13 +2,15 @@
 
 Pipeline (``base`` is ``acc`` or ``jerk``):
 
-1. the ``base`` oracle and the ``acc`` oracle on the same path, without the imposed
-   holds (they are a constant added to both bounds and inserted at the end, as the other
-   bound sets do; a motion with its holds cannot be time-scaled); every candidate is
-   judged with the holds inserted (:func:`optimal.freq.upper.verified`: a hold rests at
-   zero acceleration, which a motion crossing the stop decelerating on one side and
-   accelerating the other way on the other breaks), and the jerk-adapted NLP arrives
-   at and leaves each hold as at the path ends;
+1. the ``base`` oracle and the ``acc`` oracle on the same path; the candidates are
+   motions without the imposed holds (the holds are a constant added to both bounds and
+   inserted at the end, as the other bound sets do; a motion with its holds cannot be
+   time-scaled), each judged with the holds inserted
+   (:func:`optimal.freq.upper.verified`): a hold rests at zero acceleration, which a
+   motion crossing the stop decelerating on one side and accelerating the other way on
+   the other breaks. So the ``jerk`` oracle runs with the holds (its NLP arrives at and
+   leaves each one as at the path ends; its motion is taken out of its profile by
+   :func:`reference.core.holds.without_holds`), and so does the jerk-adapted NLP;
 2. lower bound: ``max`` of the base oracle's certified bound (``base`` is a relaxation
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
    (proof there), plus the holds;
@@ -40,7 +42,7 @@ import numpy as np
 from reference.core.constraints import BOUND_SETS, check_profile, time_scale_factors_by_block
 from reference.core.errors import ProfileError
 from reference.core.geometry import Path
-from reference.core.holds import NO_HOLDS, Holds, dwell_holds, with_holds
+from reference.core.holds import NO_HOLDS, Holds, dwell_holds, with_holds, without_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 from reference.core.rows import block_motion, block_rows
@@ -154,23 +156,30 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         return replace(solve(path, limits, "acc", holds=holds), bounds=name)
     if base == "jerk":
         jt = jerk_tol if jerk_tol else tol / 2
-        base_sol = solve(path, limits, "jerk", tol=jt, holds=NO_HOLDS, progress=sub)
+        # with the holds: the jerk NLP then rests at zero acceleration at each of them
+        # (a stop crossed decelerating on one side and accelerating the other way on the
+        # other is no motion once the hold is in); its bound and motion without them
+        base_sol = solve(path, limits, "jerk", tol=jt, holds=holds, progress=sub)
+        base_lb = base_sol.lower_bound_s - hold_t
+        base_prof = (None if base_sol.profile is None
+                     else without_holds(base_sol.profile, path, holds))
         acc = solve(path, limits, "acc", holds=NO_HOLDS)
     else:
         base_sol = acc = solve(path, limits, "acc", holds=NO_HOLDS, progress=sub)
+        base_lb, base_prof = base_sol.lower_bound_s, base_sol.profile
     moving = path.moving_axes()
     work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
     tb = time.perf_counter()
     lb_freq = freq_lower_bound(work, limits.for_axes(work.axes))
-    lb = max(base_sol.lower_bound_s, lb_freq) + hold_t
+    lb = max(base_lb, lb_freq) + hold_t
     t_bound = base_sol.bound_time_s + (acc.bound_time_s if acc is not base_sol else 0.0) \
         + time.perf_counter() - tb
     tc = time.perf_counter()
     if progress:
         progress("frequency rule: candidate motions", 0.8)
     cands = []
-    if base_sol.profile is not None:
-        c = scaled(path, limits, base_sol.profile, name, holds)
+    if base_prof is not None:
+        c = scaled(path, limits, base_prof, name, holds)
         if c is not None:
             cands.append(c)
     if acc.profile is not None:
@@ -220,13 +229,13 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             c = verified(label, path, limits, prof, name, u.rest_breaks, holds)
             if c is not None:
                 cands.append(c)
-    if (base_sol.profile is not None and cands
+    if (base_prof is not None and cands
             and min(c.duration for c in cands) + hold_t - lb > tol * lb):
         # the base optimum re-solved by the NLP where it breaks the rule
         # (optimal.freq.jerk_adapted); acc+freq on a grid graded as the jerk oracle's
         # first one (the acc grid is as coarse as straight lines allow)
         grid_s = base_sol.grid if base == "jerk" else np.unique(np.concatenate((
-            jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_sol.profile,
+            jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_prof,
                       ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid)))
         # (widen, asymmetric): the variants of optimal.freq.jerk_adapted, none always
         # faster; without a jerk limit the NLP also needs the widened bounds
@@ -235,7 +244,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         for widen, asym in variants:
             if min(c.duration for c in cands) + hold_t - lb <= tol * lb:
                 break      # the bracket is met: the next variants cannot matter
-            cands += jerk_adapted(path, limits, grid_s, base_sol.profile, bounds=name,
+            cands += jerk_adapted(path, limits, grid_s, base_prof, bounds=name,
                                   widen=widen, asymmetric=asym, holds=holds,
                                   progress=(lambda msg: progress(msg, 0.85))
                                   if progress else None)
@@ -323,7 +332,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     rows = block_rows(path, block_motion(path, prof_h), causes, hold) if path.blocks else ()
     names = ", ".join(f"{c.name} {c.duration + hold_t:.6g} s (x{c.time_scale:.4g})"
                       for c in cands)
-    lb_src = "frequency rule" if lb_freq > base_sol.lower_bound_s else f"{base} oracle"
+    lb_src = "frequency rule" if lb_freq > base_lb else f"{base} oracle"
     message = (f"gap {gap:.4%} {'<=' if status == SolveStatus.OPTIMAL else '>'} {tol:.4%}; "
                f"bracket [{lb:.6g}, {ub:.6g}] s, lower bound from the {lb_src}, "
                f"candidates: {names}")

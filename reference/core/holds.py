@@ -207,5 +207,60 @@ def with_holds(profile: Profile, path, holds: Holds) -> Profile:
     return Profile(t=t, s=s, v=v, a=a, j=j, block=blk)
 
 
+def without_holds(profile: Profile, path, holds: Holds) -> Profile:
+    """The motion of a profile built by :func:`with_holds`, its holds taken out.
+
+    Each hold is the interval :func:`with_holds` put right after the knot where the
+    motion arrives at the hold's break: ``s`` constant, ``v = a = j = 0``, the hold's
+    block and duration. That interval is removed and every later knot moved back by its
+    duration, so ``without_holds(with_holds(p, path, h), path, h)`` is ``p`` (times to
+    round-off of the sums).
+
+    Parameters
+    ----------
+    profile : Profile
+        A motion with ``holds`` in it (the oracle's reported profile).
+    path : reference.core.geometry.Path
+    holds : Holds
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ProfileError
+        A hold is not found where :func:`with_holds` puts it.
+    """
+    if holds.n == 0:
+        return profile
+    pos = path.s_breaks[holds.break_index]
+    h = np.diff(profile.t)
+    still = ((np.abs(np.diff(profile.s)) == 0.0) & (profile.v[:-1] == 0.0)
+             & (profile.v[1:] == 0.0) & (profile.a == 0.0) & (profile.j == 0.0))
+    drop = np.zeros(profile.n_intervals, bool)
+    start = 0
+    for n in range(holds.n):
+        # the first interval at rest at the break with the hold's block and duration,
+        # after the previous hold's (holds at one break run in array order)
+        cand = np.flatnonzero(still[start:] & ~drop[start:]
+                              & (profile.block[start:] == holds.block[n])
+                              & (np.abs(profile.s[start:-1] - pos[n]) <= POS_TOL_MM)
+                              & np.isclose(h[start:], holds.duration_s[n], rtol=1e-12,
+                                           atol=0.0))
+        if cand.size == 0:
+            raise ProfileError(f"hold of block {int(holds.block[n])} at s = {pos[n]:.6g} mm: "
+                               "not in the profile")
+        k = start + int(cand[0])
+        drop[k] = True
+        start = k + 1
+    keep_knot = np.ones(profile.s.size, bool)
+    keep_knot[np.flatnonzero(drop) + 1] = False
+    shift = np.concatenate(([0.0], np.cumsum(np.where(drop, h, 0.0))))
+    return Profile(t=(profile.t - shift)[keep_knot], s=profile.s[keep_knot],
+                   v=profile.v[keep_knot], a=profile.a[~drop], j=profile.j[~drop],
+                   block=profile.block[~drop])
+
+
 __all__ = ["DWELL_CAUSE", "SETTLE_CAUSE", "HOLD_CAUSES", "Holds", "NO_HOLDS", "dwell_holds",
-           "with_holds"]
+           "with_holds", "without_holds"]

@@ -305,7 +305,18 @@ class Profile:
         # each cut is found by bisection (the same set as ``np.isin(cuts, self.s)``,
         # without sorting the knots again)
         at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
-        return cuts[self.s[at] != cuts]
+        cuts, at = cuts[self.s[at] != cuts], at[self.s[at] != cuts]
+        # and the cuts within POS_TOL_MM of a knot where the motion rests: it has
+        # reached the cut there (a motion coming to rest approaches its stop as a cubic,
+        # so a cut 1e-14 mm short of it is crossed some microseconds before the knot;
+        # the sliver cut off then held the tail of the deceleration, and where pieces
+        # of two motions were joined at that stop it became a phase of 5 us)
+        near = np.zeros(cuts.size, bool)
+        for k in (at - 1, at):
+            kk = np.clip(k, 0, self.s.size - 1)
+            near |= ((k >= 0) & (np.abs(self.s[kk] - cuts) <= POS_TOL_MM)
+                     & (np.abs(self.v[kk]) <= VEL_TOL_MM_S))
+        return cuts[~near]
 
     def _cut_times(self, cuts: np.ndarray) -> np.ndarray:
         """Knot times of :meth:`_cut_positions` ``cuts``, s."""

@@ -21,7 +21,7 @@ from compare.export import CSV_COLUMNS, blocks_csv, comparison_dict
 from compare.report_html import render_report
 from reference.core.errors import MachineDataError, ProfileError
 from reference.core.geometry import BlockSpan, line_segments, path_from_pieces
-from reference.core.holds import DWELL_CAUSE, SETTLE_CAUSE, Holds, with_holds
+from reference.core.holds import DWELL_CAUSE, SETTLE_CAUSE, Holds, with_holds, without_holds
 from reference.core.profile import Profile
 from reference.holds import imposed_holds
 from reference.machine import machine_from_dict
@@ -212,7 +212,7 @@ def _two_lines():
                             stop_reason=("start", "exact stop G9", "end"))
 
 
-def test_with_holds_inserts_in_order_and_shifts_later_knots():
+def test_with_holds_inserts_in_order_and_shifts_later_knots_and_without_holds_undoes_it():
     path = _two_lines()
     # rest to rest over 10 mm in 1 s twice (v peak 20 mm/s at a = +-40)
     prof = Profile(t=[0, 0.5, 1, 1.5, 2], s=[0, 5, 10, 15, 20], v=[0, 20, 0, 20, 0],
@@ -224,6 +224,12 @@ def test_with_holds_inserts_in_order_and_shifts_later_knots():
     assert out.s.tolist() == [0, 5, 10, 10, 10, 15, 20, 20]
     assert out.block.tolist() == [-1, -1, 0, 7, -1, -1, 2]
     assert out.duration == pytest.approx(2.875)
+    # and back: without_holds takes exactly those intervals out again
+    back = without_holds(out, path, holds)
+    for f in ("t", "s", "v", "a", "j", "block"):
+        np.testing.assert_array_equal(getattr(back, f), getattr(prof, f))
+    with pytest.raises(ProfileError, match="not in the profile"):
+        without_holds(prof, path, holds)
     moving = Profile(t=[0, 1, 2], s=[0, 10, 20], v=[0, 20, 0], a=[20, -20], j=[0, 0],
                      block=[-1, -1])                       # passes break 1 at 10 mm/s
     with pytest.raises(ProfileError, match="does not rest"):

@@ -88,6 +88,26 @@ def test_cuts_on_knots_are_dropped_as_isin_drops_them():
     assert not np.isin(sc, prof.s).any()
 
 
+def test_a_cut_a_hair_short_of_a_rest_is_that_rest():
+    """A motion coming to rest approaches its stop as a cubic, so a cut 1e-14 mm short
+    of the stop (round-off of a break position) is crossed microseconds before it: the
+    sliver split off held the tail of the deceleration, and where the pieces of two
+    motions were joined at that stop it read as a phase of 5 us (a frequency ratio of
+    16,000). Within POS_TOL_MM of a knot at rest, the cut is that knot; near a moving
+    knot, and farther from a rest, it still splits."""
+    from reference.core.tolerances import POS_TOL_MM
+    prof = Profile.from_phases([0.1, 0.1, 0.1, 0.1], [0, 1000, 0, -1000],
+                               [10000, -10000, -10000, 10000])
+    stop = float(prof.s[-1])
+    assert prof.v[-1] == 0.0
+    assert prof.split_at([stop - 1e-14]).n_intervals == prof.n_intervals
+    assert prof.split_at([stop - 0.5 * POS_TOL_MM]).n_intervals == prof.n_intervals
+    assert prof.split_at([stop - 1e-3]).n_intervals == prof.n_intervals + 1
+    moving = float(prof.s[2])                       # at full speed
+    assert prof.v[2] > 0
+    assert prof.split_at([moving - 1e-9]).n_intervals == prof.n_intervals + 1
+
+
 def test_block_times_sum_to_duration_and_hold_goes_to_dwell_block():
     pts = np.array([[0, 0, 0], [10, 0, 0], [20, 0, 0]], float)
     spans = (BlockSpan(0, 1, "", "G1", 0.0, 10.0, 0, 1),

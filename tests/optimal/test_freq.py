@@ -216,3 +216,38 @@ def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
     assert sol.upper_bound_s <= hand
     assert sol.lower_bound_s <= sol.upper_bound_s
     assert sol.upper_bound_s / sol.lower_bound_s - 1.0 < 0.02    # the issue's default
+
+
+def test_a_dwell_between_two_half_circles_under_jerk_and_frequency():
+    # a half circle of R 5 mm at F6000 (G2 from X0 to X10, default machine), a 0.05 s
+    # dwell, and the half circle back (G3): Y reverses at the dwell, which rests at zero
+    # acceleration between the two. The jerk optimum solved without the dwell crossed
+    # the stop at Y'' = A (decelerating in, accelerating the other way out), the dwell
+    # then made two steps of A the checker repairs by slowing down 3.5x: bracket 44 %;
+    # solved with it, the jerk optimum keeps the frequency rule as it is: 0.69 %. The
+    # relaxation chain holds (the jerk+freq lower bound is at least the jerk one), and
+    # the axis accelerations beside the dwell, read from the profile with the arcs'
+    # tangents there (the curvature term is 0 at rest), are within one cycle's step.
+    from reference.machine import load_machine
+    from reference.nc import parse_text
+    from reference.prepare import build_path
+    text = "G21 G90 G17 G64 P0.05\nG2 X10 Y0 R5 F6000\nG4 P0.05\nG3 X0 Y0 R5\nM2\n"
+    mach = load_machine()
+    path = build_path(parse_text(text, dialect="ngc"), mach)
+    lim = mach.limits
+    jf = optimal.solve(path, lim, bounds="jerk+freq")
+    j = optimal.solve(path, lim, bounds="jerk")
+    assert jf.lower_bound_s >= j.lower_bound_s * (1 - 1e-12)
+    assert jf.lower_bound_s <= jf.upper_bound_s
+    assert jf.upper_bound_s / jf.lower_bound_s - 1.0 < 0.02    # the issue's default
+    prof = jf.profile
+    h = np.diff(prof.t)
+    k = int(np.flatnonzero((prof.v[:-1] == 0) & (prof.v[1:] == 0) & (prof.a == 0)
+                           & np.isclose(h, 0.05, rtol=1e-12))[0])
+    a_in = prof.a[k - 1] + prof.j[k - 1] * h[k - 1]
+    a_out = prof.a[k + 1]
+    ax = lim.for_axes(path.axes)
+    _, t_in, _, _ = path.evaluate(np.array([path.s_breaks[1]]), side="left")
+    _, t_out, _, _ = path.evaluate(np.array([path.s_breaks[1]]), side="right")
+    step = ax.j_max * lim.t_ipo_s * (1 + 1e-6)
+    assert np.all(np.abs(t_in[0] * a_in) <= step) and np.all(np.abs(t_out[0] * a_out) <= step)
