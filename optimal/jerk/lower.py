@@ -125,7 +125,8 @@ def rest_to_rest_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) 
         Path speed, acceleration and jerk limits, mm/s, mm/s^2, mm/s^3 (> 0).
     a_s : float
         Largest path acceleration allowed at the start and at the end (in size),
-        mm/s^2 (clipped to ``[0, A]``).
+        mm/s^2 (clipped to ``[0, min(A, sqrt(2 J V))]``: no motion under ``V`` leaves
+        rest faster).
 
     Returns
     -------
@@ -133,7 +134,13 @@ def rest_to_rest_time(L: float, V: float, A: float, J: float, a_s: float = 0.0) 
         Seconds; the jerk-free bound ``L/V + V/A`` or ``2 sqrt(L/A)`` when the move is
         too short for the jerk ramp (see the module docstring, step 3).
     """
-    a_s = min(max(a_s, 0.0), A)
+    # a motion leaving rest at acceleration a gains at least a^2 / (2 J) of speed before
+    # its acceleration can fall to zero, so under v <= V it leaves (and, mirrored,
+    # arrives) at no more than sqrt(2 J V): the allowance beyond that is none (at a
+    # reversal, where the step rule allows any acceleration, the virtual start of the
+    # closed form lay below -V and its distance came out negative: 7.22 s for a 1 mm
+    # move at 10 mm/min that takes 6.00 s)
+    a_s = min(max(a_s, 0.0), A, math.sqrt(2.0 * J * V))
     delta = a_s * a_s / (2.0 * J)
     a2j = A * A / J
 

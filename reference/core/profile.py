@@ -346,7 +346,9 @@ class Profile:
         Parameters
         ----------
         s_cuts : array_like
-            Path positions, mm; values on existing knots or outside the span are ignored.
+            Path positions, mm; values on existing knots, within ``POS_TOL_MM`` of a
+            knot where the motion rests (it reaches the cut there), or outside the span
+            are ignored.
 
         Returns
         -------

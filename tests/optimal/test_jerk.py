@@ -56,6 +56,28 @@ def test_closed_form_matches_ruckig():
         assert rest_to_rest_time(L, V, A, J, a_s) == pytest.approx(ref, rel=CLOSED_FORM_RTOL)
 
 
+def test_closed_form_is_below_every_move_within_a_large_allowance():
+    """At a 180 degree reversal the step rule allows any path acceleration at rest, so
+    the closed form gets ``a_s`` up to ``A``; but no motion under ``V`` leaves rest
+    faster than ``sqrt(2 J V)`` (it would gain more than ``V`` before its acceleration
+    could fall). The bound must stay below ruckig's move for every boundary acceleration
+    a motion can use (the fuzzer's 1 mm at 10 mm/min, G9, back: 7.22 s against the 6.00 s
+    the move takes; 391 of these 2,000 moves were below it)."""
+    rng = np.random.default_rng(2)
+    for _ in range(400):
+        L = 10 ** rng.uniform(-2, 2)
+        V, A, J = 10 ** rng.uniform(-1, 3), 10 ** rng.uniform(2, 4), 10 ** rng.uniform(3, 6)
+        a_s = A * rng.choice([0.01, 0.1, 1.0])
+        bound = rest_to_rest_time(L, V, A, J, a_s)
+        for f in (0.0, 0.25, 0.5, 0.75, 0.999):        # ruckig refuses sqrt(2 J V) itself
+            a = f * min(a_s, math.sqrt(2 * J * V))
+            assert bound <= ruckig_line_time(L, V, A, J, a) * (1 + BRACKET_SLACK)
+    # the fuzzer's case: the closed form at the largest usable allowance
+    L, V, A, J = 1.0, 10.0 / 60.0, 2000.0, 40000.0
+    assert rest_to_rest_time(L, V, A, J, A) == pytest.approx(
+        ruckig_line_time(L, V, A, J, math.sqrt(2 * J * V) * (1 - 1e-9)), rel=1e-9)
+
+
 @pytest.mark.parametrize("L", [0.5, 10.0, 200.0])
 def test_single_line_brackets_ruckig(L):
     V, A, J = 200.0, 1000.0, 10000.0

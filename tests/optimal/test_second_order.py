@@ -116,6 +116,26 @@ def test_line_tent_profile_is_the_exact_trapezoid():
     assert np.max(np.abs(prof.a)) == pytest.approx(A, rel=1e-12)
 
 
+def test_a_ramp_shorter_than_round_off_of_its_interval_is_kept_where_it_changes_the_speed():
+    """At 1 mm/min the ramp to 1.5 mm/min at 2.5 m/s^2 is 6.9e-8 mm long, below 1e-9 of
+    its 87 mm interval: dropped as round-off, it left the interval cruising at the old
+    speed into a node at the new one, and the next interval, integrated from the speed
+    the profile arrived with, ended 29 mm short of its knot (a fuzzer's program, exit 3).
+    Hand motion: the ramp at the tent's M / 2, then 1.5 mm/min to the end."""
+    from optimal.upper import LineTents, grid_profile
+    v0, v1, M, D, D2 = 1.0 / 60.0, 1.5 / 60.0, 5000.0, 86.75434355, 10.0
+    b0, b1 = v0 * v0, v1 * v1
+    s = np.array([0.0, D, D + D2])
+    tents = LineTents(cap=np.array([b1, b1]), slope=np.array([M, M]))
+    prof = grid_profile(s, np.array([b0, b1, b1]), np.array([0, 0]), None, tents)
+    ramp = (b1 - b0) / M
+    assert ramp < 1e-9 * D
+    hand = ramp / (0.5 * (v0 + v1)) + (D - ramp) / v1 + D2 / v1
+    assert prof.duration == pytest.approx(hand, rel=1e-12)
+    assert prof.s[-1] == s[-1] and prof.v[-1] == pytest.approx(v1, rel=1e-12)
+    assert np.max(np.abs(prof.a)) <= M / 2 * (1 + 1e-12)
+
+
 def _grid_upper(path, limits, counts, slopes: bool):
     la = limits.for_axes(path.axes)
     g = grid_from_counts(path, counts)
