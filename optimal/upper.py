@@ -144,9 +144,8 @@ def _tent_pieces(Dl: np.ndarray, b0: np.ndarray, b1: np.ndarray, v0: np.ndarray,
     # the next block's 1.5 mm/min at 2 m/s^2 is 9e-8 mm long, 1e-9 of its 87 mm interval,
     # and dropping it left a speed jump the next interval's integration missed by 29 mm
     tiny = 1e-9 * Dl
-    b_big = np.maximum(cap, 1e-300)
-    l1 = np.where((l1 < tiny) & (M * l1 <= 1e-9 * b_big), 0.0, l1)
-    l3 = np.where((l3 < tiny) & (M * l3 <= 1e-9 * b_big), 0.0, l3)
+    l1 = np.where((l1 < tiny) & (M * l1 <= 1e-9 * cap), 0.0, l1)
+    l3 = np.where((l3 < tiny) & (M * l3 <= 1e-9 * cap), 0.0, l3)
     l2 = Dl - l1 - l3
     l2 = np.where(l2 < tiny, 0.0, l2)
     l1 = np.where((l2 == 0.0) & (l1 > 0), Dl - l3, l1)

@@ -180,8 +180,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         # the jerk oracle's own largest NLP: beyond it a round would cost more than the
         # base solve, and the other candidates stand
         return []
-    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s,
-                                 holds.break_index if holds.n else None)
+    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, holds.break_index)
     jerk_rows = bounds != "acc+freq"
     if not jerk_rows:
         problem = _without_jerk(problem)

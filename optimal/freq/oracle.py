@@ -95,7 +95,7 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
         # the pieces whose blocks break a limit, and their joins to a piece of another
         # motion
         rep = c.report if c is not None else check_profile(
-            path, limits, with_holds(joined, path, holds) if holds.n else joined)
+            path, limits, with_holds(joined, path, holds))
         per_block = time_scale_factors_by_block(rep, BOUND_SETS[name])
         bad = [k for k, (lo, hi) in enumerate(pieces)
                if np.max(per_block[path.block[lo:hi]], initial=1.0) > 1.0]

@@ -121,7 +121,7 @@ def verified(name: str, path: Path, limits: MachineLimits, prof: Profile,
     cons = BOUND_SETS[bounds]
 
     def judge(p: Profile) -> ConstraintReport:
-        return check_profile(path, limits, with_holds(p, path, holds) if holds.n else p)
+        return check_profile(path, limits, with_holds(p, path, holds))
 
     rep = judge(prof)
     lam = time_scale_factor(rep, cons)

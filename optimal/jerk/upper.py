@@ -28,7 +28,7 @@ import numpy as np
 from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
                                         scale_time, time_scale_factor)
 from reference.core.geometry import Path
-from reference.core.holds import Holds, with_holds
+from reference.core.holds import NO_HOLDS, Holds, with_holds
 from reference.core.limits import MachineLimits
 from reference.core.profile import Profile
 
@@ -213,7 +213,7 @@ def profile_times_at(prof: Profile, s: np.ndarray) -> np.ndarray:
 
 def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
                       start: Profile | None = None, nlp_backend: str = "ipopt",
-                      holds: Holds | None = None) -> UpperResult:
+                      holds: Holds = NO_HOLDS) -> UpperResult:
     """Solve the jerk NLP on ``grid`` and verify its profile (see the module docstring).
 
     Parameters
@@ -228,18 +228,16 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
         A verified profile from a coarser grid to start from (see :func:`warm_start`).
     nlp_backend : {"ipopt", "scp"}
         NLP solver (:mod:`optimal.jerk.backends`).
-    holds : Holds, optional
+    holds : Holds
         The holds the reported motion contains: the NLP arrives at and leaves their
-        breaks as at the path ends, and the profile is judged with them inserted
-        (default: none).
+        breaks as at the path ends, and the profile is judged with them inserted.
 
     Returns
     -------
     UpperResult
     """
     lim = limits.for_axes(path.axes)
-    held = None if holds is None or holds.n == 0 else holds.break_index
-    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, held)
+    problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, holds.break_index)
     c0, a0, dt0 = warm_start(path, lim, grid, problem, start)
     nlp = get_nlp_backend(nlp_backend)(problem, c0, a0, dt0)
     empty = np.zeros(grid.n_intervals)
@@ -250,8 +248,7 @@ def upper_bound_round(path: Path, limits: MachineLimits, grid: Grid,
     prof = exact_profile(problem, nlp.c, nlp.a, nlp.a_end, nlp.dt, block)
     # judged as reported: a hold's zero acceleration between the arriving and the
     # leaving motion is two steps the profile alone does not show
-    report = check_profile(path, limits, prof if held is None else
-                           with_holds(prof, path, holds))
+    report = check_profile(path, limits, with_holds(prof, path, holds))
     lam = time_scale_factor(report, BOUND_SETS["jerk"])
     if not np.isfinite(lam):
         bad = [r for r in report.results if not np.isfinite(r.ratio)]

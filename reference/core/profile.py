@@ -305,7 +305,8 @@ class Profile:
         # each cut is found by bisection (the same set as ``np.isin(cuts, self.s)``,
         # without sorting the knots again)
         at = np.minimum(np.searchsorted(self.s, cuts), self.s.size - 1)
-        cuts, at = cuts[self.s[at] != cuts], at[self.s[at] != cuts]
+        off = self.s[at] != cuts
+        cuts, at = cuts[off], at[off]
         # and the cuts within POS_TOL_MM of a knot where the motion rests: it has
         # reached the cut there (a motion coming to rest approaches its stop as a cubic,
         # so a cut 1e-14 mm short of it is crossed some microseconds before the knot;
