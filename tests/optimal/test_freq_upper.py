@@ -399,3 +399,35 @@ def test_fir_window_of_round_off_is_none():
     assert out.s[-1] == pytest.approx(20.0, abs=1e-9)
     assert out.duration == pytest.approx(20.0 / 100.0 + 100.0 / 2000.0, rel=1e-12)
     assert abs(out.v[-1]) <= 1e-9 and np.max(out.v) <= 100.0 * (1 + 1e-12)
+
+
+def test_a_ramp_the_grid_puts_into_one_interval_becomes_the_ramp_of_1_f():
+    """A line between two slow corners (1.2 mm/s) at 20 mm/s, A = 1500 mm/s^2, 15 Hz, on
+    a grid of 1/6 mm: each acc ramp (0.13 mm) fits inside one interval. The adaptation
+    (:func:`optimal.freq.upper._adapted`) must turn each into the ramp of ``1/f`` at the
+    constant rate ``(v - v_c) f``: the hand motion of two such ramps and a cruise at
+    ``v``. It used to slow the intervals it had already set on later rounds (the phase
+    grew one interval a round, its far end halved each time): 0.385 s against the hand
+    0.313 s (examples/demo.mpf's plunge under acc+freq: 0.378 s of 0.317). The ramps end
+    inside an interval (0.707 mm on 1/6 mm steps), whose constant acceleration is then
+    a little gentler: measured 6e-4 above the hand motion."""
+    from optimal.freq.upper import ADAPT_MARGIN, _adapted
+    from optimal.grid import grid_on
+    from reference.core.phases import acceleration_phases
+    from oracle_cases import line_path
+
+    f, A, v, v_c, L, ds = 15.0, 1500.0, 20.0, 1.2, 5.0, 1.0 / 6.0
+    lim = _xyz(a=A, f=f)
+    path = line_path([[0, 0, 0], [L, 0, 0]], feed=v)
+    grid = grid_on(path, np.linspace(0.0, L, int(round(L / ds)) + 1))
+    b = np.full(grid.s.size, v * v)
+    b[0] = b[-1] = v_c * v_c
+    blocks = path.block[grid.segment]
+    out = _adapted(path, lim.for_axes(path.axes), grid, b, 2.0 * A * np.diff(grid.s),
+                   blocks, 0.0)
+    prof = Profile.from_path_velocity(grid.s, np.sqrt(out), blocks)
+    ph = acceleration_phases(prof)
+    ramp_t = (1.0 + ADAPT_MARGIN) / f            # the adaptation aims a hair above 1/f
+    hand = 2.0 * ramp_t + (L - (v + v_c) * ramp_t) / v
+    assert ph.sign.size == 2 and np.all(ph.effective_duration >= (1.0 - ADAPT_MARGIN) / f)
+    assert prof.duration == pytest.approx(hand, rel=1e-3)
