@@ -791,7 +791,7 @@ def _adapted(work: Path, lim, grid, b: np.ndarray, step: np.ndarray, blocks: np.
         short = np.flatnonzero(ph.effective_duration < need * (1.0 - ADAPT_MARGIN))
         if short.size == 0:
             break
-        # the mean acceleration of a linear ramp of the needed length (below)
+        # a_new: the mean acceleration of a linear ramp of the needed length
         aim = need[short] * (1.0 + ADAPT_MARGIN)      # > 0: the phase is short of it
         a_new = ph.dv[short] / aim
         shrink = np.clip(ph.effective_duration[short] / aim, 0.5, 1.0)
@@ -806,7 +806,6 @@ def _adapted(work: Path, lim, grid, b: np.ndarray, step: np.ndarray, blocks: np.
                 b_env[nodes] = np.minimum(b_env[nodes], float(np.min(b[nodes])))
                 continue
             a_now = step[sl] / (2.0 * ds[sl])
-            at_it = a_now <= a_new[k] * (1.0 + 1e-9)
             # the steeper intervals take the ramp's acceleration and the gentler ones
             # stay; only a phase already at it everywhere (cut by the grid into unequal
             # pieces, not quite symmetric) is slowed by the stretch still missing, at
@@ -814,7 +813,8 @@ def _adapted(work: Path, lim, grid, b: np.ndarray, step: np.ndarray, blocks: np.
             # not yet the ramp loaded its far end: a deceleration the grid put into one
             # interval grew by an interval a round, 300, 225, 112 mm/s^2 towards its
             # end, its mean time early, and lasted 46 % longer than the ramp of 1/f.)
-            a_set = a_now * shrink[k] if np.all(at_it) else np.minimum(a_now, a_new[k])
+            a_set = (a_now * shrink[k] if np.all(a_now <= a_new[k] * (1.0 + 1e-9))
+                     else np.minimum(a_now, a_new[k]))
             step[sl] = 2.0 * a_set * ds[sl]
         b = _passes(b_env, step)
     return b
