@@ -60,15 +60,22 @@ MIN_INTERVAL_TIME_REL = 1e-9
 IPOPT_TOL = 1e-9
 
 #: IPOPT's attempts, tried in turn until one succeeds: ``(barrier strategy, iteration
-#: cap, expand)``; ``expand`` solves on the scalar (SX) expansion of the MX graph, which
-#: costs ten times the build time but follows a different, sometimes better, path.
-#: Measured on the corpus and the examples (SOFT default machine, 13 programs): monotone
-#: first took 193 s in all against 277 s for adaptive first (adaptive wandered for 200
-#: iterations on a 250 mm/min raster that monotone solves in 79, and needed 371 on long
-#: arcs at the feed against 171); on sin_cead_arc.mpf monotone on the MX graph failed
-#: where the SX graph took 171 iterations. A solve that fails every attempt is reported
-#: as a solver failure (with the valid lower bound), never as a result.
-MU_STRATEGIES = (("monotone", 300, False), ("monotone", 500, True), ("adaptive", 200, False))
+#: cap, expand, scaled)``; ``expand`` solves on the scalar (SX) expansion of the MX graph,
+#: which costs ten times the build time but follows a different, sometimes better, path;
+#: ``scaled`` measures every variable in its own unit and takes the jerk rows times the
+#: interval's duration (:mod:`optimal.jerk.backends.ipopt`). Measured on the corpus and the
+#: examples (SOFT default machine, 13 programs): monotone first took 193 s in all against
+#: 277 s for adaptive first (adaptive wandered for 200 iterations on a 250 mm/min raster
+#: that monotone solves in 79, and needed 371 on long arcs at the feed against 171); on
+#: sin_cead_arc.mpf monotone on the MX graph failed where the SX graph took 171 iterations.
+#: The scaled form solves what no attempt of the plain one did (slow feeds: a 10 mm line
+#: at F100 on the default machine, sin_cead_loop.mpf on the LinuxCNC machine, slow lines
+#: beside rapid moves) but is not faster where the plain one converges
+#: (lcnc_arc_arc_sawtooth, default machine: 106 s against 52 s with it first), so it
+#: comes second. A solve that fails every attempt is reported as a solver failure (with
+#: the valid lower bound), never as a result.
+MU_STRATEGIES = (("monotone", 300, False, False), ("monotone", 300, False, True),
+                 ("monotone", 500, True, True), ("adaptive", 200, False, True))
 
 #: Fraction of the acc optimum's speed used as the warm start (a slower start is closer
 #: to jerk feasibility, so IPOPT's restoration phase is rarely needed).

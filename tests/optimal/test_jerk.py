@@ -113,6 +113,52 @@ def test_exact_stop_polyline_is_a_sum_of_ruckig_moves():
     assert len(sol.blocks) == 3 and all(b.cause.startswith("jerk") for b in sol.blocks)
 
 
+@pytest.mark.parametrize("feed_mm_min", [50.0, 100.0, 1000.0])
+def test_slow_feed_line_on_the_default_machine_brackets_ruckig(feed_mm_min):
+    """A 10 mm line along X at F50..F1000 on the default machine (A = 2000 mm/s^2,
+    J = 40000 mm/s^3): a cruise of seconds between jerk ramps of milliseconds. With one
+    time unit for the whole NLP and the jerk rows divided by the interval's duration,
+    IPOPT ran out of iterations at F100 (``solver_error``); the exact optimum is ruckig's
+    move."""
+    from reference.machine import load_machine
+    lim = load_machine().limits
+    ax = lim.axes[0]
+    F = feed_mm_min / 60.0
+    p = line_path([[0, 0, 0], [10, 0, 0]], feed=F)
+    sol = optimal.solve(p, lim, bounds="jerk", tol=TOL)
+    exact = ruckig_line_time(10.0, F, ax.a_max, ax.j_max, ax.j_max * lim.t_ipo_s)
+    assert sol.status == optimal.SolveStatus.OPTIMAL, sol.message
+    assert sol.lower_bound_s <= exact * (1 + BRACKET_SLACK)
+    assert exact * (1 - BRACKET_SLACK) <= sol.upper_bound_s <= exact * (1 + TOL)
+
+
+#: A SOFT program of slow feeds and rapid moves (a plunge at F50, rapids at 500 mm/s):
+#: intervals from milliseconds to seconds in one NLP (the fault of the test above).
+SLOW_AND_RAPID = """\
+G90 G17 SOFT G64 F50
+G1 X20 Y0
+G0 X300 Y50
+G1 X300 Y70
+G0 X0 Y0 Z10
+G1 X0 Y20
+M30
+"""
+
+
+@pytest.mark.parametrize("machine", [None, "linuxcnc_xyz"])
+def test_slow_feeds_beside_rapid_moves_get_a_bracket(machine):
+    from reference.machine import load_machine
+    from reference.nc import parse_text
+    from reference.prepare import build_path
+    m = load_machine(machine)
+    p = build_path(parse_text(SLOW_AND_RAPID), m)
+    sol = optimal.solve(p, m.limits, bounds="jerk", tol=TOL)
+    assert sol.status == optimal.SolveStatus.OPTIMAL, sol.message
+    assert sol.lower_bound_s <= sol.upper_bound_s <= sol.lower_bound_s * (1 + TOL)
+    # the slow blocks' cruise alone: 20 mm and 20 mm at F50 (0.833 mm/s), 20 mm at F50
+    assert sol.lower_bound_s >= 60.0 / (50.0 / 60.0) * (1 - BRACKET_SLACK)
+
+
 def test_jerk_never_faster_than_acc_and_lower_bound_at_least_acc():
     lim = jerk_machine(200.0, 1000.0, 10000.0)
     p = line_path([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0]])

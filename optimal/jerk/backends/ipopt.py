@@ -6,7 +6,17 @@ thousand nodes; IPOPT exploits the banded sparsity of the KKT system. Exact Hess
 come from CasADi's automatic differentiation.
 
 Variables ``x = [c (N + 1), a (N + 1), dt (N), e (extra)]``, dimensionless (``e``: the
-accelerations on arriving at interior breaks). Minimise ``sum dt``.
+accelerations on arriving at interior breaks). Minimise ``sum dt``. Two forms of the same
+problem, tried in turn (:data:`optimal.jerk.tolerances.MU_STRATEGIES`): first one unit for
+all variables (:func:`~optimal.jerk.transcription.problem_units`) and the jerk rows with
+``(e - a) / dt``; where that fails, every variable in its own unit
+(:func:`variable_scales`) and the jerk rows times ``dt``,
+``|dq (e - a) + (3 ddq c a + dddq c^3) dt| <= J dt`` (for ``dt > 0`` the same rows, without
+the pole at ``dt = 0``). The second solves programs of several time scales that the
+first does not: a 10 mm line at F100 on the default machine (a cruise of 6 s between jerk
+ramps of milliseconds, tests/optimal/test_jerk.py) ran out of IPOPT's iterations in every
+attempt of the first form, and so did sin_cead_loop.mpf on the LinuxCNC machine; two lines
+of 100 m at F10 needed the units as well as the rows times ``dt``.
 """
 
 from __future__ import annotations
@@ -20,6 +30,10 @@ from ..tolerances import IPOPT_TOL, MIN_INTERVAL_TIME_REL, MU_STRATEGIES
 from ..transcription import JerkProblem
 
 NAME = "ipopt"
+
+#: Smallest variable unit, relative to the largest of its kind: a zero speed cap (a stop)
+#: or a zero warm start gets this unit, not zero.
+SCALE_FLOOR_REL = 1e-6
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -76,7 +90,50 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     """
     import casadi as ca
 
-    tb = time.perf_counter()
+    forms: dict[bool, tuple] = {}       # the NLP of each form, built when first tried
+    build = solve = 0.0
+    iters = 0
+    N = problem.n_intervals
+    # the attempts in turn (MU_STRATEGIES: barrier strategy, iteration cap, graph, form)
+    for strategy, max_iter, expand, scaled in MU_STRATEGIES:
+        tk = time.perf_counter()
+        if scaled not in forms:
+            forms[scaled] = _nlp(ca, problem, c0, a0, dt0, scaled)
+        nlp, lbx, ubx, x0, lbg, ubg, scale = forms[scaled]
+        opts = {"ipopt.print_level": print_level, "print_time": False,
+                "ipopt.tol": IPOPT_TOL, "ipopt.constr_viol_tol": IPOPT_TOL,
+                "ipopt.max_iter": max_iter, "ipopt.mu_strategy": strategy, "ipopt.sb": "yes",
+                "expand": expand}
+        solver = ca.nlpsol("jerk", "ipopt", nlp, opts)
+        ts = time.perf_counter()
+        build += ts - tk
+        sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        solve += time.perf_counter() - ts
+        stats = solver.stats()
+        xs = np.asarray(sol["x"]).ravel() * scale
+        iters += int(stats.get("iter_count", 0))
+        status = str(stats.get("return_status", "unknown"))
+        ok = ((bool(stats.get("success", False)) or status == "Solved_To_Acceptable_Level")
+              and bool(np.all(np.isfinite(xs))))
+        if ok:
+            break
+    a_all = np.concatenate((xs[N + 1:2 * (N + 1)], xs[3 * N + 2:]))
+    return NlpResult(success=ok, c=xs[:N + 1], a=xs[N + 1:2 * (N + 1)],
+                     a_end=a_all[problem.end_index], dt=xs[2 * (N + 1):3 * N + 2],
+                     iterations=iters, message=f"{status} ({strategy} barrier update"
+                     f"{', SX graph' if expand else ''}{', scaled' if scaled else ''})",
+                     build_time_s=build, solve_time_s=solve)
+
+
+def _nlp(ca, problem: JerkProblem, c0, a0, dt0, scaled: bool):
+    """The NLP of ``problem`` as CasADi's dict, its variable bounds and start (in the
+    variables' units) and its row bounds, and the units (ones unless ``scaled``).
+
+    ``scaled``: every variable in its own unit (:func:`variable_scales`) and the jerk rows
+    times ``dt``, ``|dq (e - a) + (3 ddq c a + dddq c^3) dt| <= J dt`` (for ``dt > 0`` the
+    same rows, without the pole at ``dt = 0``); else one unit for all and the rows with
+    the jerk ``(e - a) / dt``.
+    """
     N = problem.n_intervals
     ne = problem.n_extra
     nx = 2 * (N + 1) + N + ne
@@ -87,10 +144,12 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     # sin_cead_arc.mpf), but IPOPT's path is sensitive to them on hard problems, so a
     # failed attempt is repeated on the expanded (SX) graph (MU_STRATEGIES)
     x = ca.MX.sym("x", nx)
-    c = x[0:N + 1]
-    a = x[N + 1:2 * (N + 1)]
-    dt = x[2 * (N + 1):3 * N + 2]
-    a_all = ca.vertcat(a, x[3 * N + 2:])
+    scale = variable_scales(problem, c0, a0, dt0) if scaled else np.ones(nx)
+    xs_ = ca.DM(scale) * x
+    c = xs_[0:N + 1]
+    a = xs_[N + 1:2 * (N + 1)]
+    dt = xs_[2 * (N + 1):3 * N + 2]
+    a_all = ca.vertcat(a, xs_[3 * N + 2:])
     e = a_all[problem.end_index.tolist()]
     ds = ca.DM(problem.ds)
     g, lo, hi = [], [], []
@@ -131,11 +190,21 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
         # the acceleration at the row's place: interval start, or its end value
         at_end = jr.node != jr.interval
         a_here = a_all[np.where(at_end, problem.end_index[jr.interval], jr.interval).tolist()]
-        jerk = (e[iv] - a[iv]) / dt[iv]
-        g.append(ca.DM(jr.dq) * jerk
-                 + 3 * ca.DM(jr.ddq) * cn * a_here + ca.DM(jr.dddq) * cn * cn * cn)
-        lo.append(-jr.limit)
-        hi.append(jr.limit)
+        if scaled:
+            h = dt[iv]
+            jerk_dt = (ca.DM(jr.dq) * (e[iv] - a[iv])
+                       + (3 * ca.DM(jr.ddq) * cn * a_here
+                          + ca.DM(jr.dddq) * cn * cn * cn) * h)
+            lim_dt = ca.DM(jr.limit) * h
+            g += [jerk_dt - lim_dt, jerk_dt + lim_dt]
+            lo += [np.full(jr.n, -np.inf), np.zeros(jr.n)]
+            hi += [np.zeros(jr.n), np.full(jr.n, np.inf)]
+        else:
+            jerk = (e[iv] - a[iv]) / dt[iv]
+            g.append(ca.DM(jr.dq) * jerk
+                     + 3 * ca.DM(jr.ddq) * cn * a_here + ca.DM(jr.dddq) * cn * cn * cn)
+            lo.append(-jr.limit)
+            hi.append(jr.limit)
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
     a_lo = problem.a_lo if problem.a_lo is not None else np.full(N + 1 + ne, -np.inf)
     a_hi = problem.a_hi if problem.a_hi is not None else np.full(N + 1 + ne, np.inf)
@@ -145,33 +214,36 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     a_start = np.clip(np.concatenate((a0, a0[problem.grid.break_node[1:-1]])), a_lo, a_hi)
     x0 = np.concatenate((np.clip(c0, 0.0, problem.c_max), a_start[:N + 1],
                          np.maximum(dt0, MIN_INTERVAL_TIME_REL), a_start[N + 1:]))
-    build = time.perf_counter() - tb
-    solve = 0.0
-    iters = 0
-    # the attempts in turn (MU_STRATEGIES: barrier strategy, iteration cap, graph)
-    for k, (strategy, max_iter, expand) in enumerate(MU_STRATEGIES):
-        tk = time.perf_counter()
-        opts = {"ipopt.print_level": print_level, "print_time": False,
-                "ipopt.tol": IPOPT_TOL, "ipopt.constr_viol_tol": IPOPT_TOL,
-                "ipopt.max_iter": max_iter, "ipopt.mu_strategy": strategy, "ipopt.sb": "yes",
-                "expand": expand}
-        solver = ca.nlpsol("jerk", "ipopt", nlp, opts)
-        ts = time.perf_counter()
-        build += ts - tk
-        sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lo),
-                     ubg=np.concatenate(hi))
-        solve += time.perf_counter() - ts
-        stats = solver.stats()
-        xs = np.asarray(sol["x"]).ravel()
-        iters += int(stats.get("iter_count", 0))
-        status = str(stats.get("return_status", "unknown"))
-        ok = ((bool(stats.get("success", False)) or status == "Solved_To_Acceptable_Level")
-              and bool(np.all(np.isfinite(xs))))
-        if ok:
-            break
-    a_all = np.concatenate((xs[N + 1:2 * (N + 1)], xs[3 * N + 2:]))
-    return NlpResult(success=ok, c=xs[:N + 1], a=xs[N + 1:2 * (N + 1)],
-                     a_end=a_all[problem.end_index], dt=xs[2 * (N + 1):3 * N + 2],
-                     iterations=iters, message=f"{status} ({strategy} barrier update"
-                     f"{', SX graph' if expand else ''})",
-                     build_time_s=build, solve_time_s=solve)
+    return (nlp, lbx / scale, ubx / scale, x0 / scale, np.concatenate(lo),
+            np.concatenate(hi), scale)
+
+
+def variable_scales(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray,
+                    dt0: np.ndarray) -> np.ndarray:
+    """Unit of every NLP variable, in the problem's units.
+
+    One time and one length unit (:func:`~optimal.jerk.transcription.problem_units`) do
+    not make a program of several scales near 1: a line at F10 mm/min beside a rapid
+    move has intervals of 1e-4 and 1e2 of the unit, and IPOPT ran out of iterations on
+    it. Each variable is therefore measured in its own unit: an interval's duration in
+    that of its warm start, a node's speed in its cap (the warm start's speed where the
+    cap is infinite), and an acceleration in what that speed gains over the shorter
+    neighbouring interval (the scale a ramp there has). A unit only rescales a variable:
+    the problem and its solution are the same.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2 (N + 1) + N + n_extra,)
+        In the order of ``x``.
+    """
+    ne = problem.n_extra
+    d = np.maximum(np.asarray(dt0, np.float64), MIN_INTERVAL_TIME_REL)
+    cap = np.asarray(problem.c_max, np.float64)
+    c = np.where(np.isfinite(cap) & (cap > 0), cap, np.abs(c0))
+    top = float(np.max(c[np.isfinite(c)], initial=0.0))
+    c = np.maximum(np.where(np.isfinite(c), c, top), SCALE_FLOOR_REL * max(top, 1.0))
+    shorter = np.minimum(np.concatenate(([d[0]], d)), np.concatenate((d, [d[-1]])))
+    acc = np.maximum(c / shorter, np.abs(a0))
+    acc = np.maximum(acc, SCALE_FLOOR_REL * float(np.max(acc)))
+    extra = acc[problem.grid.break_node[1:-1]] if ne else np.zeros(0)
+    return np.concatenate((c, acc, d, extra))
