@@ -145,11 +145,11 @@ def _nlp(ca, problem: JerkProblem, c0, a0, dt0, scaled: bool):
     # failed attempt is repeated on the expanded (SX) graph (MU_STRATEGIES)
     x = ca.MX.sym("x", nx)
     scale = variable_scales(problem, c0, a0, dt0) if scaled else np.ones(nx)
-    xs_ = ca.DM(scale) * x
-    c = xs_[0:N + 1]
-    a = xs_[N + 1:2 * (N + 1)]
-    dt = xs_[2 * (N + 1):3 * N + 2]
-    a_all = ca.vertcat(a, xs_[3 * N + 2:])
+    xu = ca.DM(scale) * x                   # the variables in the problem's units
+    c = xu[0:N + 1]
+    a = xu[N + 1:2 * (N + 1)]
+    dt = xu[2 * (N + 1):3 * N + 2]
+    a_all = ca.vertcat(a, xu[3 * N + 2:])
     e = a_all[problem.end_index.tolist()]
     ds = ca.DM(problem.ds)
     g, lo, hi = [], [], []
@@ -190,19 +190,17 @@ def _nlp(ca, problem: JerkProblem, c0, a0, dt0, scaled: bool):
         # the acceleration at the row's place: interval start, or its end value
         at_end = jr.node != jr.interval
         a_here = a_all[np.where(at_end, problem.end_index[jr.interval], jr.interval).tolist()]
+        # the row's terms 3 q'' v s'' and q''' v^3 (at the row's place)
+        mixed, cubic = 3 * ca.DM(jr.ddq) * cn * a_here, ca.DM(jr.dddq) * cn * cn * cn
         if scaled:
             h = dt[iv]
-            jerk_dt = (ca.DM(jr.dq) * (e[iv] - a[iv])
-                       + (3 * ca.DM(jr.ddq) * cn * a_here
-                          + ca.DM(jr.dddq) * cn * cn * cn) * h)
+            jerk_dt = ca.DM(jr.dq) * (e[iv] - a[iv]) + (mixed + cubic) * h
             lim_dt = ca.DM(jr.limit) * h
             g += [jerk_dt - lim_dt, jerk_dt + lim_dt]
             lo += [np.full(jr.n, -np.inf), np.zeros(jr.n)]
             hi += [np.zeros(jr.n), np.full(jr.n, np.inf)]
         else:
-            jerk = (e[iv] - a[iv]) / dt[iv]
-            g.append(ca.DM(jr.dq) * jerk
-                     + 3 * ca.DM(jr.ddq) * cn * a_here + ca.DM(jr.dddq) * cn * cn * cn)
+            g.append(ca.DM(jr.dq) * ((e[iv] - a[iv]) / dt[iv]) + mixed + cubic)
             lo.append(-jr.limit)
             hi.append(jr.limit)
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
@@ -236,14 +234,12 @@ def variable_scales(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray,
     numpy.ndarray, shape (2 (N + 1) + N + n_extra,)
         In the order of ``x``.
     """
-    ne = problem.n_extra
     d = np.maximum(np.asarray(dt0, np.float64), MIN_INTERVAL_TIME_REL)
     cap = np.asarray(problem.c_max, np.float64)
     c = np.where(np.isfinite(cap) & (cap > 0), cap, np.abs(c0))
-    top = float(np.max(c[np.isfinite(c)], initial=0.0))
-    c = np.maximum(np.where(np.isfinite(c), c, top), SCALE_FLOOR_REL * max(top, 1.0))
+    c = np.maximum(c, SCALE_FLOOR_REL * max(float(np.max(c)), 1.0))
     shorter = np.minimum(np.concatenate(([d[0]], d)), np.concatenate((d, [d[-1]])))
     acc = np.maximum(c / shorter, np.abs(a0))
     acc = np.maximum(acc, SCALE_FLOOR_REL * float(np.max(acc)))
-    extra = acc[problem.grid.break_node[1:-1]] if ne else np.zeros(0)
-    return np.concatenate((c, acc, d, extra))
+    # the arriving accelerations at interior breaks: the break node's unit
+    return np.concatenate((c, acc, d, acc[problem.grid.break_node[1:-1]]))
