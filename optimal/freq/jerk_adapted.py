@@ -20,7 +20,13 @@ does, and lets the jerk NLP (:mod:`optimal.jerk.backends`) find the rest again:
   of 3-6 ms phases between them;
 * a smaller change (a wiggle: the motion following a cap that varies a little along an
   arc) is crossed at constant speed (``s'' = 0`` at its nodes), which costs at most
-  that share of the time across it. The share doubles every round: a bounded phase that
+  that share of the time across it; a wiggle between two phases of the other sign that
+  follow within its ``1/f`` (a dip at each kink of a polyline along which the speed
+  rises) is crossed with that sign instead (``s'' >= ADAPT_TREND_REL`` times the NLP's
+  acceleration unit, or ``<=`` its negative), so that the phases beside it make one
+  (examples/demo.mpf's 0.5 mm CAM run: held at 45.7 mm/s by constant-speed wiggles, now
+  one rise of 273 ms from 1.6 to 61.6 mm/s; ``jerk+freq`` upper bound 4.8644 ->
+  4.8511 s). The share doubles every round: a bounded phase that
   stays short loses speed change rather than length (its ``dv`` shrinks round by round
   while it still lasts about 50 ms against 67 ms on ``lcnc_test_12mmflat``), so later
   rounds flatten what earlier ones could only shrink;
@@ -72,8 +78,8 @@ from ..jerk.transcription import JerkProblem, Rows, StepRows, build_jerk_problem
 from ..jerk.upper import exact_profile, warm_start
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
 
-__all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "JERK_ADAPT_DONE_REL",
-           "JERK_ADAPT_ROUNDS", "jerk_adapted"]
+__all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "ADAPT_TREND_REL",
+           "JERK_ADAPT_DONE_REL", "JERK_ADAPT_ROUNDS", "jerk_adapted"]
 
 #: NLP rounds of :func:`jerk_adapted` at most (each costs one jerk NLP on the base
 #: solve's final grid; the loop stops as soon as no phase is short). The corpus programs
@@ -103,6 +109,27 @@ def _short_phases(path: Path, lim, prof: Profile):
     need = min_phase_duration(f)
     short = np.flatnonzero(ph.effective_duration < need * (1.0 - ADAPT_MARGIN))
     return ph, short, need
+
+
+#: The least path acceleration at a wiggle crossed with its neighbours' sign, as a share
+#: of the NLP's acceleration unit (the largest axis limit): a thousand times the
+#: checker's phase threshold (FREQ_ACCEL_TOL_REL of the largest ``|s''|``), so that the
+#: rise stays one phase at IPOPT's tolerance, and too little to cost time (2 mm/s^2 on
+#: the default machine: 0.01 mm/s over a 5 ms dip).
+ADAPT_TREND_REL = 1e-3
+
+
+def _trend(ph, p: int, gap_s: float) -> int:
+    """Sign of the phases on both sides of phase ``p`` where both have the other sign and
+    each follows within ``gap_s`` of it (s); 0 otherwise (a peak, a valley, a wiggle at
+    either end of the motion or beside a cruise)."""
+    if p == 0 or p + 1 >= ph.sign.size:
+        return 0
+    if ph.sign[p - 1] != ph.sign[p + 1] or ph.sign[p - 1] == ph.sign[p]:
+        return 0
+    if ph.start_t[p] - ph.end_t[p - 1] > gap_s or ph.start_t[p + 1] - ph.end_t[p] > gap_s:
+        return 0
+    return int(ph.sign[p - 1])
 
 
 def _without_jerk(problem: JerkProblem) -> JerkProblem:
@@ -209,9 +236,17 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
                 (inner > i0) & (inner < i1))))
             v_hi = max(prof.v[ph.first[p]], prof.v[ph.last[p] + 1])
             if ph.dv[p] <= ADAPT_WIGGLE_REL * 2.0 ** r * v_hi:
-                # a wiggle: crossed at constant speed (no acceleration at its nodes)
-                a_lo[nodes] = np.maximum(a_lo[nodes], 0.0)
-                a_hi[nodes] = np.minimum(a_hi[nodes], 0.0)
+                trend = _trend(ph, p, need[p])
+                if trend > 0:
+                    # a dip inside a rise: crossed rising, so that the rises beside it
+                    # make one phase
+                    a_lo[nodes] = np.maximum(a_lo[nodes], ADAPT_TREND_REL * a_unit)
+                elif trend < 0:
+                    a_hi[nodes] = np.minimum(a_hi[nodes], -ADAPT_TREND_REL * a_unit)
+                else:
+                    # a wiggle: crossed at constant speed (no acceleration at its nodes)
+                    a_lo[nodes] = np.maximum(a_lo[nodes], 0.0)
+                    a_hi[nodes] = np.minimum(a_hi[nodes], 0.0)
                 continue
             aim = need[p] * (1.0 + ADAPT_MARGIN)
             # the mean acceleration that makes the phase last its 1/f, less what an
@@ -226,6 +261,10 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
                 now = -a_lo[nodes]
                 shrink = float(np.clip(ph.effective_duration[p] / aim, 0.5, 1.0))
                 a_lo[nodes] = -np.where(now <= a_new * (1.0 + 1e-9), now * shrink, a_new)
+        # a node between two trends (a dip in a rise beside a bump in a fall) or a trend
+        # against a later round's bound: the upper bound stands, so the NLP's bounds
+        # stay consistent (IPOPT rejects lb > ub)
+        a_lo = np.minimum(a_lo, a_hi)
         prob_r = replace(problem, a_lo=a_lo / a_unit, a_hi=a_hi / a_unit)
         c0, a0, dt0 = warm_start(path, lim, grid, prob_r, prof)
         nlp = nlp_solve(prob_r, c0, a0, dt0)
