@@ -142,7 +142,7 @@ __all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_RE
            "HUMP_SLACK_LEVELS", "HUMP_SPEED_LEVELS", "HUMP_SPEED_RATIO",
            "HUMP_SPREAD_ROUNDS", "HUMP_TURN_MARGIN", "HUMP_TURN_SPLIT", "HUMP_TURN_WIDTH",
            "Envelope",
-           "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound"]
+           "HumpPlan", "hump_lower_bound", "hump_plan", "humps_bound", "humps_piece_bounds"]
 
 #: Cells are cut so that each takes at most this fraction of its period at the fastest
 #: speed the envelope allows in it. Each turn leaves out its cell's time (step 4 of the
@@ -524,7 +524,17 @@ def _lost(d: np.ndarray, u: np.ndarray, w: float, g: np.ndarray) -> np.ndarray:
 def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
                 beat: float = 0.0, segment_floor: np.ndarray | None = None,
                 enough: float = math.inf) -> float:
-    """Lower bound on the motion time under ``acc+freq`` (holds excluded), s.
+    """Lower bound on the motion time under ``acc+freq`` (holds excluded), s: the sum of
+    :func:`humps_piece_bounds` (same parameters)."""
+    return float(np.sum(humps_piece_bounds(path, lim, grid, t_upper, beat, segment_floor,
+                                           enough)))
+
+
+def humps_piece_bounds(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
+                       beat: float = 0.0, segment_floor: np.ndarray | None = None,
+                       enough: float = math.inf) -> np.ndarray:
+    """Lower bound on the time of each rest-to-rest piece under ``acc+freq`` (holds
+    excluded), s.
 
     Per rest-to-rest piece (:func:`optimal.freq.lower.rest_pieces`) the larger of the
     ``acc`` relaxation's time on the piece and the turn programme on the piece's cells,
@@ -565,17 +575,18 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
 
     Returns
     -------
-    float
-        s; 0 where the path has no segment or the rule does not apply.
+    numpy.ndarray, shape (P,)
+        One per piece of :func:`optimal.freq.lower.rest_pieces`, s; 0 where the rule
+        does not apply.
     """
+    pieces = rest_pieces(path)
     if path.n_segments == 0 or not math.isfinite(t_upper):
-        return 0.0
+        return np.zeros(pieces.shape[0])
     bounds = speed_envelope_bounds(path, lim, grid)
     t = _tents(path, lim, grid, bounds)
     drift = FREQ_ACCEL_TOL_REL * t.accel * t_upper
     if not np.any(t.period > 0) or not math.isfinite(drift):
-        return 0.0
-    pieces = rest_pieces(path)
+        return np.zeros(pieces.shape[0])
     ends = grid.break_node[pieces]                     # (P, 2) first and end interval
     seg_t = np.bincount(grid.segment, weights=bounds[3], minlength=path.n_segments)
     if segment_floor is not None and segment_floor.shape == seg_t.shape:
@@ -596,19 +607,19 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
         # and only while the whole can come near the best bound known
         todo = dp >= (1.0 - HUMP_REFINE_MARGIN) * acc
         if T < (1.0 - HUMP_REFINE_MARGIN) * beat or not np.any(todo):
-            return T
+            return np.maximum(acc, dp)
     if not (T < enough and T >= (1.0 - HUMP_TURN_MARGIN) * enough) or not turns.any():
-        return T
+        return np.maximum(acc, dp)
     cut = np.where(turns, HUMP_TURN_SPLIT, 1)
     if int(cut.sum()) > HUMP_MAX_CELLS:
-        return T
+        return np.maximum(acc, dp)
     # only the pieces with a cell cut run again (the others' cells are the same)
     lo, hi = _piece_cells(env, ends)
     n_cut = np.concatenate(([0], np.cumsum(turns)))
     again = np.flatnonzero(todo & (n_cut[hi] > n_cut[lo]))
     env = _split(t, env.interval, env.s[:-1], env.s[1:], cut)
     _run_pieces(env, ends, again, HUMP_CELL_TIME_REL, drift, dp)
-    return float(np.sum(np.maximum(acc, dp)))
+    return np.maximum(acc, dp)
 
 
 def _piece_cells(env: Envelope, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -67,8 +67,8 @@ from reference.core.limits import AxisArrays
 from reference.core.phases import FREQ_ACCEL_TOL_REL, min_phase_duration, moving_axes_by_segment
 from reference.core.tolerances import POS_TOL_MM, RATIO_TOL, VEL_TOL_MM_S
 
-__all__ = ["freq_lower_bound", "path_rate_bounds", "piece_lower_bounds", "rest_pieces",
-           "segment_periods", "segment_speed_caps"]
+__all__ = ["freq_lower_bound", "path_accel_bound", "path_rate_bounds", "piece_lower_bounds",
+           "rest_pieces", "segment_periods", "segment_speed_caps"]
 
 
 def rest_pieces(path: Path, extra_breaks: np.ndarray | None = None) -> np.ndarray:
@@ -128,6 +128,15 @@ def segment_speed_caps(path: Path, lim: AxisArrays) -> np.ndarray:
     return np.minimum(path_rate_bounds(path, lim.v_max), path.feed) * (1.0 + RATIO_TOL)
 
 
+def path_accel_bound(path: Path, lim: AxisArrays) -> float:
+    """``abar``: a bound on ``|s''|`` of every accepted profile, mm/s^2 (module
+    docstring, last paragraph)."""
+    n = path.n_axes
+    kappa = float(np.max(plane_amplitudes(path).curvature, initial=0.0))
+    a_bar = math.sqrt(n) * (float(np.max(lim.a_max)) + kappa * n * float(np.max(lim.v_max)) ** 2)
+    return a_bar * (1.0 + RATIO_TOL)
+
+
 def piece_lower_bounds(path: Path, lim: AxisArrays) -> np.ndarray:
     """Lower bound on the time of each rest-to-rest piece from the frequency rule, s.
 
@@ -150,10 +159,7 @@ def piece_lower_bounds(path: Path, lim: AxisArrays) -> np.ndarray:
     per = segment_periods(path, lim)
     vcap = segment_speed_caps(path, lim)
     pieces = rest_pieces(path)
-    n = path.n_axes
-    kappa = float(np.max(plane_amplitudes(path).curvature, initial=0.0))
-    a_bar = math.sqrt(n) * (float(np.max(lim.a_max)) + kappa * n * float(np.max(lim.v_max)) ** 2)
-    a_bar *= 1.0 + RATIO_TOL
+    a_bar = path_accel_bound(path, lim)
     eta, e = FREQ_ACCEL_TOL_REL, VEL_TOL_MM_S
     p = POS_TOL_MM * max(1.0, float(path.total_length))
     out = np.zeros(pieces.shape[0])

@@ -13,7 +13,10 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    :func:`reference.core.holds.without_holds`), and so does the jerk-adapted NLP;
 2. lower bound: ``max`` of the base oracle's certified bound (``base`` is a relaxation
    of ``base+freq``: fewer constraints) and :func:`optimal.freq.lower.freq_lower_bound`
-   (proof there), plus the holds;
+   (proof there), plus the holds; where the candidates of step 3 leave the bracket open,
+   for ``jerk+freq`` the jerk relaxation again with rows of the rule on three segments
+   at a time (:mod:`optimal.freq.windows`), and then the turn programme over the whole
+   path (:mod:`optimal.freq.humps`);
 3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
    (the base optimum slowed down, the filtered acc optimum, for ``acc+freq`` the acc
    optimum with its rises and falls capped per hump (:mod:`optimal.freq.capped`), the
@@ -51,11 +54,13 @@ from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from ..grid import grid_on
 from ..jerk.oracle import jerk_grid
+from ..jerk.relaxation import RunFloors
 from .capped import capped_optimum
-from .humps import humps_bound
+from .humps import humps_piece_bounds
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
+from .windows import window_lower_bound
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     piece_times, pieced, scaled, verified)
 
@@ -255,6 +260,20 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     if c is not None:
         cands.append(c)
     t_check = time.perf_counter() - tc
+    if (base == "jerk" and cands and base_sol.segment_lower_bounds_s is not None
+            and min(c.duration for c in cands) + hold_t - lb > tol * lb):
+        # the jerk relaxation again, with rows of the frequency rule on the segments
+        # whose rise and fall it lengthens (optimal.freq.windows: a slow segment between
+        # low corner caps), for the motions no slower than the fastest candidate
+        if progress:
+            progress("frequency lower bound: the jerk relaxation with the rule's rows", 0.88)
+        tb = time.perf_counter()
+        lb_win = window_lower_bound(work, sub_lim, limits.t_ipo_s, acc.grid, base_sol.grid,
+                                    base_sol.segment_lower_bounds_s,
+                                    min(c.duration for c in cands), holds.break_index)
+        t_bound += time.perf_counter() - tb
+        if lb_win + hold_t > lb:
+            lb, lb_freq = lb_win + hold_t, max(lb_freq, lb_win)
     if cands and (min(c.duration for c in cands) + hold_t - lb) > tol * lb:
         # the frequency rule over the whole path (optimal.freq.humps), from the acc
         # relaxation's speed envelope; a verified upper bound limits the motions it must
@@ -279,8 +298,9 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         # near it, it cuts its cells finer where its motion turns (the turn run)
         enough = (t_best + hold_t) / (1.0 + tol) - hold_t
         env_grid = grid_on(work, acc.grid)
-        raw = humps_bound(work, sub_lim, env_grid, t_up, lb - hold_t,
-                          base_sol.segment_lower_bounds_s, enough=enough)
+        per_piece = humps_piece_bounds(work, sub_lim, env_grid, t_up, lb - hold_t,
+                                       base_sol.segment_lower_bounds_s, enough=enough)
+        raw, t_valid = float(np.sum(per_piece)), t_up
         lb_humps = min(raw, t_up)
         if raw >= t_up and t_up < t_best:
             # the stand-in motion capped the bound (every motion no slower than it is
@@ -289,10 +309,27 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             # bound for any t (examples/slot.ngc's zig-zag after a rapid move, cut out:
             # the programme reached the acc+freq ramps' 1.374 s; for the motions up to the
             # verified 1.467 s it shows 1.414 s, the zig-zag's own ramps)
-            raw = humps_bound(work, sub_lim, env_grid, t_best,
-                              max(lb - hold_t, lb_humps), base_sol.segment_lower_bounds_s,
-                              enough=enough)
+            per_piece = humps_piece_bounds(work, sub_lim, env_grid, t_best,
+                                           max(lb - hold_t, lb_humps),
+                                           base_sol.segment_lower_bounds_s, enough=enough)
+            raw, t_valid = float(np.sum(per_piece)), t_best
             lb_humps = max(lb_humps, min(raw, t_best))
+        if (base == "jerk" and raw < t_valid and base_sol.segment_lower_bounds_s is not None
+                and t_best + hold_t - max(lb, lb_humps + hold_t)
+                > tol * max(lb, lb_humps + hold_t)):
+            # the programme's bound of each piece as a row of the jerk relaxation, with
+            # the window rows: the relaxation then keeps its segment floors and coupling
+            # where the programme bounds only the piece's total (examples/slot.ngc: the
+            # zig-zag's rises and falls of 1/f beside the jerk floors of the lines after
+            # it, in one piece)
+            if progress:
+                progress("frequency lower bound: the jerk relaxation with the programme's "
+                         "rows", 0.95)
+            pieces = rest_pieces(work)
+            lb_humps = max(lb_humps, window_lower_bound(
+                work, sub_lim, limits.t_ipo_s, acc.grid, base_sol.grid,
+                base_sol.segment_lower_bounds_s, t_valid, holds.break_index,
+                extra=RunFloors(pieces[:, 0], pieces[:, 1], per_piece)))
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

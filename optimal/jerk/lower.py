@@ -99,6 +99,7 @@ Units: mm, s.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
@@ -320,7 +321,8 @@ def rise(p: np.ndarray, vb: np.ndarray, a0: np.ndarray, A: np.ndarray, J: np.nda
 
 def peak_times(L: np.ndarray, vb0: np.ndarray, vb1: np.ndarray, as0: np.ndarray,
                as1: np.ndarray, V: np.ndarray, A: np.ndarray, J: np.ndarray,
-               eps: float | np.ndarray = 0.0) -> np.ndarray:
+               eps: float | np.ndarray = 0.0, t_cap: np.ndarray | None = None
+               ) -> np.ndarray:
     """Lower bound of the time on a segment from its peak speed (step 4 of the module
     docstring), vectorised over segments.
 
@@ -339,6 +341,12 @@ def peak_times(L: np.ndarray, vb0: np.ndarray, vb1: np.ndarray, as0: np.ndarray,
         As :func:`envelope_times`.
     eps : float or numpy.ndarray, shape (k,)
         Acceleration steps allowed inside the segment in total, mm/s^2.
+    t_cap : numpy.ndarray, shape (k,), optional
+        The time below which the loosened parameters are claimed, s (default twice the
+        step-free bound). The proof holds for any value; one fixed across lengths makes
+        the bound nondecreasing in ``L`` (every other parameter fixed): both branches
+        cover ``L`` under a fixed envelope, and their bisections' lower ends do not
+        fall as ``L`` grows.
 
     Returns
     -------
@@ -374,7 +382,8 @@ def peak_times(L: np.ndarray, vb0: np.ndarray, vb1: np.ndarray, as0: np.ndarray,
     free = bound(L, V, A, as0, as1)
     # steps inside the segment (module docstring): parameters loosened for every motion
     # that takes less than t_cap, so the bound is min(t_cap, that)
-    t_cap = 2.0 * free
+    if t_cap is None:
+        t_cap = 2.0 * free
     Lx = np.maximum(L - eps * t_cap ** 2 / 2, 0.0)
     with_eps = bound(Lx, V + eps * t_cap, A + eps, as0 + eps, as1 + eps)
     return np.where(eps > 0, np.minimum(t_cap, with_eps), free)
@@ -470,6 +479,97 @@ def _curve_limits(path: Path, lim: AxisArrays, seg: np.ndarray, B: np.ndarray):
     return A, np.sqrt(np.sum(J_ax ** 2, axis=1))
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class SegmentEnvelope:
+    """What steps 3 and 4 of the module docstring know of every segment.
+
+    Attributes
+    ----------
+    vb : numpy.ndarray, shape (m + 1,)
+        Upper bound of the speed at each break, mm/s.
+    a_in, a_out : numpy.ndarray, shape (m + 1,)
+        Largest path acceleration (in size) on arriving at and on leaving each break
+        (:func:`break_accelerations`), mm/s^2.
+    V, A, J : numpy.ndarray, shape (m,)
+        Path speed, acceleration and jerk bounds valid on the whole segment (exact on
+        lines, :func:`_curve_limits` on curves), mm/s, mm/s^2, mm/s^3.
+    eps : float
+        The path acceleration's steps allowed inside a segment in total, mm/s^2.
+    line : numpy.ndarray of bool, shape (m,)
+        Moving line segments.
+    used : numpy.ndarray of int64
+        Segments the bound applies to (moving, ``V > 0``).
+    """
+
+    vb: np.ndarray
+    a_in: np.ndarray
+    a_out: np.ndarray
+    V: np.ndarray
+    A: np.ndarray
+    J: np.ndarray
+    eps: float
+    line: np.ndarray
+    used: np.ndarray
+
+    def peak_time(self, seg: np.ndarray, L: np.ndarray, vb0: np.ndarray | None = None,
+                  vb1: np.ndarray | None = None, as0: np.ndarray | None = None,
+                  as1: np.ndarray | None = None, t_cap: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """Step 4 (:func:`peak_times`) on segments ``seg`` (repeats allowed) of lengths
+        ``L`` (a piece of the segment with its geometry, mm), with end bounds that
+        default to the segment's own; shape of ``seg``, s."""
+        return peak_times(L, self.vb[seg] if vb0 is None else vb0,
+                          self.vb[seg + 1] if vb1 is None else vb1,
+                          self.a_out[seg] if as0 is None else as0,
+                          self.a_in[seg + 1] if as1 is None else as1,
+                          self.V[seg], self.A[seg], self.J[seg], self.eps, t_cap)
+
+
+def segment_envelope(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray,
+                     b_seg: np.ndarray) -> SegmentEnvelope:
+    """The per-segment bounds of steps 3 and 4 (:class:`SegmentEnvelope`).
+
+    Parameters
+    ----------
+    path : Path
+    lim : AxisArrays
+    t_ipo : float
+        IPO cycle, s.
+    b_break : numpy.ndarray, shape (m + 1,)
+        Upper bounds of ``v^2`` at the breaks valid for every feasible motion, mm^2/s^2.
+    b_seg : numpy.ndarray, shape (m,)
+        Upper bounds of ``v^2`` on every segment, valid likewise, mm^2/s^2.
+
+    Returns
+    -------
+    SegmentEnvelope
+    """
+    m = path.n_segments
+    moving = np.any(path.d != 0, axis=1) | (path.radius > 0)
+    line = (path.radius == 0) & moving
+    curve = path.radius > 0
+    V = np.sqrt(np.maximum(b_seg, 0.0))
+    A = np.full(m, np.inf)
+    J = np.full(m, np.inf)
+    seg_l = np.flatnonzero(line)
+    if seg_l.size:
+        V_l, A[seg_l], J[seg_l] = _line_limits(path, lim, seg_l)
+        V[seg_l] = np.minimum(V[seg_l], V_l)
+    seg_c = np.flatnonzero(curve)
+    if seg_c.size:
+        A[seg_c], J[seg_c] = _curve_limits(path, lim, seg_c, np.maximum(b_seg[seg_c], 0.0))
+    seg = np.flatnonzero(moving & (V > 0))
+    if seg.size:
+        a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A[seg])), b_break)
+    else:
+        a_in = a_out = np.zeros(m + 1)
+    vb = np.sqrt(np.maximum(b_break, 0.0))
+    # the path acceleration's steps inside a segment: axis steps are q'_i times it and
+    # some axis has |q'_i| >= 1/sqrt(n), so it steps by at most sqrt(n) max_i eps_i
+    eps = math.sqrt(len(path.axes)) * float(np.max(ACCEL_CONTINUITY_TOL_REL * lim.j_max)) * t_ipo
+    return SegmentEnvelope(vb, a_in, a_out, V, A, J, eps, line, seg)
+
+
 def segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray,
                   b_seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Steps 3 and 4 of the module docstring: per-segment jerk bounds.
@@ -496,36 +596,18 @@ def segment_times(path: Path, lim: AxisArrays, t_ipo: float, b_break: np.ndarray
     env = np.zeros(m)
     stops = np.flatnonzero(path.stop)
     runs = np.zeros(max(stops.size - 1, 0))
-    moving = np.any(path.d != 0, axis=1) | (path.radius > 0)
-    line = (path.radius == 0) & moving
-    curve = path.radius > 0
-    V = np.sqrt(np.maximum(b_seg, 0.0))
-    A = np.full(m, np.inf)
-    J = np.full(m, np.inf)
-    seg_l = np.flatnonzero(line)
-    if seg_l.size:
-        V_l, A[seg_l], J[seg_l] = _line_limits(path, lim, seg_l)
-        V[seg_l] = np.minimum(V[seg_l], V_l)
-    seg_c = np.flatnonzero(curve)
-    if seg_c.size:
-        A[seg_c], J[seg_c] = _curve_limits(path, lim, seg_c, np.maximum(b_seg[seg_c], 0.0))
-    seg = np.flatnonzero(moving & (V > 0))
+    e = segment_envelope(path, lim, t_ipo, b_break, b_seg)
+    seg = e.used
     if seg.size == 0:
         return env, runs
-    a_in, a_out = break_accelerations(path, lim, t_ipo, float(np.max(A[seg])), b_break)
-    vb = np.sqrt(np.maximum(b_break, 0.0))
-    # the path acceleration's steps inside a segment: axis steps are q'_i times it and
-    # some axis has |q'_i| >= 1/sqrt(n), so it steps by at most sqrt(n) max_i eps_i
-    eps = math.sqrt(len(path.axes)) * float(np.max(ACCEL_CONTINUITY_TOL_REL * lim.j_max)) * t_ipo
-    env[seg] = peak_times(path.length[seg], vb[seg], vb[seg + 1], a_out[seg],
-                          a_in[seg + 1], V[seg], A[seg], J[seg], eps)
+    env[seg] = e.peak_time(seg, path.length[seg])
     for r in np.flatnonzero(np.diff(stops) == 1):
         k = int(stops[r])
-        if line[k] and V[k] > 0:
+        if e.line[k] and e.V[k] > 0:
             # the 1-D bound is symmetric in its ends: the larger allowance is a relaxation
-            a_k = max(float(a_out[k]), float(a_in[k + 1]))
-            runs[r] = rest_to_rest_time(float(path.length[k]), float(V[k]), float(A[k]),
-                                        float(J[k]), a_k)
+            a_k = max(float(e.a_out[k]), float(e.a_in[k + 1]))
+            runs[r] = rest_to_rest_time(float(path.length[k]), float(e.V[k]), float(e.A[k]),
+                                        float(e.J[k]), a_k)
     return env, runs
 
 
@@ -582,6 +664,35 @@ def curvature_break_caps(path: Path, lim: AxisArrays, t_ipo: float, b_max: np.nd
     return out
 
 
+def speed_bounds(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steps 2 and 5 of the module docstring: the ``acc`` relaxation on ``acc_grid_s``
+    with the curvature-jump caps.
+
+    Returns
+    -------
+    acc_seg : numpy.ndarray, shape (m,)
+        The relaxation's time on each segment, s.
+    b_break : numpy.ndarray, shape (m + 1,)
+        Upper bounds of ``v^2`` at the breaks, mm^2/s^2.
+    b_seg : numpy.ndarray, shape (m,)
+        Upper bounds of ``v^2`` on each segment (its intervals' a-priori bounds and its
+        node bounds), mm^2/s^2.
+    """
+    grid = grid_on(path, np.asarray(acc_grid_s, dtype=np.float64))
+    _, t_lb, rel, b_hat = lower_bound(path, lim, grid)
+    caps = curvature_break_caps(path, lim, t_ipo, b_hat[grid.break_node])
+    if np.any(caps < b_hat[grid.break_node]):
+        b_node = b_hat.copy()
+        b_node[grid.break_node] = np.minimum(b_node[grid.break_node], caps)
+        _, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
+    acc_seg = np.bincount(grid.segment, weights=t_lb, minlength=path.n_segments)
+    b_seg = np.zeros(path.n_segments)
+    np.maximum.at(b_seg, grid.segment, np.maximum(rel.b_bar, np.maximum(b_hat[:-1],
+                                                                         b_hat[1:])))
+    return acc_seg, b_hat[grid.break_node], b_seg
+
+
 def jerk_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
                      ) -> tuple[float, np.ndarray, np.ndarray]:
     """Certified lower bound of the motion time (holds excluded), module docstring.
@@ -607,19 +718,8 @@ def jerk_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.n
         bounds (0 on arcs), s; on runs that are one line the run bound (step 3) is in
         ``jerk_seg``.
     """
-    grid = grid_on(path, np.asarray(acc_grid_s, dtype=np.float64))
-    _, t_lb, rel, b_hat = lower_bound(path, lim, grid)
-    caps = curvature_break_caps(path, lim, t_ipo, b_hat[grid.break_node])
-    if np.any(caps < b_hat[grid.break_node]):
-        b_node = b_hat.copy()
-        b_node[grid.break_node] = np.minimum(b_node[grid.break_node], caps)
-        _, t_lb, rel, b_hat = lower_bound(path, lim, grid, b_node=b_node)
-    acc_seg = np.bincount(grid.segment, weights=t_lb, minlength=path.n_segments)
-    # v^2 on each segment: at most its intervals' a-priori bounds and its node bounds
-    b_seg = np.zeros(path.n_segments)
-    np.maximum.at(b_seg, grid.segment, np.maximum(rel.b_bar, np.maximum(b_hat[:-1],
-                                                                         b_hat[1:])))
-    env, runs = segment_times(path, lim, t_ipo, b_hat[grid.break_node], b_seg)
+    acc_seg, b_break, b_seg = speed_bounds(path, lim, t_ipo, acc_grid_s)
+    env, runs = segment_times(path, lim, t_ipo, b_break, b_seg)
     jerk_seg = env.copy()
     stops = np.flatnonzero(path.stop)
     one = np.flatnonzero(runs > 0)

@@ -103,6 +103,23 @@ from .tolerances import RELAX_SOLVER_MARGIN_REL, RELAX_SOLVER_MAX_ITER, RELAX_SO
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class RunFloors:
+    """Lower bounds of the time on runs of consecutive segments.
+
+    Attributes
+    ----------
+    lo, hi : numpy.ndarray of int64, shape (R,)
+        Each run is the segments ``lo .. hi - 1`` (``lo < hi``).
+    value : numpy.ndarray, shape (R,)
+        Its bound, s.
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    value: np.ndarray
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class RelaxationResult:
     """The relaxation's solution.
 
@@ -263,7 +280,8 @@ class RelaxationProblem:
 def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
                              b_hat: np.ndarray, t_acc: np.ndarray,
                              seg_floor: np.ndarray | None = None,
-                             hold_breaks: np.ndarray | None = None) -> RelaxationProblem:
+                             hold_breaks: np.ndarray | None = None,
+                             run_floor: RunFloors | None = None) -> RelaxationProblem:
     """Assemble the relaxation of the module docstring on ``grid``.
 
     Parameters
@@ -290,6 +308,11 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
         Path breaks (``0..m``, repeats allowed) where a hold rests the motion
         (:attr:`reference.core.holds.Holds.break_index`): rows ``|A_i| <= J_i T_ipo`` on
         both sides, as at the path ends.
+    run_floor : RunFloors, optional
+        Lower bounds of the time a smaller set of motions (the caller's) spends on runs
+        of consecutive segments: rows ``sum_{k on lo..hi-1} tau_k >= value``. The
+        relaxation's optimum is then a bound for that set only (the ``jerk+freq``
+        oracle's window rows, :mod:`optimal.freq.windows`).
 
     Returns
     -------
@@ -355,6 +378,17 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
             lin.v.append(np.full(sel_k.size, -1.0))
             lin.rhs.append(-fl[g_use] / Ts)
             lin.n += g_use.size
+    if run_floor is not None and run_floor.value.size:
+        first = grid.break_node[run_floor.lo]
+        count = grid.break_node[run_floor.hi] - first
+        # one row per run over its intervals (contiguous in the grid's order)
+        rows = np.repeat(np.arange(count.size), count)
+        cols = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        lin.r.append(lin.n + rows)
+        lin.c.append(CT[cols])
+        lin.v.append(np.full(cols.size, -1.0))
+        lin.rhs.append(-np.asarray(run_floor.value, dtype=np.float64) / Ts)
+        lin.n += count.size
     # axis accelerations at the interval ends as (col, coef) terms, physical units
     def acc_start(i):
         return [(C0, dq0[:, i] * As), (B0, ddq0[:, i] * Bs)]
@@ -483,7 +517,8 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
 def jerk_relaxation(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
                     b_hat: np.ndarray, t_acc: np.ndarray,
                     seg_floor: np.ndarray | None = None,
-                    hold_breaks: np.ndarray | None = None) -> RelaxationResult:
+                    hold_breaks: np.ndarray | None = None,
+                    run_floor: RunFloors | None = None) -> RelaxationResult:
     """Build (:func:`build_relaxation_problem`, same parameters) and solve the relaxation.
 
     Returns
@@ -492,7 +527,7 @@ def jerk_relaxation(path: Path, lim: AxisArrays, t_ipo: float, grid: Grid,
     """
     tb = time.perf_counter()
     prob = build_relaxation_problem(path, lim, t_ipo, grid, b_hat, t_acc, seg_floor,
-                                    hold_breaks)
+                                    hold_breaks, run_floor)
     N = grid.n_intervals
     _, _, Ts = prob.scales
     Bs = prob.scales[0]

@@ -14,7 +14,9 @@ Then the turn run of the frequency bound (:func:`optimal.freq.humps.humps_bound`
 its bound comes within HUMP_TURN_MARGIN of the bracket) on
 ``../shared/corpus/lcnc_arc_arc_sawtooth.ngc`` (``acc+freq``, default gap): the oracle's
 wall time and the bound's time with the run and without it (the margin set to 0), and
-both brackets; left out where ``../shared`` is absent.
+both brackets; left out where ``../shared`` is absent. Before it, the rows of the rule in
+the jerk relaxation (:mod:`optimal.freq.windows`) on examples/demo.mpf: their time
+against the jerk solve, and the bound with them.
 """
 
 from __future__ import annotations
@@ -74,8 +76,41 @@ def main() -> int:
           f"{(t2 - t1) / (t1 - t0):>10.2f}  [{j.lower_bound_s:.4f}, {j.upper_bound_s:.4f}] | "
           f"[{f.lower_bound_s:.4f}, {f.upper_bound_s:.4f}] at the default gap "
           f"({f.status}, {f.gap:.2%})", flush=True)
+    window_row(machine)
     turn_run_row(machine)
     return 0
+
+
+def window_row(machine) -> None:
+    """The jerk relaxation with the rule's rows (:mod:`optimal.freq.windows`) on
+    examples/demo.mpf, whose plunge needs them: the time of that bound alone against the
+    jerk solve on the same path, and the bracket with and without it."""
+    from optimal.freq.windows import window_lower_bound, window_rows
+    from reference.nc import parse_file
+
+    path = build_path(parse_file(HERE.parents[1] / "examples" / "demo.mpf"), machine)
+    t0 = time.perf_counter()
+    j = optimal.solve(path, machine.limits, bounds="jerk")
+    t1 = time.perf_counter()
+    f = optimal.solve(path, machine.limits, bounds="jerk+freq")
+    t2 = time.perf_counter()
+    acc = optimal.solve(path, machine.limits, bounds="acc")
+    moving = path.moving_axes()
+    work = path.restricted(moving) if 0 < moving.size < path.n_axes else path
+    lim = machine.limits.for_axes(work.axes)
+    hold = j.holds.total_s
+    t_up = f.upper_bound_s - hold
+    t3 = time.perf_counter()
+    rows = window_rows(work, lim, machine.limits.t_ipo_s, acc.grid,
+                       j.segment_lower_bounds_s, t_up, j.holds.break_index)
+    lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, acc.grid, j.grid,
+                            j.segment_lower_bounds_s, t_up, j.holds.break_index)
+    t4 = time.perf_counter()
+    print(f"{'windows':>9} demo.mpf: jerk {t1 - t0:.2f} s, jerk+freq {t2 - t1:.2f} s; "
+          f"{rows.value.size} rows and their relaxation {t4 - t3:.2f} s "
+          f"(x{(t4 - t3) / (t1 - t0):.2f} of the jerk solve); lower bound "
+          f"{j.lower_bound_s:.4f} -> {lb + hold:.4f} s; jerk+freq [{f.lower_bound_s:.4f}, "
+          f"{f.upper_bound_s:.4f}] {f.gap:.2%} ({f.status})", flush=True)
 
 
 def turn_run_row(machine) -> None:

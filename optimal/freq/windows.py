@@ -1,0 +1,254 @@
+"""Rows of the frequency rule for the jerk relaxation: the time on a segment and its two
+neighbours (bound set ``jerk+freq``).
+
+The jerk oracle's relaxation (:mod:`optimal.jerk.relaxation`) knows nothing of the rule,
+and :mod:`optimal.freq.humps` knows nothing of the jerk: on a slow segment between two low
+corner caps (examples/demo.mpf's plunge at F1200 between a reversal and a 90 degree
+corner) the rule makes the rise and the fall last ``1/f`` each, where the jerk lets them
+last a third of that, and neither bound sees it. A row per such segment ``k`` bounds the
+time on segments ``k - 1, k, k + 1`` from below, for every motion the checker accepts
+under ``jerk+freq`` that is no slower than ``T_up``; the relaxation with these rows is then
+a lower bound of the minimum under ``jerk+freq`` (``min(bound, T_up)``, as in
+:mod:`optimal.freq.humps`).
+
+Proof
+=====
+Notation (:mod:`optimal.freq.lower`): ``g_k = (1/f_k) / (1 + RATIO_TOL)``, ``f_k`` the
+smallest LOOKAH_FREQUENCY of the axes moving on segment ``k``; every phase that overlaps
+the segment moves those axes, so it lasts an effective duration of at least ``g_k``;
+``eta = FREQ_ACCEL_TOL_REL``; ``abar`` bounds ``|s''|``
+(:func:`~optimal.freq.lower.path_accel_bound`) and ``dr = eta abar T_up`` what the
+accelerations outside phases change the speed by. ``u_j`` bounds the speed at break ``j``
+(``sqrt(b)`` of the ``acc`` relaxation's node bound, :func:`optimal.jerk.lower.speed_bounds`,
+with the checker's tolerances) and ``Vc_k`` the speed on segment ``k``
+(:func:`~optimal.freq.lower.segment_speed_caps` and the relaxation's segment bound).
+
+1. *One segment.* Let ``[t_a, t_b]`` be the time on segment ``k`` (length ``L``), ``V``
+   the largest speed in it, at ``t*``, and ``u0 = u_k``, ``u1 = u_{k+1}``. Then
+   ``T_k = (L + int (V - v) dt) / V``. If ``V <= max(u0, u1)``, ``T_k >= L / V``. Else
+   ``t*`` lies strictly inside and the speed rises by ``V - v(t_a) >= V - u0`` before it;
+   the rise phases in ``[t_a, t*]`` carry at least ``V - u0 - dr`` of it. A rise phase
+   ``P`` inside loses ``int_P (V - v) >= int_P (v(p_1) - v) = dv_P (t_c - p_0) >=
+   dv_P g_k / 2`` (integration by parts). One phase ``Q`` may have started before
+   ``t_a``, ``c0`` earlier: inside it still loses ``dv_Q g_k / 2 - c0 V`` (what it lost
+   before ``t_a`` is at most ``c0 v(q_1)``). With the fall alike (``u1``, ``c1``: a fall
+   phase that ends after ``t_b``), ``T_k >= F(V) = (L + X0 + X1) / V`` with
+   ``Xi = max(0, (V - ui - dr) g_k / 2 - ci V)``. Where ``L > (u0 + u1 + 2 dr) g_k / 2``
+   every piece of ``F`` falls with ``V``, so
+   ``T_k >= G(c0, c1) = min(L / max(u0, u1), F(Vc_k))``.
+2. *The neighbours.* The ``c0`` before ``t_a`` belong to a rise ending at ``v(t_a)``: the
+   motion creeps there at most at ``u0``. If the creep stays on segment ``k - 1`` (length
+   ``L'``), that segment takes ``c0`` plus the time on its first ``L' - delta`` with
+   ``delta <= u0 c0``, entered as the segment is and left at most at ``u0`` with
+   ``|s''| <= eta abar + eps`` (the phase starts there; ``eps`` the segment's budget of
+   acceleration steps): at least its jerk bound ``E(L' - delta)``
+   (:func:`optimal.jerk.lower.peak_times` with those ends and a fixed ``t_cap``, which
+   is nondecreasing in the length). If the creep covers the whole segment it takes at
+   least ``L' / u0``. Mirrored after ``t_b``. At the path ends and at holds (zero
+   acceleration for the hold's duration) no phase runs through: ``c = 0``.
+3. *The row.* ``T_{k-1} + T_k + T_{k+1} >= min over c0, c1 >= 0`` of
+   ``P0(c0) + G(c0, c1) + P1(c1)``. ``G`` is ``L / Vc + X0(c0) / Vc + X1(c1) / Vc`` or a
+   constant, so the minimum splits into one over ``c0`` and one over ``c1``; each runs
+   over cells ``[c_a, c_b]`` (:data:`WINDOW_LINEAR_CELLS` up to where ``X`` is zero, then
+   cells growing by :data:`WINDOW_CELL_GROWTH` up to ``L' / u0``, then the rest), on
+   which ``P >= min(c_a + E(max(L' - u0 c_b, 0)), L' / u0)`` (the second only where
+   ``u0 c_b >= L'``) and ``X(c) >= X(c_b)``: the smallest cell value bounds the minimum.
+   A cell of width ``h`` gives away at most about ``h`` (the creep's cost and its saving
+   are both about ``c``).
+
+Only segments where ``G(0, 0)`` exceeds the relaxation's own floor of the segment by
+:data:`WINDOW_MIN_GAIN_REL` get a row (elsewhere the row cannot bind).
+
+Units: mm, s, mm/s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference.core.geometry import Path
+from reference.core.limits import AxisArrays
+from reference.core.phases import FREQ_ACCEL_TOL_REL
+from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
+
+from ..bounds import lower_bound
+from ..grid import grid_on
+from ..jerk.lower import segment_envelope, speed_bounds
+from ..jerk.relaxation import RunFloors, jerk_relaxation
+from ..tolerances import LB_ROUNDOFF_REL
+from .lower import path_accel_bound, segment_periods, segment_speed_caps
+
+__all__ = ["WINDOW_CELL_GROWTH", "WINDOW_LINEAR_CELLS", "WINDOW_MIN_GAIN_REL",
+           "window_lower_bound", "window_rows"]
+
+#: Cells of the creep time ``c`` from 0 to where the phase's lost time is used up
+#: (step 3): each gives away at most its width, ``g / 2`` over this (0.5 ms at 15 Hz).
+WINDOW_LINEAR_CELLS = 64
+#: Growth of the cells beyond that, up to the creep that covers the whole neighbour (the
+#: creep costs at least its own time there, so coarse cells lose little).
+WINDOW_CELL_GROWTH = 1.25
+#: Cells beyond the linear ones at most (then the rest as one).
+WINDOW_MAX_GROWN_CELLS = 48
+#: A row only where the frequency bound of the segment exceeds its floor by this share.
+WINDOW_MIN_GAIN_REL = 1e-3
+
+
+def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
+                floors: np.ndarray, t_upper: float,
+                hold_breaks: np.ndarray | None = None) -> RunFloors:
+    """The rows of the module docstring.
+
+    Parameters
+    ----------
+    path : Path
+        Restricted to its moving axes.
+    lim : AxisArrays
+        Limits of ``path.axes``.
+    t_ipo : float
+        IPO cycle, s.
+    acc_grid_s : numpy.ndarray, shape (N + 1,)
+        Nodes of an ``acc`` relaxation grid (every break a node), mm.
+    floors : numpy.ndarray, shape (m,)
+        The relaxation's own floor per segment, s (rows only where they can bind).
+    t_upper : float
+        The rows hold for every motion no slower than this, s (holds excluded).
+    hold_breaks : numpy.ndarray of int, optional
+        Breaks where a hold rests the motion.
+
+    Returns
+    -------
+    RunFloors
+        Runs ``k - 1 .. k + 1`` (clipped where a side has no neighbour) and their bounds.
+    """
+    m = path.n_segments
+    none = RunFloors(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+    if m == 0 or not np.isfinite(t_upper):
+        return none
+    _, b_break, b_seg = speed_bounds(path, lim, t_ipo, acc_grid_s)
+    env = segment_envelope(path, lim, t_ipo, b_break, b_seg)
+    slack = 1.0 + RATIO_TOL
+    u = np.sqrt(np.maximum(b_break, 0.0)) * slack + VEL_TOL_MM_S
+    vc = np.minimum(segment_speed_caps(path, lim),
+                    np.sqrt(np.maximum(b_seg, 0.0)) * slack + VEL_TOL_MM_S)
+    g = segment_periods(path, lim) / slack
+    a_bar = path_accel_bound(path, lim)
+    dr = FREQ_ACCEL_TOL_REL * a_bar * t_upper
+    L = path.length
+    u0, u1 = u[:-1], u[1:]
+    lo_v = np.maximum(u0, u1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x0 = np.maximum((vc - u0 - dr) * g / 2.0, 0.0)
+        x1 = np.maximum((vc - u1 - dr) * g / 2.0, 0.0)
+        g00 = np.minimum(L / lo_v, (L + x0 + x1) / vc)
+    ok = (np.isfinite(g) & (g > 0) & np.isfinite(vc) & (vc > lo_v)
+          & (L > (u0 + u1 + 2.0 * dr) * g / 2.0)
+          & (g00 * (1.0 - LB_ROUNDOFF_REL) > floors * (1.0 + WINDOW_MIN_GAIN_REL)))
+    sel = np.flatnonzero(ok)
+    if sel.size == 0:
+        return none
+    cut = np.zeros(m + 1, bool)
+    cut[[0, m]] = True
+    if hold_breaks is not None and np.size(hold_breaks):
+        cut[np.asarray(hold_breaks, dtype=np.int64)] = True
+    moving = np.zeros(m, bool)
+    moving[env.used] = True
+    # the creep before segment k (on k - 1, at most u_k) and after it (on k + 1, at most
+    # u_{k+1}): the smallest of P + X / Vc over the cells, per side
+    before, after = ~cut[sel], ~cut[sel + 1]
+    side0 = _side(env, L, moving, sel, sel - 1, u0[sel], x0[sel], vc[sel], dr, a_bar,
+                  leaving=True, present=before)
+    side1 = _side(env, L, moving, sel, sel + 1, u1[sel], x1[sel], vc[sel], dr, a_bar,
+                  leaving=False, present=after)
+    with np.errstate(divide="ignore"):
+        far = L[sel] / lo_v[sel] + side0[1] + side1[1]
+    near = L[sel] / vc[sel] + side0[0] + side1[0]
+    value = np.minimum(far, near) * (1.0 - LB_ROUNDOFF_REL)
+    lo = np.where(before, sel - 1, sel)
+    hi = np.where(after, sel + 2, sel + 1)
+    return RunFloors(lo.astype(np.int64), hi.astype(np.int64), value)
+
+
+def _side(env, L: np.ndarray, moving: np.ndarray, sel: np.ndarray, nb: np.ndarray,
+          u: np.ndarray, x: np.ndarray, vc: np.ndarray, dr: float, a_bar: float,
+          leaving: bool, present: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Step 3 for one side of the segments ``sel``: ``(min_c P(c) + X(c) / Vc,
+    min_c P(c))`` per segment, s, shape (K,) each. ``nb`` the neighbour on that side,
+    ``u`` the speed bound at the common break, ``x`` the lost time at ``c = 0`` (mm),
+    ``leaving``: the neighbour is left at that break (the creep is at its end)."""
+    K = sel.size
+    with_x = np.zeros(K)
+    alone = np.zeros(K)
+    idx = np.flatnonzero(present)
+    if idx.size == 0:
+        return x / vc, alone                 # no neighbour: c = 0
+    k_nb = nb[idx]
+    Ln = L[k_nb]
+    un = u[idx]
+    c_zero = x[idx] / vc[idx]                # X(c) = x - c Vc reaches 0 here, s
+    c_all = Ln / un                          # the creep covers the whole neighbour
+    # cell edges: linear to c_zero, growing to c_all, then the rest
+    lin = np.linspace(0.0, 1.0, WINDOW_LINEAR_CELLS + 1)[None, :] * c_zero[:, None]
+    start = np.maximum(c_zero, 1e-12 * np.maximum(c_all, 1.0))
+    grown = start[:, None] * WINDOW_CELL_GROWTH ** np.arange(1, WINDOW_MAX_GROWN_CELLS + 1)
+    grown = np.minimum(grown, c_all[:, None])
+    edges = np.concatenate((lin, grown), axis=1)          # (k, n_edges), nondecreasing
+    ca, cb = edges[:, :-1], edges[:, 1:]
+    # the neighbour's jerk bound on what the creep leaves of it (t_cap fixed at twice
+    # its whole length's bound, so that the bound grows with the length)
+    rows = np.repeat(k_nb, cb.shape[1])
+    L_left = np.maximum(Ln[:, None] - un[:, None] * cb, 0.0).ravel()
+    eps_end = np.full(rows.size, FREQ_ACCEL_TOL_REL * a_bar + env.eps)
+    u_end = np.repeat(un, cb.shape[1])
+    with np.errstate(all="ignore"):     # non-moving neighbours: masked below
+        t_cap = np.repeat(2.0 * env.peak_time(k_nb, Ln), cb.shape[1])
+        if leaving:    # the creep is at the neighbour's end: it leaves at most at u
+            E = env.peak_time(rows, L_left, vb1=u_end,
+                              as1=np.maximum(env.a_in[rows + 1], eps_end), t_cap=t_cap)
+        else:          # at its start: entered at most at u
+            E = env.peak_time(rows, L_left, vb0=u_end,
+                              as0=np.maximum(env.a_out[rows], eps_end), t_cap=t_cap)
+    E = np.where((L_left > 0) & moving[rows], np.nan_to_num(E, nan=0.0, posinf=0.0), 0.0)
+    E = np.maximum(E, 0.0).reshape(cb.shape)
+    P = np.where(un[:, None] * cb >= Ln[:, None], np.minimum(ca + E, c_all[:, None]), ca + E)
+    X = np.maximum(x[idx, None] - cb * vc[idx, None], 0.0) / vc[idx, None]
+    # the rest: c beyond the last edge (at least c_all, or the creep covers the neighbour)
+    tail = np.minimum(edges[:, -1], c_all)
+    with_x[idx] = np.minimum(np.min(P + X, axis=1), tail)
+    alone[idx] = np.minimum(np.min(P, axis=1), tail)
+    return np.where(present, with_x, x / vc), alone
+
+
+def window_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
+                       grid_s: np.ndarray, floors: np.ndarray, t_upper: float,
+                       hold_breaks: np.ndarray | None = None,
+                       extra: RunFloors | None = None) -> float:
+    """The jerk relaxation with the rows of :func:`window_rows`: a lower bound of the
+    motion time under ``jerk+freq`` (holds excluded), s.
+
+    Parameters
+    ----------
+    path, lim, t_ipo, acc_grid_s, floors, t_upper, hold_breaks
+        As :func:`window_rows`; ``floors`` are also the relaxation's segment floors.
+    grid_s : numpy.ndarray, shape (N + 1,)
+        Nodes of the relaxation (the jerk oracle's final grid), mm.
+    extra : RunFloors, optional
+        More rows that hold for the motions no slower than ``t_upper`` (the turn
+        programme's bound of each rest-to-rest piece, :mod:`optimal.freq.humps`).
+
+    Returns
+    -------
+    float
+        ``min(relaxation, t_upper)`` (the rows hold for the motions no slower than
+        ``t_upper``), s; 0 where no row was made or the relaxation failed.
+    """
+    rows = window_rows(path, lim, t_ipo, acc_grid_s, floors, t_upper, hold_breaks)
+    if extra is not None:
+        rows = RunFloors(np.concatenate((rows.lo, extra.lo)),
+                         np.concatenate((rows.hi, extra.hi)),
+                         np.concatenate((rows.value, extra.value)))
+    if rows.value.size == 0:
+        return 0.0
+    grid = grid_on(path, np.asarray(grid_s, dtype=np.float64))
+    _, t_acc, _, b_hat = lower_bound(path, lim, grid)
+    rel = jerk_relaxation(path, lim, t_ipo, grid, b_hat, t_acc, floors, hold_breaks, rows)
+    return min(rel.lower_bound_s, t_upper) if rel.ok else 0.0
