@@ -60,7 +60,7 @@ from .humps import humps_piece_bounds
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
-from .windows import window_lower_bound
+from .windows import window_lower_bound, window_rows
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     piece_times, pieced, scaled, verified)
 
@@ -260,6 +260,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     if c is not None:
         cands.append(c)
     t_check = time.perf_counter() - tc
+    win_rows = None
     if (base == "jerk" and cands and base_sol.segment_lower_bounds_s is not None
             and min(c.duration for c in cands) + hold_t - lb > tol * lb):
         # the jerk relaxation again, with rows of the frequency rule on the segments
@@ -268,9 +269,12 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         if progress:
             progress("frequency lower bound: the jerk relaxation with the rule's rows", 0.88)
         tb = time.perf_counter()
-        lb_win = window_lower_bound(work, sub_lim, limits.t_ipo_s, acc.grid, base_sol.grid,
-                                    base_sol.segment_lower_bounds_s,
-                                    min(c.duration for c in cands), holds.break_index)
+        t_fast = min(c.duration for c in cands)
+        win_rows = window_rows(work, sub_lim, limits.t_ipo_s, acc.grid,
+                               base_sol.segment_lower_bounds_s, t_fast, holds.break_index)
+        lb_win = window_lower_bound(work, sub_lim, limits.t_ipo_s, base_sol.grid,
+                                    base_sol.segment_lower_bounds_s, win_rows, t_fast,
+                                    holds.break_index)
         t_bound += time.perf_counter() - tb
         if lb_win + hold_t > lb:
             lb, lb_freq = lb_win + hold_t, max(lb_freq, lb_win)
@@ -314,22 +318,23 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
                                            base_sol.segment_lower_bounds_s, enough=enough)
             raw, t_valid = float(np.sum(per_piece)), t_best
             lb_humps = max(lb_humps, min(raw, t_best))
-        if (base == "jerk" and raw < t_valid and base_sol.segment_lower_bounds_s is not None
+        if (win_rows is not None and raw < t_valid
                 and t_best + hold_t - max(lb, lb_humps + hold_t)
                 > tol * max(lb, lb_humps + hold_t)):
             # the programme's bound of each piece as a row of the jerk relaxation, with
             # the window rows: the relaxation then keeps its segment floors and coupling
             # where the programme bounds only the piece's total (examples/slot.ngc: the
             # zig-zag's rises and falls of 1/f beside the jerk floors of the lines after
-            # it, in one piece)
+            # it, in one piece); the window rows hold for the motions no slower than the
+            # fastest candidate, so for those no slower than t_valid too
             if progress:
                 progress("frequency lower bound: the jerk relaxation with the programme's "
                          "rows", 0.95)
             pieces = rest_pieces(work)
             lb_humps = max(lb_humps, window_lower_bound(
-                work, sub_lim, limits.t_ipo_s, acc.grid, base_sol.grid,
-                base_sol.segment_lower_bounds_s, t_valid, holds.break_index,
-                extra=RunFloors(pieces[:, 0], pieces[:, 1], per_piece)))
+                work, sub_lim, limits.t_ipo_s, base_sol.grid, base_sol.segment_lower_bounds_s,
+                win_rows.joined(RunFloors(pieces[:, 0], pieces[:, 1], per_piece)), t_valid,
+                holds.break_index))
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)

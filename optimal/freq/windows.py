@@ -155,9 +155,9 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     # the creep before segment k (on k - 1, at most u_k) and after it (on k + 1, at most
     # u_{k+1}): the smallest of P + X / Vc over the cells, per side
     before, after = ~cut[sel], ~cut[sel + 1]
-    side0 = _side(env, L, moving, sel, sel - 1, u0[sel], x0[sel], vc[sel], dr, a_bar,
+    side0 = _side(env, L, moving, sel - 1, u0[sel], x0[sel], vc[sel], a_bar,
                   leaving=True, present=before)
-    side1 = _side(env, L, moving, sel, sel + 1, u1[sel], x1[sel], vc[sel], dr, a_bar,
+    side1 = _side(env, L, moving, sel + 1, u1[sel], x1[sel], vc[sel], a_bar,
                   leaving=False, present=after)
     with np.errstate(divide="ignore"):
         far = L[sel] / lo_v[sel] + side0[1] + side1[1]
@@ -168,16 +168,15 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     return RunFloors(lo.astype(np.int64), hi.astype(np.int64), value)
 
 
-def _side(env, L: np.ndarray, moving: np.ndarray, sel: np.ndarray, nb: np.ndarray,
-          u: np.ndarray, x: np.ndarray, vc: np.ndarray, dr: float, a_bar: float,
-          leaving: bool, present: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Step 3 for one side of the segments ``sel``: ``(min_c P(c) + X(c) / Vc,
-    min_c P(c))`` per segment, s, shape (K,) each. ``nb`` the neighbour on that side,
+def _side(env, L: np.ndarray, moving: np.ndarray, nb: np.ndarray, u: np.ndarray,
+          x: np.ndarray, vc: np.ndarray, a_bar: float, leaving: bool, present: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Step 3 for one side of K segments: ``(min_c P(c) + X(c) / Vc, min_c P(c))`` per
+    segment, s, shape (K,) each. ``nb`` the neighbour on that side,
     ``u`` the speed bound at the common break, ``x`` the lost time at ``c = 0`` (mm),
     ``leaving``: the neighbour is left at that break (the creep is at its end)."""
-    K = sel.size
-    with_x = np.zeros(K)
-    alone = np.zeros(K)
+    with_x = np.zeros(nb.size)
+    alone = np.zeros(nb.size)
     idx = np.flatnonzero(present)
     if idx.size == 0:
         return x / vc, alone                 # no neighbour: c = 0
@@ -218,34 +217,31 @@ def _side(env, L: np.ndarray, moving: np.ndarray, sel: np.ndarray, nb: np.ndarra
     return np.where(present, with_x, x / vc), alone
 
 
-def window_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
-                       grid_s: np.ndarray, floors: np.ndarray, t_upper: float,
-                       hold_breaks: np.ndarray | None = None,
-                       extra: RunFloors | None = None) -> float:
-    """The jerk relaxation with the rows of :func:`window_rows`: a lower bound of the
-    motion time under ``jerk+freq`` (holds excluded), s.
+def window_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, grid_s: np.ndarray,
+                       floors: np.ndarray, rows: RunFloors, t_upper: float,
+                       hold_breaks: np.ndarray | None = None) -> float:
+    """The jerk relaxation with ``rows``: a lower bound of the motion time under
+    ``jerk+freq`` (holds excluded), s.
 
     Parameters
     ----------
-    path, lim, t_ipo, acc_grid_s, floors, t_upper, hold_breaks
-        As :func:`window_rows`; ``floors`` are also the relaxation's segment floors.
+    path, lim, t_ipo, floors, hold_breaks
+        As :func:`window_rows`; ``floors`` are the relaxation's segment floors.
     grid_s : numpy.ndarray, shape (N + 1,)
         Nodes of the relaxation (the jerk oracle's final grid), mm.
-    extra : RunFloors, optional
-        More rows that hold for the motions no slower than ``t_upper`` (the turn
-        programme's bound of each rest-to-rest piece, :mod:`optimal.freq.humps`).
+    rows : RunFloors
+        Rows that hold for every motion no slower than ``t_upper``: those of
+        :func:`window_rows`, and the turn programme's bound of each rest-to-rest piece
+        (:func:`optimal.freq.humps.humps_piece_bounds`).
+    t_upper : float
+        s, holds excluded.
 
     Returns
     -------
     float
-        ``min(relaxation, t_upper)`` (the rows hold for the motions no slower than
-        ``t_upper``), s; 0 where no row was made or the relaxation failed.
+        ``min(relaxation, t_upper)``, s; 0 where there is no row or the relaxation
+        failed.
     """
-    rows = window_rows(path, lim, t_ipo, acc_grid_s, floors, t_upper, hold_breaks)
-    if extra is not None:
-        rows = RunFloors(np.concatenate((rows.lo, extra.lo)),
-                         np.concatenate((rows.hi, extra.hi)),
-                         np.concatenate((rows.value, extra.value)))
     if rows.value.size == 0:
         return 0.0
     grid = grid_on(path, np.asarray(grid_s, dtype=np.float64))

@@ -118,6 +118,12 @@ class RunFloors:
     hi: np.ndarray
     value: np.ndarray
 
+    def joined(self, other: RunFloors) -> RunFloors:
+        """Both sets of rows."""
+        return RunFloors(np.concatenate((self.lo, other.lo)),
+                         np.concatenate((self.hi, other.hi)),
+                         np.concatenate((self.value, other.value)))
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class RelaxationResult:
@@ -366,28 +372,24 @@ def build_relaxation_problem(path: Path, lim: AxisArrays, t_ipo: float, grid: Gr
     if stops.size:
         eq.add([(ib + stops, 1.0)], np.zeros(stops.size), normalise=False)
     lin.add([(CT, -Ts)], -np.asarray(t_acc, dtype=np.float64))
+    # a segment's floor is a run of one segment: one row per run, -sum tau_k <= -floor,
+    # over its intervals (contiguous in the grid's order; rows of varying length: COO)
+    runs = [] if run_floor is None else [run_floor]
     if seg_floor is not None:
         fl = np.asarray(seg_floor, dtype=np.float64)
         g_use = np.flatnonzero(fl > 0)
-        if g_use.size:
-            # one row per segment: -sum tau_k <= -floor (rows of varying length: COO)
-            sel_k = np.flatnonzero(np.isin(seg, g_use))
-            row_of = np.searchsorted(g_use, seg[sel_k])
-            lin.r.append(lin.n + row_of)
-            lin.c.append(CT[sel_k])
-            lin.v.append(np.full(sel_k.size, -1.0))
-            lin.rhs.append(-fl[g_use] / Ts)
-            lin.n += g_use.size
-    if run_floor is not None and run_floor.value.size:
-        first = grid.break_node[run_floor.lo]
-        count = grid.break_node[run_floor.hi] - first
-        # one row per run over its intervals (contiguous in the grid's order)
+        runs.insert(0, RunFloors(g_use, g_use + 1, fl[g_use]))
+    for run in runs:
+        if run.value.size == 0:
+            continue
+        first = grid.break_node[run.lo]
+        count = grid.break_node[run.hi] - first
         rows = np.repeat(np.arange(count.size), count)
         cols = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
         lin.r.append(lin.n + rows)
         lin.c.append(CT[cols])
         lin.v.append(np.full(cols.size, -1.0))
-        lin.rhs.append(-np.asarray(run_floor.value, dtype=np.float64) / Ts)
+        lin.rhs.append(-np.asarray(run.value, dtype=np.float64) / Ts)
         lin.n += count.size
     # axis accelerations at the interval ends as (col, coef) terms, physical units
     def acc_start(i):

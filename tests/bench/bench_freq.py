@@ -103,8 +103,8 @@ def window_row(machine) -> None:
     t3 = time.perf_counter()
     rows = window_rows(work, lim, machine.limits.t_ipo_s, acc.grid,
                        j.segment_lower_bounds_s, t_up, j.holds.break_index)
-    lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, acc.grid, j.grid,
-                            j.segment_lower_bounds_s, t_up, j.holds.break_index)
+    lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, j.grid,
+                            j.segment_lower_bounds_s, rows, t_up, j.holds.break_index)
     t4 = time.perf_counter()
     print(f"{'windows':>9} demo.mpf: jerk {t1 - t0:.2f} s, jerk+freq {t2 - t1:.2f} s; "
           f"{rows.value.size} rows and their relaxation {t4 - t3:.2f} s "
