@@ -60,6 +60,7 @@ from .humps import humps_piece_bounds
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
+from .chains import chain_rows
 from .windows import window_lower_bound, window_rows
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     piece_times, pieced, scaled, verified)
@@ -271,7 +272,10 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         tb = time.perf_counter()
         t_fast = min(c.duration for c in cands)
         win_rows = window_rows(work, sub_lim, limits.t_ipo_s, acc.grid,
-                               base_sol.segment_lower_bounds_s, t_fast, holds.break_index)
+                               base_sol.segment_lower_bounds_s, t_fast, holds.break_index
+                               ).joined(chain_rows(work, sub_lim, limits.t_ipo_s, acc.grid,
+                                                   base_sol.segment_lower_bounds_s, t_fast,
+                                                   holds.break_index))
         lb_win = window_lower_bound(work, sub_lim, limits.t_ipo_s, base_sol.grid,
                                     base_sol.segment_lower_bounds_s, win_rows, t_fast,
                                     holds.break_index)

@@ -64,6 +64,8 @@ Units: mm, s, mm/s.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from reference.core.geometry import Path
@@ -73,13 +75,13 @@ from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
 
 from ..bounds import lower_bound
 from ..grid import grid_on
-from ..jerk.lower import segment_envelope, speed_bounds
+from ..jerk.lower import SegmentEnvelope, segment_envelope, speed_bounds
 from ..jerk.relaxation import RunFloors, jerk_relaxation
 from ..tolerances import LB_ROUNDOFF_REL
 from .lower import path_accel_bound, segment_periods, segment_speed_caps
 
-__all__ = ["WINDOW_CELL_GROWTH", "WINDOW_LINEAR_CELLS", "WINDOW_MIN_GAIN_REL",
-           "window_lower_bound", "window_rows"]
+__all__ = ["WINDOW_CELL_GROWTH", "WINDOW_LINEAR_CELLS", "WINDOW_MIN_GAIN_REL", "CreepCells", "RuleEnvelope",
+           "creep_cells", "rule_envelope", "window_lower_bound", "window_rows"]
 
 #: Cells of the creep time ``c`` from 0 to where the phase's lost time is used up
 #: (step 3): each gives away at most its width, ``g / 2`` over this (0.5 ms at 15 Hz).
@@ -91,6 +93,58 @@ WINDOW_CELL_GROWTH = 1.25
 WINDOW_MAX_GROWN_CELLS = 48
 #: A row only where the frequency bound of the segment exceeds its floor by this share.
 WINDOW_MIN_GAIN_REL = 1e-3
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RuleEnvelope:
+    """What the rows of the rule know of a path (module docstring, notation).
+
+    Attributes
+    ----------
+    env : optimal.jerk.lower.SegmentEnvelope
+        The jerk bounds' inputs per segment (step 2).
+    u : numpy.ndarray, shape (m + 1,)
+        Bound on the speed at each break, mm/s.
+    vc : numpy.ndarray, shape (m,)
+        Bound on the speed on each segment, mm/s.
+    g : numpy.ndarray, shape (m,)
+        ``g_k``: the shortest duration the checker accepts of a phase that moves the axes
+        of segment ``k``, s (0 where no axis moving on it has a frequency).
+    a_bar : float
+        Bound on ``|s''|``, mm/s^2.
+    dr : float
+        What the accelerations outside phases change the speed by at most, mm/s.
+    cut : numpy.ndarray of bool, shape (m + 1,)
+        Breaks no phase runs through: the path ends and the holds.
+    """
+
+    env: SegmentEnvelope
+    u: np.ndarray
+    vc: np.ndarray
+    g: np.ndarray
+    a_bar: float
+    dr: float
+    cut: np.ndarray
+
+
+def rule_envelope(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
+                  t_upper: float, hold_breaks: np.ndarray | None = None) -> RuleEnvelope:
+    """The bounds of the module docstring's notation, for the motions no slower than
+    ``t_upper`` (s); arguments as :func:`window_rows`."""
+    m = path.n_segments
+    _, b_break, b_seg = speed_bounds(path, lim, t_ipo, acc_grid_s)
+    env = segment_envelope(path, lim, t_ipo, b_break, b_seg)
+    slack = 1.0 + RATIO_TOL
+    u = np.sqrt(np.maximum(b_break, 0.0)) * slack + VEL_TOL_MM_S
+    vc = np.minimum(segment_speed_caps(path, lim),
+                    np.sqrt(np.maximum(b_seg, 0.0)) * slack + VEL_TOL_MM_S)
+    g = segment_periods(path, lim) / slack
+    a_bar = path_accel_bound(path, lim)
+    cut = np.zeros(m + 1, bool)
+    cut[[0, m]] = True
+    if hold_breaks is not None and np.size(hold_breaks):
+        cut[np.asarray(hold_breaks, dtype=np.int64)] = True
+    return RuleEnvelope(env, u, vc, g, a_bar, FREQ_ACCEL_TOL_REL * a_bar * t_upper, cut)
 
 
 def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
@@ -124,15 +178,8 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     none = RunFloors(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
     if m == 0 or not np.isfinite(t_upper):
         return none
-    _, b_break, b_seg = speed_bounds(path, lim, t_ipo, acc_grid_s)
-    env = segment_envelope(path, lim, t_ipo, b_break, b_seg)
-    slack = 1.0 + RATIO_TOL
-    u = np.sqrt(np.maximum(b_break, 0.0)) * slack + VEL_TOL_MM_S
-    vc = np.minimum(segment_speed_caps(path, lim),
-                    np.sqrt(np.maximum(b_seg, 0.0)) * slack + VEL_TOL_MM_S)
-    g = segment_periods(path, lim) / slack
-    a_bar = path_accel_bound(path, lim)
-    dr = FREQ_ACCEL_TOL_REL * a_bar * t_upper
+    rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
+    env, u, vc, g, a_bar, dr = rule.env, rule.u, rule.vc, rule.g, rule.a_bar, rule.dr
     L = path.length
     u0, u1 = u[:-1], u[1:]
     lo_v = np.maximum(u0, u1)
@@ -146,10 +193,7 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     sel = np.flatnonzero(ok)
     if sel.size == 0:
         return none
-    cut = np.zeros(m + 1, bool)
-    cut[[0, m]] = True
-    if hold_breaks is not None and np.size(hold_breaks):
-        cut[np.asarray(hold_breaks, dtype=np.int64)] = True
+    cut = rule.cut
     moving = np.zeros(m, bool)
     moving[env.used] = True
     # the creep before segment k (on k - 1, at most u_k) and after it (on k + 1, at most
@@ -180,14 +224,49 @@ def _side(env, L: np.ndarray, moving: np.ndarray, nb: np.ndarray, u: np.ndarray,
     idx = np.flatnonzero(present)
     if idx.size == 0:
         return x / vc, alone                 # no neighbour: c = 0
-    k_nb = nb[idx]
+    # X(c) = x - c Vc reaches 0 at c = x / Vc
+    cells = creep_cells(env, L, moving, nb[idx], u[idx], x[idx] / vc[idx], a_bar, leaving)
+    X = np.maximum(x[idx, None] - cells.cb * vc[idx, None], 0.0) / vc[idx, None]
+    with_x[idx] = np.minimum(np.min(cells.P + X, axis=1), cells.tail)
+    alone[idx] = cells.least
+    return np.where(present, with_x, x / vc), alone
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CreepCells:
+    """What a creep of ``c`` on a neighbour costs it (step 3), per cell of ``c``.
+
+    Attributes
+    ----------
+    cb : numpy.ndarray, shape (K, n)
+        Each cell's upper edge, s (the lower edges are 0 and the upper ones before).
+    P : numpy.ndarray, shape (K, n)
+        A bound on the neighbour's time with a creep in the cell, s.
+    tail : numpy.ndarray, shape (K,)
+        The same beyond the last cell, s.
+    least : numpy.ndarray, shape (K,)
+        The smallest of them: a bound on the neighbour's time whatever the creep, s.
+    """
+
+    cb: np.ndarray
+    P: np.ndarray
+    tail: np.ndarray
+    least: np.ndarray
+
+
+def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: np.ndarray,
+                un: np.ndarray, c_lin: np.ndarray, a_bar: float, leaving: bool
+                ) -> CreepCells:
+    """The cells of step 3 on neighbours ``k_nb`` (shape (K,)), the creep at most at
+    ``un`` (mm/s): :data:`WINDOW_LINEAR_CELLS` up to ``c_lin`` (s), then growing by
+    :data:`WINDOW_CELL_GROWTH` up to the creep over the whole neighbour. ``L`` the
+    segment lengths (mm), ``moving`` which segments move, ``leaving``: the neighbour is
+    left at the break (the creep is at its end)."""
     Ln = L[k_nb]
-    un = u[idx]
-    c_zero = x[idx] / vc[idx]                # X(c) = x - c Vc reaches 0 here, s
     c_all = Ln / un                          # the creep covers the whole neighbour
-    # cell edges: linear to c_zero, growing to c_all, then the rest
-    lin = np.linspace(0.0, 1.0, WINDOW_LINEAR_CELLS + 1)[None, :] * c_zero[:, None]
-    start = np.maximum(c_zero, 1e-12 * np.maximum(c_all, 1.0))
+    # cell edges: linear to c_lin, growing to c_all, then the rest
+    lin = np.linspace(0.0, 1.0, WINDOW_LINEAR_CELLS + 1)[None, :] * c_lin[:, None]
+    start = np.maximum(c_lin, 1e-12 * np.maximum(c_all, 1.0))
     grown = start[:, None] * WINDOW_CELL_GROWTH ** np.arange(1, WINDOW_MAX_GROWN_CELLS + 1)
     grown = np.minimum(grown, c_all[:, None])
     edges = np.concatenate((lin, grown), axis=1)          # (k, n_edges), nondecreasing
@@ -209,12 +288,9 @@ def _side(env, L: np.ndarray, moving: np.ndarray, nb: np.ndarray, u: np.ndarray,
     E = np.where((L_left > 0) & moving[rows], np.nan_to_num(E, nan=0.0, posinf=0.0), 0.0)
     E = np.maximum(E, 0.0).reshape(cb.shape)
     P = np.where(un[:, None] * cb >= Ln[:, None], np.minimum(ca + E, c_all[:, None]), ca + E)
-    X = np.maximum(x[idx, None] - cb * vc[idx, None], 0.0) / vc[idx, None]
     # the rest: c beyond the last edge (at least c_all, or the creep covers the neighbour)
     tail = np.minimum(edges[:, -1], c_all)
-    with_x[idx] = np.minimum(np.min(P + X, axis=1), tail)
-    alone[idx] = np.minimum(np.min(P, axis=1), tail)
-    return np.where(present, with_x, x / vc), alone
+    return CreepCells(cb, P, tail, np.minimum(np.min(P, axis=1), tail))
 
 
 def window_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, grid_s: np.ndarray,

@@ -15,8 +15,9 @@ its bound comes within HUMP_TURN_MARGIN of the bracket) on
 ``../shared/corpus/lcnc_arc_arc_sawtooth.ngc`` (``acc+freq``, default gap): the oracle's
 wall time and the bound's time with the run and without it (the margin set to 0), and
 both brackets; left out where ``../shared`` is absent. Before it, the rows of the rule in
-the jerk relaxation (:mod:`optimal.freq.windows`) on examples/demo.mpf: their time
-against the jerk solve, and the bound with them.
+the jerk relaxation (:mod:`optimal.freq.windows` and :mod:`optimal.freq.chains`) on
+examples/demo.mpf and examples/slot.ngc: their time against the jerk solve, and the
+bound with them.
 """
 
 from __future__ import annotations
@@ -76,19 +77,23 @@ def main() -> int:
           f"{(t2 - t1) / (t1 - t0):>10.2f}  [{j.lower_bound_s:.4f}, {j.upper_bound_s:.4f}] | "
           f"[{f.lower_bound_s:.4f}, {f.upper_bound_s:.4f}] at the default gap "
           f"({f.status}, {f.gap:.2%})", flush=True)
-    window_row(machine)
+    for name in ("demo.mpf", "slot.ngc"):
+        window_row(machine, name)
     turn_run_row(machine)
     return 0
 
 
-def window_row(machine) -> None:
-    """The jerk relaxation with the rule's rows (:mod:`optimal.freq.windows`) on
-    examples/demo.mpf, whose plunge needs them: the time of that bound alone against the
-    jerk solve on the same path, and the bracket with and without it."""
+def window_row(machine, name: str) -> None:
+    """The jerk relaxation with the rule's rows (:mod:`optimal.freq.windows`, and the
+    chains of :mod:`optimal.freq.chains`) on a bundled example (examples/demo.mpf's
+    plunge needs the windows, examples/slot.ngc's zig-zag the chains): the time of those
+    rows and that bound against the jerk solve on the same path, and the bracket with and
+    without them."""
+    from optimal.freq.chains import chain_rows
     from optimal.freq.windows import window_lower_bound, window_rows
     from reference.nc import parse_file
 
-    path = build_path(parse_file(HERE.parents[1] / "examples" / "demo.mpf"), machine)
+    path = build_path(parse_file(HERE.parents[1] / "examples" / name), machine)
     t0 = time.perf_counter()
     j = optimal.solve(path, machine.limits, bounds="jerk")
     t1 = time.perf_counter()
@@ -100,15 +105,21 @@ def window_row(machine) -> None:
     lim = machine.limits.for_axes(work.axes)
     hold = j.holds.total_s
     t_up = f.upper_bound_s - hold
+    args = (work, lim, machine.limits.t_ipo_s, acc.grid, j.segment_lower_bounds_s, t_up,
+            j.holds.break_index)
     t3 = time.perf_counter()
-    rows = window_rows(work, lim, machine.limits.t_ipo_s, acc.grid,
-                       j.segment_lower_bounds_s, t_up, j.holds.break_index)
-    lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, j.grid,
-                            j.segment_lower_bounds_s, rows, t_up, j.holds.break_index)
+    windows = window_rows(*args)
     t4 = time.perf_counter()
-    print(f"{'windows':>9} demo.mpf: jerk {t1 - t0:.2f} s, jerk+freq {t2 - t1:.2f} s; "
-          f"{rows.value.size} rows and their relaxation {t4 - t3:.2f} s "
-          f"(x{(t4 - t3) / (t1 - t0):.2f} of the jerk solve); lower bound "
+    chains = chain_rows(*args)
+    t5 = time.perf_counter()
+    lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, j.grid,
+                            j.segment_lower_bounds_s, windows.joined(chains), t_up,
+                            j.holds.break_index)
+    t6 = time.perf_counter()
+    print(f"{'rows':>9} {name}: jerk {t1 - t0:.2f} s, jerk+freq {t2 - t1:.2f} s; "
+          f"{windows.value.size} window rows {t4 - t3:.2f} s, {chains.value.size} chain rows "
+          f"{t5 - t4:.3f} s, relaxation with them {t6 - t5:.2f} s (all: "
+          f"x{(t6 - t3) / (t1 - t0):.2f} of the jerk solve); lower bound "
           f"{j.lower_bound_s:.4f} -> {lb + hold:.4f} s; jerk+freq [{f.lower_bound_s:.4f}, "
           f"{f.upper_bound_s:.4f}] {f.gap:.2%} ({f.status})", flush=True)
 

@@ -316,6 +316,115 @@ def test_window_rows_stop_at_holds():
         assert not (lo < 1 < hi)
 
 
+# --- the chain rows of optimal.freq.chains (a run of short segments) ------------------
+
+def _end(g, cb=None, P=None, tail=np.inf, least=0.0):
+    """An end of a run for :func:`optimal.freq.chains._chain_bound`: a cut (no creep)
+    or cells of a creep with the given costs."""
+    from optimal.freq.chains import _EndCost
+    e = _EndCost.__new__(_EndCost)
+    e.g, e.tail, e.least = g, tail, least
+    e.cb = np.zeros(1) if cb is None else np.asarray(cb, float)
+    e.P = np.zeros(1) if P is None else np.asarray(P, float)
+    return e
+
+
+def _chain_brute_force(flat, L, w_flat, u, peak_ok, g, start, end):
+    """Steps 2 to 4 of optimal.freq.chains over every choice of peaked segments."""
+    import itertools
+    n = flat.size
+    one = lambda x: np.array([x], float)          # noqa: E731
+    best = flat.sum() + start.least + end.least
+    cand = [k for k in range(n) if peak_ok[k]]
+    for r in range(1, len(cand) + 1):
+        for peaks in itertools.combinations(cand, r):
+            k1, kp = peaks[0], peaks[-1]
+            tot = start(one(flat[:k1].sum()), one(L[:k1].sum()),
+                        one(np.max(w_flat[:k1], initial=0.0) if k1 else np.inf),
+                        one(u[k1]))[0]
+            for k0, k in zip(peaks[:-1], peaks[1:]):
+                S, D = flat[k0 + 1:k].sum(), L[k0 + 1:k].sum()
+                spread = (max(D - (u[k0 + 1] + u[k]) * g, 0.0)
+                          / np.max(w_flat[k0 + 1:k]) if D > 0 else 0.0)
+                tot += max(S, 2 * g + spread)
+            tot += end(one(flat[kp + 1:].sum()), one(L[kp + 1:].sum()),
+                       one(np.max(w_flat[kp + 1:], initial=0.0) if kp < n - 1 else np.inf),
+                       one(u[kp + 1]))[0]
+            best = min(best, tot)
+    return best
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_chain_bound_is_the_least_over_every_choice_of_peaks(seed):
+    # the shortest path of _chain_bound against enumerating every set of peaks, on
+    # random runs with cut ends and with creep ends
+    from optimal.freq.chains import _chain_bound
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 8))
+    g = 0.05
+    L = rng.uniform(0.2, 3.0, n)
+    u = rng.uniform(1.0, 20.0, n + 1)
+    w_flat = np.maximum(u[:-1], u[1:]) * rng.uniform(1.0, 1.5, n)
+    flat = L / w_flat * rng.uniform(1.0, 1.2, n)
+    peak_ok = rng.random(n) < 0.8
+    if seed % 2:
+        cb = np.linspace(0.0, 0.1, 9)[1:]
+        start = _end(g, cb, 0.3 + cb * rng.uniform(0.2, 1.0), 0.45, 0.3)
+        end = _end(g, cb, 0.2 + cb * rng.uniform(0.2, 1.0), 0.35, 0.2)
+    else:
+        start, end = _end(g), _end(g)
+    got = _chain_bound(flat, L, w_flat, u, peak_ok, g, start, end)
+    assert got == pytest.approx(_chain_brute_force(flat, L, w_flat, u, peak_ok, g, start,
+                                                   end), rel=1e-12)
+
+
+def _zig_zag(n):
+    # n steps of 1.02 mm with 22 degree kinks at F3000 on 20 Hz axes, rest to rest: each
+    # kink caps the speed near 4 mm/s, so every step rises and falls once, for 1/f each
+    return line_path([[i * 1.0, 0.2 * (i % 2), 0.0] for i in range(n + 1)], feed=50.0)
+
+
+def test_zig_zag_rises_and_falls_once_per_step():
+    # by hand: n peaks between rests, a rise before the first and a fall after the last,
+    # and between two peaks a fall and a rise: 2 n / f (the checker's RATIO_TOL on 1/f
+    # lowers it); ruckig, rest to rest on every step with the acceleration lowered until
+    # each phase lasts 1/f, is a motion of the set, so the bound is below it; the
+    # oracle's motion is judged by the checker
+    from optimal.freq.chains import chain_rows
+    n, f = 4, 20.0
+    lim = machine(f=f)
+    path = _zig_zag(n)
+    sol_j = optimal.solve(path, lim, bounds="jerk", initial_intervals=N0)
+    rows = chain_rows(path, lim.for_axes(path.axes), T_IPO, path.s_breaks,
+                      sol_j.segment_lower_bounds_s, 10.0)
+    assert rows.lo.tolist() == [0] and rows.hi.tolist() == [n]
+    assert rows.value[0] == pytest.approx(2 * n / f, rel=2 * RATIO_TOL + 1e-6)
+    assert rows.value[0] > 1.5 * sol_j.lower_bound_s      # the jerk alone allows far less
+    step = float(np.hypot(1.0, 0.2))
+    ref = n * ruckig_lowered(step, 50.0, 2000.0, 100_000.0, 1 / f)
+    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    # the relaxation with the row certifies it less its solver margin
+    from optimal.jerk.tolerances import RELAX_SOLVER_MARGIN_REL
+    assert sol.lower_bound_s >= rows.value[0] * (1 - 2 * RELAX_SOLVER_MARGIN_REL)
+    assert sol.lower_bound_s <= ref * (1 + MATCH_SLACK)
+    assert sol.lower_bound_s <= sol.upper_bound_s
+    rep = check_profile(path, lim, sol.profile)
+    assert rep.ok(BOUND_SETS["jerk+freq"]), rep.violations(BOUND_SETS["jerk+freq"])
+
+
+def test_chain_rows_stop_at_holds():
+    # a hold rests the motion (no phase runs through it): the rows end there, and each
+    # side then holds its own rise or fall
+    from optimal.freq.chains import chain_rows
+    lim = machine(f=20.0)
+    path = _zig_zag(6)
+    floors = np.full(6, 0.049)
+    held = chain_rows(path, lim.for_axes(path.axes), T_IPO, path.s_breaks, floors, 10.0,
+                      hold_breaks=np.array([3]))
+    assert sorted(zip(held.lo.tolist(), held.hi.tolist())) == [(0, 3), (3, 6)]
+    assert held.value == pytest.approx([0.3, 0.3], rel=2 * RATIO_TOL + 1e-6)
+
+
 def test_demo_meets_the_default_bracket_under_jerk_and_frequency():
     # issue 12 item 2 (bracket <= 2 % by default) on examples/demo.mpf, default machine:
     # its plunge (5 mm at F1200 on Z, LOOKAH_FREQUENCY 15 Hz) between a reversal and a
