@@ -135,7 +135,7 @@ from reference.core.tolerances import RATIO_TOL, VEL_TOL_MM_S
 from ..bounds import speed_envelope_bounds
 from ..grid import Grid
 from ..tolerances import LB_ROUNDOFF_REL
-from .lower import rest_pieces, segment_periods
+from .lower import path_accel_bound, rest_pieces, segment_periods
 
 __all__ = ["HUMP_CELL_TIME_REL", "HUMP_CHAIN_PERIODS", "HUMP_COARSE_CELL_TIME_REL",
            "HUMP_MAX_CELLS", "HUMP_MERGE_SHARE", "HUMP_REFINE_MARGIN", "HUMP_SPREAD_REL",
@@ -295,9 +295,10 @@ def _tents(path: Path, lim: AxisArrays, grid: Grid,
         top = np.where(good, np.clip((b1 - b0 + Mg * D) / (2 * np.where(good, Mg, 1.0)),
                                      0.0, D), 0.0)
     per = segment_periods(path, lim)[grid.segment] / (1.0 + RATIO_TOL)
-    a_bar = 0.5 * float(np.max(M[np.isfinite(M)], initial=0.0)) * (1.0 + RATIO_TOL)
-    if not np.all(np.isfinite(M)):
-        a_bar = math.inf
+    # |s''| <= M / 2 where the slopes are finite; the axes' bound holds everywhere
+    a_bar = path_accel_bound(path, lim)
+    if np.all(np.isfinite(M)):
+        a_bar = min(a_bar, 0.5 * float(np.max(M, initial=0.0)) * (1.0 + RATIO_TOL))
     return _Tents(s, b0, b1, B, Mg, top, per, a_bar)
 
 

@@ -137,6 +137,31 @@ def test_frequency_bound_decides_many_short_exact_stop_moves():
     assert check_profile(path, lim, frq.profile).ok(BOUND_SETS["jerk+freq"])
 
 
+def test_path_acceleration_bound_is_reached_on_a_diagonal_and_holds_on_small_arcs():
+    # abar of optimal/freq/lower.py bounds |s''| of every accepted motion by the axes'
+    # accelerations alone: (sum A_i^2)^(1/2). By hand it is reached on a line along the
+    # diagonal of two axes at their limit (s'' = A sqrt 2 there), and on arcs of 0.3 mm
+    # at speed (the old bound grew with the curvature times V_max^2, here 100 times this
+    # one) the acc oracle's motion, judged by the checker, stays below it
+    from optimal.freq.lower import path_accel_bound
+    lim = machine()
+    diag = line_path([[0, 0, 0], [40, 40, 0]], feed=np.inf)
+    moved = diag.restricted(diag.moving_axes())
+    bound = path_accel_bound(moved, lim.for_axes(moved.axes))
+    assert bound == pytest.approx(2000.0 * np.sqrt(2.0) * (1 + RATIO_TOL), rel=1e-15)
+    sol = optimal.solve(diag, lim, bounds="acc", initial_intervals=N0)
+    assert check_profile(diag, lim, sol.profile).ok(BOUND_SETS["acc"])
+    assert np.max(np.abs(sol.profile.a)) == pytest.approx(2000.0 * np.sqrt(2.0), rel=1e-3)
+    assert np.max(np.abs(sol.profile.a)) <= bound
+    arcs = line_arc_line(0.3, 2.0, feed=300.0)
+    sol = optimal.solve(arcs, lim, bounds="acc", initial_intervals=N0)
+    assert check_profile(arcs, lim, sol.profile).ok(BOUND_SETS["acc"])
+    work = arcs.restricted(arcs.moving_axes())
+    assert np.max(np.abs(sol.profile.a)) <= path_accel_bound(work, lim.for_axes(work.axes))
+    old = np.sqrt(2) * (2000.0 + (1 / 0.3) * 2 * 500.0 ** 2)
+    assert old > 100 * path_accel_bound(work, lim.for_axes(work.axes))
+
+
 @pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
 def test_dip_at_a_curvature_jump_beats_the_hand_plateau(bounds):
     # line -> half circle R -> line at F150, f = 10 Hz. The jerk set caps the speed where
