@@ -309,13 +309,14 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
             rlen[la], rmin[la], rate[la] = sh.length, sh.radius, sh.rate
             piece[la] = np.minimum(sh.piece, sh.ramp)
             small[la], cut[la], devo[la] = small_la, cut_la, sh.deviation
-        search, newton = _compiled_parts(int(np.sum(sbend[o] | samedir[o])))
+        search, newton, pieces = _compiled_parts(int(np.sum(sbend[o] | samedir[o])))
         for kind, sized, shape_of, measured, to_rows, n_p in (
                 (sbend, partial(sbend_for_deviation, search=search), sbend_shape,
                  partial(sbend_measured, search=search), sbend_rows, SBEND_PIECES),
-                (samedir, partial(samedir_for_deviation, search=search, newton=newton),
+                (samedir, partial(samedir_for_deviation, search=search, newton=newton,
+                                  pieces=pieces),
                  partial(samedir_shape, newton=newton),
-                 partial(samedir_measured, search=search), samedir_rows,
+                 partial(samedir_measured, search=search, pieces=pieces), samedir_rows,
                  SAMEDIR_PIECES)):
             sel = kind[o]
             at = o[sel]
@@ -456,16 +457,17 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
 
 
 def _compiled_parts(n: int) -> tuple:
-    """The deviation search and the same-way landing's Newton iteration for ``n``
-    two-arc transitions: the compiled ones (:func:`reference.transition_kernel.
-    deviation_where` and :func:`~reference.transition_kernel.samedir_newton`, bit for
+    """The deviation search, the same-way landing's Newton iteration and the same-way
+    pieces for ``n`` two-arc transitions: the compiled ones (:func:`reference.
+    transition_kernel.deviation_where`, :func:`~reference.transition_kernel.
+    samedir_newton` and :func:`~reference.transition_kernel.samedir_pieces`, bit for
     bit the vectorised ones) from :data:`SEARCH_COMPILED_MIN` transitions on or once
-    they are loaded, else ``(None, None)`` (the vectorised ones, without loading
+    they are loaded, else ``(None, None, None)`` (the vectorised ones, without loading
     numba)."""
     if n < SEARCH_COMPILED_MIN and _KERNEL not in sys.modules:
-        return None, None
-    from .transition_kernel import deviation_where, samedir_newton
-    return deviation_where, samedir_newton
+        return None, None, None
+    from .transition_kernel import deviation_where, samedir_newton, samedir_pieces
+    return deviation_where, samedir_newton, samedir_pieces
 
 
 def _leftovers(path: Path, a: np.ndarray, b: np.ndarray, cut_in: np.ndarray,

@@ -1,7 +1,8 @@
 """Compiled parts of the two-arc transitions' sizing (numba): the deviation search of
-:func:`reference.core.transition_sbend._deviation_where` and the steps of the same-way
-landing's Newton iteration (:func:`reference.core.transition_samedir._newton`), written
-as the plain loops they are.
+:func:`reference.core.transition_sbend._deviation_where`, the same-way landing's Newton
+iteration (:func:`reference.core.transition_samedir._newton`) and the same-way pieces
+the search measures (:func:`reference.core.transition_samedir._canonical_pieces`),
+written as the plain loops they are.
 
 The search is that of :func:`reference.core.transition_sbend.pieces_deviation` (its
 docstring has the argument): samples along the rounding, scan rounds around the largest,
@@ -34,16 +35,22 @@ lookahead_kernel`: from :data:`reference.rounding_tangential.SEARCH_COMPILED_MIN
 transitions on, or once loaded, else the vectorised search runs (the core modules take
 it as an argument, ``search``: they import only numpy and scipy).
 
-The same-way landing (:func:`samedir_newton`): each Newton step of every transition still
-iterating is one compiled loop (:func:`_newton_step`: the landing's miss and Jacobian,
-the step and its halvings, with ``_landing``'s and ``_halved``'s operations), the
-iteration around it, its compaction and its verdicts those of ``_newton``. Only
-``tan(h/2)`` is taken from numpy, once per step over the transitions still iterating:
-numpy's float64 ``tan`` is vectorised (SVML on AVX-512) and differs from the C
-library's in the last bit. Why: the transitions beyond the flatter arc's fold (radius
-ratio about 16) wander for all ``NEWTON_MAX_ITER`` steps there, each step some 170
-numpy operations on a few hundred transitions (measured: the 22 landings of the
-same-way quick row's sizing, 63 -> 12 ms CPU).
+The same-way landing (:func:`samedir_newton`): the whole iteration of ``_newton`` is
+one compiled loop (:func:`_newton_loop`: per step and transition still iterating
+:func:`_step`, the landing's miss and Jacobian, the step and its halvings, with
+``_landing``'s and ``_halved``'s operations; the compaction and the verdicts those of
+``_newton``). Only ``tan(h/2)`` is taken from numpy, called back from the loop once per
+step over the transitions still iterating (:func:`_half_turn_tan`): numpy's float64
+``tan`` is vectorised (SVML on AVX-512) and differs from the C library's in the last
+bit. Why: the transitions beyond the flatter arc's fold (radius ratio about 16) wander
+for all ``NEWTON_MAX_ITER`` steps there, each step some 170 numpy operations on a few
+hundred transitions (measured: the 22 landings of the same-way quick row's sizing,
+63 -> 12 ms CPU with each step compiled). With only the steps compiled, every step
+still went through Python (the call of the step's loop with its thirteen arrays, the
+compaction of nine arrays, the verdicts' writes), some 280 times per ``build_path`` of
+the same-way row of 10^4 arcs: its landings 41 -> 36 ms wall with the loop compiled
+(the call back for ``tan`` costs some 2 us a step); what is left is the landings'
+own arithmetic, a Fresnel integral and some ten sines and cosines per step.
 
 Units: mm. Shapes: ``k`` transitions, ``p`` pieces each.
 """
@@ -54,14 +61,15 @@ import math
 
 import llvmlite.binding as llvm
 import numpy as np
-from numba import njit, types
+from numba import njit, objmode, types
 from numba.extending import get_cython_function_address
 
+from .core.transition import ramp_offset
 from .core.transition_samedir import NEWTON_MAX_ITER as NEWTON_MAX_ITER_SAMEDIR
 from .core.transition_samedir import STEP_HALVINGS, _start
 from .core.transition_sbend import (DEV_SAMPLES, LANDING_TOL_MM, NEWTON_MAX_ITER,
                                     NEWTON_STEP_TOL, REFINE_POINTS, REFINE_SHRINK,
-                                    SCAN_ROUNDS, THETA_MAX, _packed, _refine_sampled)
+                                    SCAN_ROUNDS, THETA_MAX, _refine_sampled)
 
 # scipy's Fresnel integrals for one double (S, C by pointer), the C function behind
 # scipy.special.fresnel, called by its symbol name (a ctypes pointer would be a constant
@@ -301,6 +309,11 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
         sv = np.empty(p * n1)
         d = np.empty(off.size)
         xs = np.empty(off.size)
+        # every piece has a sample at its zero-curvature end (sigma 0): the integrals
+        # there, of +0 and of -0, evaluated once (the same numbers as at each sample)
+        zero = np.empty(4)
+        _FRESNEL(0.0, zero[0:].ctypes, zero[1:].ctypes)
+        _FRESNEL(-0.0, zero[2:].ctypes, zero[3:].ctypes)
         for t in range(k):
             for j in range(p):
                 rate, length, st = packed[t, j, 6], packed[t, j, 7], packed[t, j, 8]
@@ -308,7 +321,12 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
                 for i in range(n1):
                     s_local = length * lin[i]
                     sigma = length - s_local if rate < 0 else s_local
-                    _FRESNEL(sigma / scale, sc[0:].ctypes, sc[1:].ctypes)
+                    z = sigma / scale
+                    if z == 0.0:
+                        zi = 0 if math.copysign(1.0, z) > 0 else 2
+                        sc[0], sc[1] = zero[zi], zero[zi + 1]
+                    else:
+                        _FRESNEL(z, sc[0:].ctypes, sc[1:].ctypes)
                     fc, fs = scale * sc[1], scale * sc[0]
                     x = packed[t, j, 0] + fc * packed[t, j, 2] + fs * packed[t, j, 4]
                     y = packed[t, j, 1] + fc * packed[t, j, 3] + fs * packed[t, j, 5]
@@ -375,6 +393,26 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
     return best, where, at, h0, lo, hi, ok
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def _pack(origin, e1, e2, rates, lengths):  # pragma: no cover - compiled
+    """``transition_sbend._packed`` of the pieces (the starts as there: the running sum
+    of the lengths, piece by piece as ``numpy.cumsum``, less the piece's own length)."""
+    k, p = lengths.shape
+    out = np.empty((k, p, 9))
+    for t in range(k):
+        run = 0.0
+        for j in range(p):
+            out[t, j, 0], out[t, j, 1] = origin[t, j, 0], origin[t, j, 1]
+            out[t, j, 2], out[t, j, 3] = e1[t, j, 0], e1[t, j, 1]
+            out[t, j, 4], out[t, j, 5] = e2[t, j, 0], e2[t, j, 1]
+            out[t, j, 6] = rates[t, j]
+            length = lengths[t, j]
+            out[t, j, 7] = length
+            run = length if j == 0 else run + length
+            out[t, j, 8] = run - length
+    return out
+
+
 def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
                     scan=SCAN_ROUNDS):
     """:func:`reference.core.transition_sbend._deviation_where` by the compiled
@@ -383,7 +421,9 @@ def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMP
     k = lengths.shape[0]
     f64 = np.float64
     total = lengths.sum(axis=1)
-    packed = np.ascontiguousarray(_packed(pieces), f64)
+    # packed by one compiled loop: numpy's concatenation of the (k, p, 2) strided parts
+    # took about as long as a near search (1.1 ms of 8,000 transitions)
+    packed = _pack(*(np.asarray(v, f64) for v in pieces))
     r_in, r_out, centre_out = (np.ascontiguousarray(v, f64) for v in (r_in, r_out,
                                                                         centre_out))
     use_near = near is not None
@@ -427,13 +467,14 @@ def _landing(t1, p2, r_in, r_out, rate, xq1, yq1, xq2, yq2, th, sc,
     _FRESNEL(1.0 / scale, sc[0:].ctypes, sc[1:].ctypes)
     big_x, big_y = scale * sc[1], scale * sc[0]
     d_1 = big_x + big_y * th
-    half = h / 2.0
-    e_1 = big_y / math.cos(half)
+    # clothoid_pair_shape's cos(h / 2) is the Jacobian's cos(0.5 h): halving is exact,
+    # so one cosine serves both
+    ch, sh = math.cos(0.5 * h), math.sin(0.5 * h)
+    e_1 = big_y / ch
     d_p = l_p * d_1
     wx, wy = uax + ubx, uay + uby
     out[0] = q2x - q1x - d_p * wx
     out[1] = q2y - q1y - d_p * wy
-    ch, sh = math.cos(0.5 * h), math.sin(0.5 * h)
     y = e_1 * ch
     x = d_1 - y * th
     dd1 = (ch - x) / (2.0 * h) + (sh - y) / (2.0 * h) * th + 0.5 * y / (ch * ch)
@@ -445,87 +486,173 @@ def _landing(t1, p2, r_in, r_out, rate, xq1, yq1, xq2, yq2, th, sc,
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _newton_step(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, tol, theta_max,
-                 halvings):  # pragma: no cover - compiled
-    """One step of ``transition_samedir._newton`` for every transition still iterating
-    (shape (m,) each): whether it lands at ``(a1, a2)``, whether it steps, and the
-    iterates after the step (``_halved`` included)."""
-    m = a1.size
-    ok = np.empty(m, dtype=np.bool_)
-    step = np.empty(m, dtype=np.bool_)
-    n1 = a1.copy()
-    n2 = a2.copy()
-    sc = np.empty(2)
-    out = np.empty(6)
-    for i in range(m):
-        _landing(a1[i], a2[i], r1[i], r2[i], c[i], xq1[i], yq1[i], xq2[i], yq2[i], th[i],
-                 sc, out)
-        g0, g1 = out[0], out[1]
-        ok[i] = abs(g0) <= tol and abs(g1) <= tol
-        j00, j01, j10, j11 = out[2], out[3], out[4], out[5]
-        det = j00 * j11 - j01 * j10
-        dt = -(j11 * g0 - j01 * g1) / det
-        dp = -(j00 * g1 - j10 * g0) / det
-        a, b = a1[i] + dt, a2[i] + dp
-        if not (a + a2[i] + dp > 0 and abs(a) < theta_max and abs(b) < theta_max):
-            # the halvings dt 2^-k, the first allowed, else the last
-            ct, cp = dt, dp
-            for k in range(halvings + 1):
-                if k > 0:
-                    ct, cp = ct * 0.5, cp * 0.5
-                a, b = a1[i] + ct, a2[i] + cp
-                if k == halvings or (a + a2[i] + cp > 0 and abs(a) < theta_max
-                                     and abs(b) < theta_max):
-                    break
-            dt, dp = ct, cp
-        step[i] = (not ok[i]) and np.isfinite(dt) and np.isfinite(dp)
-        if step[i]:
-            n1[i] = a1[i] + dt
-            n2[i] = a2[i] + dp
-    return ok, step, n1, n2
+def _step(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, tol, theta_max, halvings, sc,
+          out):  # pragma: no cover - compiled
+    """One step of ``transition_samedir._newton`` for one transition at ``(a1, a2)``:
+    whether it lands there, whether it steps, and the iterate after the step
+    (``_halved`` included); ``sc``, ``out`` scratch of :func:`_landing`."""
+    _landing(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, sc, out)
+    g0, g1 = out[0], out[1]
+    ok = abs(g0) <= tol and abs(g1) <= tol
+    j00, j01, j10, j11 = out[2], out[3], out[4], out[5]
+    det = j00 * j11 - j01 * j10
+    dt = -(j11 * g0 - j01 * g1) / det
+    dp = -(j00 * g1 - j10 * g0) / det
+    a, b = a1 + dt, a2 + dp
+    if not (a + a2 + dp > 0 and abs(a) < theta_max and abs(b) < theta_max):
+        # the halvings dt 2^-k, the first allowed, else the last
+        ct, cp = dt, dp
+        for k in range(halvings + 1):
+            if k > 0:
+                ct, cp = ct * 0.5, cp * 0.5
+            a, b = a1 + ct, a2 + cp
+            if k == halvings or (a + a2 + cp > 0 and abs(a) < theta_max
+                                 and abs(b) < theta_max):
+                break
+        dt, dp = ct, cp
+    step = (not ok) and np.isfinite(dt) and np.isfinite(dp)
+    if step:
+        return ok, step, a1 + dt, a2 + dp
+    return ok, step, a1, a2
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _lands(a1, a2, r1, r2, c, xq1, yq1, xq2, yq2, th, tol):  # pragma: no cover
-    """Whether each transition's landing misses by at most ``tol`` at ``(a1, a2)``."""
-    out = np.empty(6)
+def _numpy_tan(x: np.ndarray) -> np.ndarray:
+    """``numpy.tan(x)`` (float64) as the vectorised landing takes it (see
+    :func:`samedir_newton`)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.tan(x)
+
+
+@njit(cache=True, error_model="numpy")
+def _half_turn_tan(t1, p2, act, m):  # pragma: no cover - compiled
+    """``numpy.tan(0.5 * (t1 + p2))`` of the transitions ``act[:m]``, shape (m,): the
+    sum and the half in this loop (the same operations as numpy's), the tangent by
+    numpy itself, called back from the compiled loop (numpy's float64 ``tan`` differs
+    from the C library's in the last bit where it is vectorised). Without ``nogil``:
+    the call back holds the interpreter."""
+    half = np.empty(m)
+    for n in range(m):
+        i = act[n]
+        half[n] = 0.5 * (t1[i] + p2[i])
+    with objmode(th="float64[:]"):
+        th = _numpy_tan(half)
+    return th
+
+
+@njit(cache=True, error_model="numpy")
+def _newton_loop(t1, p2, r1, r2, c, xq1, yq1, xq2, yq2, tol, theta_max, halvings,
+                 max_iter):  # pragma: no cover - compiled
+    """The iteration of ``transition_samedir._newton`` from the start ``(t1, p2)``
+    (shape (k,) each, updated in place to each transition's last iterate): whether each
+    lands, before the final ``h > 0`` test. The transitions still iterating are the
+    first ``m`` of ``act`` (a transition leaves it when it lands or its step is not
+    finite, keeping the order), so each one's iterates are those it has alone."""
+    k = t1.size
+    lands = np.zeros(k, dtype=np.bool_)
+    act = np.arange(k)
+    m = k
     sc = np.empty(2)
-    res = np.empty(a1.size, dtype=np.bool_)
-    for i in range(a1.size):
-        _landing(a1[i], a2[i], r1[i], r2[i], c[i], xq1[i], yq1[i], xq2[i], yq2[i], th[i],
-                 sc, out)
-        res[i] = abs(out[0]) <= tol and abs(out[1]) <= tol
-    return res
+    out = np.empty(6)
+    for _ in range(max_iter):
+        if m == 0:
+            break
+        th = _half_turn_tan(t1, p2, act, m)
+        keep = 0
+        for n in range(m):
+            i = act[n]
+            ok, step, t1[i], p2[i] = _step(t1[i], p2[i], r1[i], r2[i], c[i], xq1[i],
+                                           yq1[i], xq2[i], yq2[i], th[n], tol, theta_max,
+                                           halvings, sc, out)
+            if ok:
+                lands[i] = True
+            if step:
+                act[keep] = i
+                keep += 1
+        m = keep
+    if m:                                     # still iterating: the miss after the last step
+        th = _half_turn_tan(t1, p2, act, m)
+        for n in range(m):
+            i = act[n]
+            _landing(t1[i], p2[i], r1[i], r2[i], c[i], xq1[i], yq1[i], xq2[i], yq2[i],
+                     th[n], sc, out)
+            lands[i] = abs(out[0]) <= tol and abs(out[1]) <= tol
+    return lands
 
 
 def samedir_newton(r_in, r_out, ramp, rate, off, flat_out):
-    """:func:`reference.core.transition_samedir._newton` with each step compiled
-    (:func:`_newton_step`; the same arguments and results, bit for bit). ``tan(h/2)``
-    is numpy's, computed here over the transitions still iterating as ``_landing``
-    computes it (numpy's float64 ``tan`` is vectorised, SVML on AVX-512, and differs
-    from the C library's in the last bit); every other operation the C library's, which
-    numpy's float64 loops match."""
+    """:func:`reference.core.transition_samedir._newton` compiled (:func:`_newton_loop`;
+    the same arguments and results, bit for bit). ``tan(h/2)`` is numpy's, called back
+    from the loop over the transitions still iterating as ``_landing`` computes it
+    (numpy's float64 ``tan`` is vectorised, SVML on AVX-512, and differs from the C
+    library's in the last bit); every other operation the C library's, which numpy's
+    float64 loops match."""
     t1, p2 = _start(r_in, r_out, ramp, rate, flat_out)
-    lands = np.zeros(t1.shape, bool)
-    act = np.arange(t1.size)
-    a1, a2 = t1, p2
-    r1, r2, c, o = r_in, r_out, rate, off
-    for _ in range(NEWTON_MAX_ITER_SAMEDIR):
-        if not act.size:
-            break
-        with np.errstate(invalid="ignore", divide="ignore"):
-            th = np.tan(0.5 * (a1 + a2))
-        ok, step, a1, a2 = _newton_step(a1, a2, r1, r2, c, *o, th, LANDING_TOL_MM,
-                                        THETA_MAX, STEP_HALVINGS)
-        lands[act[ok]] = True
-        if not step.all():                    # some stop: write back, compact the rest
-            t1[act], p2[act] = a1, a2
-            act, a1, a2 = act[step], a1[step], a2[step]
-            r1, r2, c, o = r1[step], r2[step], c[step], tuple(x[step] for x in o)
-    if act.size:                              # still iterating: the miss after the last step
-        t1[act], p2[act] = a1, a2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            th = np.tan(0.5 * (a1 + a2))
-        lands[act] = _lands(a1, a2, r1, r2, c, *o, th, LANDING_TOL_MM)
+    f64 = np.float64
+    t1, p2 = np.array(t1, f64), np.array(p2, f64)
+    args = (np.ascontiguousarray(v, f64) for v in (r_in, r_out, rate, *off))
+    lands = _newton_loop(t1, p2, *args, LANDING_TOL_MM, THETA_MAX, STEP_HALVINGS,
+                         NEWTON_MAX_ITER_SAMEDIR)
     lands &= t1 + p2 > 0
     return np.where(lands, t1, np.nan), np.where(lands, p2, np.nan)
+
+
+# ----------------------------------------------------------------- same-way pieces
+@njit(cache=True, nogil=True, error_model="numpy")
+def _samedir_pieces(theta, phi, r_in, r_out, ramp_in, ramp_out, piece, rate, xq1, yq1,
+                    xq2, yq2):  # pragma: no cover - compiled
+    """``transition_samedir._canonical_pieces`` (with ``_ends``) of ``k`` transitions
+    whose ramps start at ``(xq1, yq1)``, ``(xq2, yq2)`` (shape (k,) each): its
+    operations, per transition, in its order (``2 sin^2(b/2)`` as two products, as
+    numpy's ``** 2``)."""
+    k = theta.size
+    origin = np.empty((k, 4, 2))
+    e1 = np.empty((k, 4, 2))
+    e2 = np.empty((k, 4, 2))
+    rates = np.empty((k, 4))
+    lengths = np.empty((k, 4))
+    for t in range(k):
+        t1, p2 = theta[t], phi[t]
+        b = -t1
+        uax, uay = math.cos(b), math.sin(b)
+        nax, nay = -uay, uax
+        ubx, uby = math.cos(p2), math.sin(p2)
+        nbx, nby = -uby, ubx
+        r1, r2 = r_in[t], r_out[t]
+        s1 = math.sin(0.5 * t1)
+        p1x, p1y = -r1 * math.sin(t1), 2.0 * r1 * (s1 * s1)
+        s2 = math.sin(0.5 * p2)
+        p2x, p2y = r2 * math.sin(p2), 2.0 * r2 * (s2 * s2)
+        q1x, q1y = p1x - xq1[t] * uax + yq1[t] * nax, p1y - xq1[t] * uay + yq1[t] * nay
+        q2x, q2y = p2x + xq2[t] * ubx + yq2[t] * nbx, p2y + xq2[t] * uby + yq2[t] * nby
+        for j, qx, qy, ux, uy, nx, ny in ((0, q1x, q1y, -uax, -uay, nax, nay),
+                                          (1, q1x, q1y, uax, uay, nax, nay),
+                                          (2, q2x, q2y, -ubx, -uby, nbx, nby),
+                                          (3, q2x, q2y, ubx, uby, nbx, nby)):
+            origin[t, j, 0], origin[t, j, 1] = qx, qy
+            e1[t, j, 0], e1[t, j, 1] = ux, uy
+            e2[t, j, 0], e2[t, j, 1] = nx, ny
+        c = rate[t]
+        rates[t, 0] = -1.0 / (r1 * ramp_in[t])
+        rates[t, 1] = c
+        rates[t, 2] = -c
+        rates[t, 3] = 1.0 / (r2 * ramp_out[t])
+        lengths[t, 0] = ramp_in[t]
+        lengths[t, 1] = piece[t]
+        lengths[t, 2] = piece[t]
+        lengths[t, 3] = ramp_out[t]
+    return origin, e1, e2, rates, lengths
+
+
+def samedir_pieces(sh):
+    """:func:`reference.core.transition_samedir._canonical_pieces` by the compiled
+    :func:`_samedir_pieces` (the same argument and results, bit for bit; the ramps'
+    starts by :func:`reference.core.transition.ramp_offset`, as there). Why: it builds
+    the pieces of every shape the sizing measures, some thirty numpy operations on
+    (k, 2) rows and five stacks each time (measured on 8,000 same-way transitions:
+    2.4 ms a call, 0.7 ms compiled, most of it the two ``ramp_offset``)."""
+    xq1, yq1, _, _ = ramp_offset(sh.r_in, sh.ramp_in)
+    xq2, yq2, _, _ = ramp_offset(sh.r_out, sh.ramp_out)
+    f64 = np.float64
+    return _samedir_pieces(*(np.ascontiguousarray(v, f64) for v in (
+        sh.theta, sh.phi, sh.r_in, sh.r_out, sh.ramp_in, sh.ramp_out, sh.piece, sh.rate,
+        xq1, yq1, xq2, yq2)))

@@ -416,18 +416,19 @@ def samedir_canonical(sh: SameDirShape, newton=None) -> SameDirShape:
     return scatter(sh, sharp[lands], part)
 
 
-def samedir_measured(sh: SameDirShape, search=None) -> SameDirShape:
+def samedir_measured(sh: SameDirShape, search=None, pieces=None) -> SameDirShape:
     """``sh`` with its deviation measured where it lands (``nan`` elsewhere): what
     :func:`samedir_shape` returns with ``deviation=True`` for the same radii and rates
     (its landing is each transition's own, whatever the batch); ``search`` as for
-    :func:`reference.core.transition_sbend.pieces_deviation`."""
+    :func:`reference.core.transition_sbend.pieces_deviation`, ``pieces`` as for
+    :func:`samedir_for_deviation`."""
     ok = np.isfinite(sh.theta)
     dev = np.full_like(sh.rate, np.nan)
     if ok.any():
         i = np.flatnonzero(ok)
         part = take(sh, i)
-        dev[i] = pieces_deviation(_canonical_pieces(part), part.r_in, part.r_out,
-                                  part.r_out, search)
+        dev[i] = pieces_deviation((pieces or _canonical_pieces)(part), part.r_in,
+                                  part.r_out, part.r_out, search)
     return SameDirShape(*(dev if f == "deviation" else getattr(sh, f)
                           for f in SameDirShape.__slots__))
 
@@ -453,7 +454,7 @@ def _canonical_pieces(sh: SameDirShape):
 
 
 def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
-                          search=None, newton=None) -> SameDirShape:
+                          search=None, newton=None, pieces=None) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
     :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
     of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
@@ -468,6 +469,10 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
         As for :func:`reference.core.transition_sbend.pieces_deviation`.
     newton : callable, optional
         As for :func:`samedir_shape`.
+    pieces : callable, optional
+        Another implementation of :func:`_canonical_pieces` (the same argument and
+        results, bit for bit: the compiled one of :mod:`reference.transition_kernel`);
+        by default :func:`_canonical_pieces`.
 
     Returns
     -------
@@ -479,7 +484,7 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     if newton is not None:
         shape_of = partial(samedir_shape, newton=newton)
         canonical = partial(samedir_canonical, newton=newton)
-    return size_for_deviation(shape_of, _canonical_pieces, r_out, r_in, r_out,
+    return size_for_deviation(shape_of, pieces or _canonical_pieces, r_out, r_in, r_out,
                               deviation, ratio_guess(_samedir_table(), r_in, r_out,
                                                      deviation),
                               canonical=canonical, search=search)

@@ -1,8 +1,10 @@
-"""The compiled deviation search and same-way landing (reference.transition_kernel) give
-the vectorised ones' numbers, bit for bit.
+"""The compiled deviation search, same-way landing and same-way pieces
+(reference.transition_kernel) give the vectorised ones' numbers, bit for bit.
 
-The references are :func:`reference.core.transition_sbend._deviation_where` and
-:func:`reference.core.transition_samedir._newton` themselves, run on the same inputs:
+The references are :func:`reference.core.transition_sbend._deviation_where`,
+:func:`reference.core.transition_samedir._newton` and
+:func:`reference.core.transition_samedir._canonical_pieces` themselves, run on the same
+inputs:
 random S-bends and transitions between arcs curving the same way (the full search, the
 sizing's coarse one and the local one ``near`` a place; the landing from either side,
 where it lands and where it wanders), every search and landing the sizing makes on the
@@ -24,7 +26,7 @@ from reference.machine import machine_from_dict
 from reference.nc import parse_text
 from reference.prepare import build_path
 from reference.core.transition import ramp_offset
-from reference.transition_kernel import deviation_where, samedir_newton
+from reference.transition_kernel import deviation_where, samedir_newton, samedir_pieces
 from seeded_programs import s_bend_chain, same_way_chain
 
 PATH_FIELDS = ("origin", "e1", "e2", "d", "radius", "omega", "theta0", "length", "block",
@@ -101,6 +103,21 @@ def test_compiled_landing_equals_the_vectorised_landing(seed):
         assert np.isnan(want[0]).any() and np.isfinite(want[0]).any()
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_compiled_pieces_equal_the_vectorised_pieces(seed):
+    """The same-way pieces of random transitions, those that land and those that do
+    not (``theta`` nan: every number nan where the vectorised ones are)."""
+    rng = np.random.default_rng(seed)
+    n = 400
+    r1 = rng.uniform(2.0, 200.0, n)
+    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, n))
+    rate = np.exp(rng.uniform(np.log(2.0), np.log(3000.0), n)) / np.minimum(r1, r2) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sh = samedir.samedir_shape(r1, r2, rate, deviation=False)
+    assert np.isnan(sh.theta).any() and np.isfinite(sh.theta).any()
+    _same(samedir._canonical_pieces(sh), samedir_pieces(sh))
+
+
 def _machine():
     """The default machine with PATH_TRANS_POS_TOL = 0.05 mm (most transitions rounded,
     as in the benchmark)."""
@@ -138,14 +155,14 @@ def test_every_search_of_the_sizing_and_the_path_are_the_same(monkeypatch, name)
     with monkeypatch.context() as mp:
         mp.setattr(sbend, "_deviation_where", both)
         mp.setattr(samedir, "_newton", both_newton)
-        mp.setattr(tangential, "_compiled_parts", lambda n: (None, None))
+        mp.setattr(tangential, "_compiled_parts", lambda n: (None, None, None))
         plain = build_path(prog, machine)
     assert {"near" in kw for kw in calls} == {False, True} and len(calls) >= 4
     assert (len(landings) >= 4) == (name == "same-way")
     assert int(plain.rounding.inserted.sum()) > 50
     with monkeypatch.context() as mp:
         mp.setattr(tangential, "_compiled_parts",
-                   lambda n: (deviation_where, samedir_newton))
+                   lambda n: (deviation_where, samedir_newton, samedir_pieces))
         fast = build_path(prog, machine)
     for f in PATH_FIELDS:
         assert np.array_equal(getattr(fast, f), getattr(plain, f)), f
