@@ -45,7 +45,8 @@ floor of segment ``k`` (it holds for every accepted motion). Take a run of segme
    phase runs through it: as in step 2, ``t*_{k1} - t_a >= max(S, g + (D - u_{k1} g)+ /
    W*)``. Elsewhere ``Q`` may start ``c`` before ``t_a``, on segment ``a - 1``: that is
    a creep at most at ``u_a`` as in :mod:`optimal.freq.windows`, and segment ``a - 1``
-   takes at least its creep cost ``P(c)`` (:func:`~optimal.freq.windows.creep_cells`);
+   takes at least its creep cost ``P(c)`` (:func:`~optimal.freq.windows.creep_cells`,
+   with the neighbour's own phase beside the creep);
    what is left of ``Q`` is ``(g - c)+``: ``T_{a-1} + t*_{k1} - t_a >= max(S, r + (D -
    u_{k1} r)+ / W*) + P(c)``, ``r = (g - c)+``, least over the cells of ``c``. With no
    peak in the run, the neighbour takes at least the least ``P``. After the last peak
@@ -72,7 +73,7 @@ from reference.core.limits import AxisArrays
 
 from ..jerk.relaxation import RunFloors
 from ..tolerances import LB_ROUNDOFF_REL
-from .windows import WINDOW_MIN_GAIN_REL, RuleEnvelope, creep_cells, rule_envelope
+from .windows import WINDOW_MIN_GAIN_REL, RuleEnvelope, creep_cells, own_phase, rule_envelope
 
 __all__ = ["CHAIN_WINDOW", "chain_rows"]
 
@@ -160,7 +161,8 @@ class _EndCost:
             return
         nb = j - 1 if leaving else j
         cells = creep_cells(rule.env, L, moving, np.array([nb]), rule.u[j:j + 1],
-                            np.array([g]), rule.a_bar, leaving)
+                            np.array([g]), rule.a_bar, leaving,
+                            own_phase(rule, np.array([nb]), np.array([j])))
         self.cb, self.P = cells.cb[0], cells.P[0]
         self.tail, self.least = float(cells.tail[0]), float(cells.least[0])
 

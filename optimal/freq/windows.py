@@ -43,7 +43,13 @@ with the checker's tolerances) and ``Vc_k`` the speed on segment ``k``
    ``|s''| <= eta abar + eps`` (the phase starts there; ``eps`` the segment's budget of
    acceleration steps): at least its jerk bound ``E(L' - delta)``
    (:func:`optimal.jerk.lower.peak_times` with those ends and a fixed ``t_cap``, which
-   is nondecreasing in the length). If the creep covers the whole segment it takes at
+   is nondecreasing in the length). The neighbour's own fall to the valley before the
+   creep also lies on that part if the neighbour peaks there (above ``W'``, its larger
+   corner bound plus ``dr``; a fall phase does not start before the peak): it loses
+   ``(V' - u0 - dr) g' / 2`` at the neighbour's top speed ``V'``, so the part takes at
+   least ``min(F'(W'), F'(Vc'))``, ``F'(V) = (L' - delta + X'(V)) / V``, monotone on
+   each piece; without a peak at least ``(L' - delta) / W'``; the larger of this and
+   ``E`` counts. If the creep covers the whole segment it takes at
    least ``L' / u0``. Mirrored after ``t_b``. At the path ends and at holds (zero
    acceleration for the hold's duration) no phase runs through: ``c = 0``.
 3. *The row.* ``T_{k-1} + T_k + T_{k+1} >= min over c0, c1 >= 0`` of
@@ -81,7 +87,7 @@ from ..tolerances import LB_ROUNDOFF_REL
 from .lower import path_accel_bound, segment_periods, segment_speed_caps
 
 __all__ = ["WINDOW_CELL_GROWTH", "WINDOW_LINEAR_CELLS", "WINDOW_MIN_GAIN_REL", "CreepCells", "RuleEnvelope",
-           "creep_cells", "rule_envelope", "window_lower_bound", "window_rows"]
+           "creep_cells", "own_phase", "rule_envelope", "window_lower_bound", "window_rows"]
 
 #: Cells of the creep time ``c`` from 0 to where the phase's lost time is used up
 #: (step 3): each gives away at most its width, ``g / 2`` over this (0.5 ms at 15 Hz).
@@ -179,7 +185,7 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     if m == 0 or not np.isfinite(t_upper):
         return none
     rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
-    env, u, vc, g, a_bar, dr = rule.env, rule.u, rule.vc, rule.g, rule.a_bar, rule.dr
+    env, u, vc, g, dr = rule.env, rule.u, rule.vc, rule.g, rule.dr
     L = path.length
     u0, u1 = u[:-1], u[1:]
     lo_v = np.maximum(u0, u1)
@@ -199,10 +205,10 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     # the creep before segment k (on k - 1, at most u_k) and after it (on k + 1, at most
     # u_{k+1}): the smallest of P + X / Vc over the cells, per side
     before, after = ~cut[sel], ~cut[sel + 1]
-    side0 = _side(env, L, moving, sel - 1, u0[sel], x0[sel], vc[sel], a_bar,
-                  leaving=True, present=before)
-    side1 = _side(env, L, moving, sel + 1, u1[sel], x1[sel], vc[sel], a_bar,
-                  leaving=False, present=after)
+    side0 = _side(rule, L, moving, sel - 1, sel, x0[sel], vc[sel], leaving=True,
+                  present=before)
+    side1 = _side(rule, L, moving, sel + 1, sel + 1, x1[sel], vc[sel], leaving=False,
+                  present=after)
     with np.errstate(divide="ignore"):
         far = L[sel] / lo_v[sel] + side0[1] + side1[1]
     near = L[sel] / vc[sel] + side0[0] + side1[0]
@@ -212,12 +218,12 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     return RunFloors(lo.astype(np.int64), hi.astype(np.int64), value)
 
 
-def _side(env, L: np.ndarray, moving: np.ndarray, nb: np.ndarray, u: np.ndarray,
-          x: np.ndarray, vc: np.ndarray, a_bar: float, leaving: bool, present: np.ndarray
+def _side(rule: RuleEnvelope, L: np.ndarray, moving: np.ndarray, nb: np.ndarray,
+          j: np.ndarray, x: np.ndarray, vc: np.ndarray, leaving: bool, present: np.ndarray
           ) -> tuple[np.ndarray, np.ndarray]:
     """Step 3 for one side of K segments: ``(min_c P(c) + X(c) / Vc, min_c P(c))`` per
-    segment, s, shape (K,) each. ``nb`` the neighbour on that side,
-    ``u`` the speed bound at the common break, ``x`` the lost time at ``c = 0`` (mm),
+    segment, s, shape (K,) each. ``nb`` the neighbour on that side, ``j`` the common
+    break, ``x`` the lost time at ``c = 0`` (mm), ``vc`` the segments' speed bounds,
     ``leaving``: the neighbour is left at that break (the creep is at its end)."""
     with_x = np.zeros(nb.size)
     alone = np.zeros(nb.size)
@@ -225,7 +231,9 @@ def _side(env, L: np.ndarray, moving: np.ndarray, nb: np.ndarray, u: np.ndarray,
     if idx.size == 0:
         return x / vc, alone                 # no neighbour: c = 0
     # X(c) = x - c Vc reaches 0 at c = x / Vc
-    cells = creep_cells(env, L, moving, nb[idx], u[idx], x[idx] / vc[idx], a_bar, leaving)
+    k_nb, jj = nb[idx], j[idx]
+    cells = creep_cells(rule.env, L, moving, k_nb, rule.u[jj], x[idx] / vc[idx], rule.a_bar,
+                        leaving, own_phase(rule, k_nb, jj))
     X = np.maximum(x[idx, None] - cells.cb * vc[idx, None], 0.0) / vc[idx, None]
     with_x[idx] = np.minimum(np.min(cells.P + X, axis=1), cells.tail)
     alone[idx] = cells.least
@@ -255,13 +263,16 @@ class CreepCells:
 
 
 def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: np.ndarray,
-                un: np.ndarray, c_lin: np.ndarray, a_bar: float, leaving: bool
+                un: np.ndarray, c_lin: np.ndarray, a_bar: float, leaving: bool,
+                own: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
                 ) -> CreepCells:
     """The cells of step 3 on neighbours ``k_nb`` (shape (K,)), the creep at most at
     ``un`` (mm/s): :data:`WINDOW_LINEAR_CELLS` up to ``c_lin`` (s), then growing by
     :data:`WINDOW_CELL_GROWTH` up to the creep over the whole neighbour. ``L`` the
     segment lengths (mm), ``moving`` which segments move, ``leaving``: the neighbour is
-    left at the break (the creep is at its end)."""
+    left at the break (the creep is at its end). ``own = (W, Vc, X)`` (shape (K,) each:
+    mm/s, mm/s, mm) adds step 2's bound from the neighbour's own phase beside the creep,
+    ``min(L'' / W, (L'' + X) / Vc)`` on what the creep leaves of it (:func:`own_phase`)."""
     Ln = L[k_nb]
     c_all = Ln / un                          # the creep covers the whole neighbour
     # cell edges: linear to c_lin, growing to c_all, then the rest
@@ -287,10 +298,29 @@ def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: n
                               as0=np.maximum(env.a_out[rows], eps_end), t_cap=t_cap)
     E = np.where((L_left > 0) & moving[rows], np.nan_to_num(E, nan=0.0, posinf=0.0), 0.0)
     E = np.maximum(E, 0.0).reshape(cb.shape)
+    if own is not None:
+        # the neighbour's own phase beside the creep lies on what the creep leaves of it
+        W, Vc, X = (np.asarray(v, dtype=np.float64)[:, None] for v in own)
+        Lr = L_left.reshape(cb.shape)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            F = np.minimum(Lr / W, (Lr + X) / Vc)
+        E = np.maximum(E, np.where(np.isfinite(F) & moving[k_nb][:, None], F, 0.0))
     P = np.where(un[:, None] * cb >= Ln[:, None], np.minimum(ca + E, c_all[:, None]), ca + E)
     # the rest: c beyond the last edge (at least c_all, or the creep covers the neighbour)
     tail = np.minimum(edges[:, -1], c_all)
     return CreepCells(cb, P, tail, np.minimum(np.min(P, axis=1), tail))
+
+
+def own_phase(rule: RuleEnvelope, nb: np.ndarray, j: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(W, Vc, X)`` of :func:`creep_cells` for neighbours ``nb`` of a creep through
+    break ``j`` (shape (K,) each): a neighbour that peaks (above ``W``, its larger corner
+    bound plus ``dr``) falls to the creep (or rises from it) in a phase of its own, all
+    on it, which loses ``X = (Vc - u_j - dr) g / 2`` at its largest speed ``Vc`` (step 1);
+    one that does not peak takes ``L'' / W``."""
+    w = np.maximum(rule.u[nb], rule.u[nb + 1]) + rule.dr
+    x = np.maximum((rule.vc[nb] - rule.u[j] - rule.dr) * rule.g[nb] / 2.0, 0.0)
+    return w, rule.vc[nb], x
 
 
 def window_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, grid_s: np.ndarray,
