@@ -84,7 +84,8 @@ CHAIN_WINDOW = 32
 
 def chain_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
                floors: np.ndarray, t_upper: float,
-               hold_breaks: np.ndarray | None = None) -> RunFloors:
+               hold_breaks: np.ndarray | None = None,
+               rule: RuleEnvelope | None = None) -> RunFloors:
     """The rows of the module docstring.
 
     Parameters
@@ -103,6 +104,9 @@ def chain_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
         The rows hold for every motion no slower than this, s (holds excluded).
     hold_breaks : numpy.ndarray of int, optional
         Breaks where a hold rests the motion.
+    rule : RuleEnvelope, optional
+        :func:`~optimal.freq.windows.rule_envelope` of the same arguments, where the caller has it (else made
+        here).
 
     Returns
     -------
@@ -113,7 +117,8 @@ def chain_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
     none = RunFloors(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
     if m == 0 or not np.isfinite(t_upper):
         return none
-    rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
+    if rule is None:
+        rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
     floors = np.asarray(floors, dtype=np.float64)
     L = path.length
     w = np.maximum(rule.u[:-1], rule.u[1:]) + rule.dr

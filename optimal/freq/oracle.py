@@ -61,7 +61,7 @@ from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_ada
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
 from .chains import chain_rows
-from .windows import window_lower_bound, window_rows
+from .windows import rule_envelope, window_lower_bound, window_rows
 from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
                     piece_times, pieced, scaled, verified)
 
@@ -271,11 +271,12 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             progress("frequency lower bound: the jerk relaxation with the rule's rows", 0.88)
         tb = time.perf_counter()
         t_fast = min(c.duration for c in cands)
-        win_rows = window_rows(work, sub_lim, limits.t_ipo_s, acc.grid,
-                               base_sol.segment_lower_bounds_s, t_fast, holds.break_index
-                               ).joined(chain_rows(work, sub_lim, limits.t_ipo_s, acc.grid,
-                                                   base_sol.segment_lower_bounds_s, t_fast,
-                                                   holds.break_index))
+        # the rule's bounds once for both kinds of rows (an acc relaxation on its grid)
+        args = (work, sub_lim, limits.t_ipo_s, acc.grid, base_sol.segment_lower_bounds_s,
+                t_fast, holds.break_index)
+        rule = rule_envelope(work, sub_lim, limits.t_ipo_s, acc.grid, t_fast,
+                             holds.break_index)
+        win_rows = window_rows(*args, rule=rule).joined(chain_rows(*args, rule=rule))
         lb_win = window_lower_bound(work, sub_lim, limits.t_ipo_s, base_sol.grid,
                                     base_sol.segment_lower_bounds_s, win_rows, t_fast,
                                     holds.break_index)

@@ -155,7 +155,8 @@ def rule_envelope(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndar
 
 def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
                 floors: np.ndarray, t_upper: float,
-                hold_breaks: np.ndarray | None = None) -> RunFloors:
+                hold_breaks: np.ndarray | None = None,
+                rule: RuleEnvelope | None = None) -> RunFloors:
     """The rows of the module docstring.
 
     Parameters
@@ -174,6 +175,9 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
         The rows hold for every motion no slower than this, s (holds excluded).
     hold_breaks : numpy.ndarray of int, optional
         Breaks where a hold rests the motion.
+    rule : RuleEnvelope, optional
+        :func:`rule_envelope` of the same arguments, where the caller has it (else made
+        here).
 
     Returns
     -------
@@ -184,7 +188,8 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     none = RunFloors(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
     if m == 0 or not np.isfinite(t_upper):
         return none
-    rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
+    if rule is None:
+        rule = rule_envelope(path, lim, t_ipo, acc_grid_s, t_upper, hold_breaks)
     env, u, vc, g, dr = rule.env, rule.u, rule.vc, rule.g, rule.dr
     L = path.length
     u0, u1 = u[:-1], u[1:]

@@ -90,7 +90,7 @@ def window_row(machine, name: str) -> None:
     rows and that bound against the jerk solve on the same path, and the bracket with and
     without them."""
     from optimal.freq.chains import chain_rows
-    from optimal.freq.windows import window_lower_bound, window_rows
+    from optimal.freq.windows import rule_envelope, window_lower_bound, window_rows
     from reference.nc import parse_file
 
     path = build_path(parse_file(HERE.parents[1] / "examples" / name), machine)
@@ -108,16 +108,19 @@ def window_row(machine, name: str) -> None:
     args = (work, lim, machine.limits.t_ipo_s, acc.grid, j.segment_lower_bounds_s, t_up,
             j.holds.break_index)
     t3 = time.perf_counter()
-    windows = window_rows(*args)
+    rule = rule_envelope(work, lim, machine.limits.t_ipo_s, acc.grid, t_up,
+                         j.holds.break_index)
+    windows = window_rows(*args, rule=rule)
     t4 = time.perf_counter()
-    chains = chain_rows(*args)
+    chains = chain_rows(*args, rule=rule)
     t5 = time.perf_counter()
     lb = window_lower_bound(work, lim, machine.limits.t_ipo_s, j.grid,
                             j.segment_lower_bounds_s, windows.joined(chains), t_up,
                             j.holds.break_index)
     t6 = time.perf_counter()
     print(f"{'rows':>9} {name}: jerk {t1 - t0:.2f} s, jerk+freq {t2 - t1:.2f} s; "
-          f"{windows.value.size} window rows {t4 - t3:.2f} s, {chains.value.size} chain rows "
+          f"the rule's bounds and {windows.value.size} window rows {t4 - t3:.2f} s, "
+          f"{chains.value.size} chain rows "
           f"{t5 - t4:.3f} s, relaxation with them {t6 - t5:.2f} s (all: "
           f"x{(t6 - t3) / (t1 - t0):.2f} of the jerk solve); lower bound "
           f"{j.lower_bound_s:.4f} -> {lb + hold:.4f} s; jerk+freq [{f.lower_bound_s:.4f}, "
