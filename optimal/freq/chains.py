@@ -73,7 +73,7 @@ from reference.core.limits import AxisArrays
 
 from ..jerk.relaxation import RunFloors
 from ..tolerances import LB_ROUNDOFF_REL
-from .windows import WINDOW_MIN_GAIN_REL, RuleEnvelope, creep_cells, own_phase, rule_envelope
+from .windows import WINDOW_MIN_GAIN_REL, RuleEnvelope, creep_cells, rule_envelope
 
 __all__ = ["CHAIN_WINDOW", "chain_rows"]
 
@@ -130,17 +130,15 @@ def chain_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
     binds = ((rule.g > 0) & (np.minimum(2.0 * rule.g, flat) * (1.0 - LB_ROUNDOFF_REL)
                              > floors * gain))
     # maximal runs of binding segments, cut at the holds
-    starts = np.flatnonzero(binds & ~np.r_[False, binds[:-1]] | binds & rule.cut[:-1])
-    moving = np.zeros(m, bool)
-    moving[rule.env.used] = True
+    starts = np.flatnonzero(binds & (~np.r_[False, binds[:-1]] | rule.cut[:-1]))
     lo, hi, value = [], [], []
     for a in starts:
         b = a + 1
         while b < m and binds[b] and not rule.cut[b]:
             b += 1
         g = float(np.min(rule.g[a:b]))
-        start = _EndCost(rule, L, moving, a, g, leaving=True)
-        end = _EndCost(rule, L, moving, b, g, leaving=False)
+        start = _EndCost(rule, a, g, leaving=True)
+        end = _EndCost(rule, b, g, leaving=False)
         v = _chain_bound(flat[a:b], L[a:b], w_flat[a:b], rule.u[a:b + 1], peak_ok[a:b], g,
                          start, end) * (1.0 - LB_ROUNDOFF_REL)
         r0, r1 = a - (not rule.cut[a]), b + (not rule.cut[b])
@@ -157,17 +155,14 @@ class _EndCost:
     """Step 3 at break ``j``, one end of a run: :meth:`__call__` bounds the time from the
     peak nearest the end to it, plus the neighbour's beyond it (none at a cut)."""
 
-    def __init__(self, rule: RuleEnvelope, L: np.ndarray, moving: np.ndarray, j: int,
-                 g: float, leaving: bool):
+    def __init__(self, rule: RuleEnvelope, j: int, g: float, leaving: bool):
         self.g = g
         if rule.cut[j]:              # no phase runs through: c = 0, no neighbour
             self.cb, self.P = np.zeros(1), np.zeros(1)
             self.tail, self.least = np.inf, 0.0
             return
         nb = j - 1 if leaving else j
-        cells = creep_cells(rule.env, L, moving, np.array([nb]), rule.u[j:j + 1],
-                            np.array([g]), rule.a_bar, leaving,
-                            own_phase(rule, np.array([nb]), np.array([j])))
+        cells = creep_cells(rule, np.array([nb]), np.array([j]), np.array([g]), leaving)
         self.cb, self.P = cells.cb[0], cells.P[0]
         self.tail, self.least = float(cells.tail[0]), float(cells.least[0])
 
@@ -178,11 +173,17 @@ class _EndCost:
         for none) and ``u_near`` the speed bound at the peak segment's break on this
         side, mm/s."""
         r = np.maximum(self.g - self.cb, 0.0)[None, :]            # (1, cells)
-        with np.errstate(invalid="ignore"):
-            spread = np.maximum(D[:, None] - u_near[:, None] * r, 0.0) / w_star[:, None]
-        spread = np.nan_to_num(spread, nan=0.0)
+        spread = _flats_beyond(D[:, None], u_near[:, None] * r, w_star[:, None])
         inside = np.min(np.maximum(S[:, None], r + spread) + self.P[None, :], axis=1)
         return np.minimum(inside, S + self.tail)
+
+
+def _flats_beyond(D: np.ndarray, covered: np.ndarray, w_star: np.ndarray) -> np.ndarray:
+    """Step 2: the least time on flats of length ``D`` (mm) beyond the ``covered`` mm the
+    phases that run into them cover, crossed at most at ``w_star`` (mm/s), s; 0 where
+    there are no flats (``D = 0``, ``w_star`` 0 or ``inf``)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(D > 0, np.maximum(D - covered, 0.0) / w_star, 0.0)
 
 
 def _chain_bound(flat: np.ndarray, L: np.ndarray, w_flat: np.ndarray, u: np.ndarray,
@@ -219,9 +220,7 @@ def _chain_bound(flat: np.ndarray, L: np.ndarray, w_flat: np.ndarray, u: np.ndar
         S = P[k] - P[k0 + 1]
         Dl = LP[k] - LP[k0 + 1]
         w_star = np.concatenate((np.maximum.accumulate(w_flat[lo + 1:k][::-1])[::-1], [0.0]))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            spread = np.where(Dl > 0, np.maximum(Dl - (u[k0 + 1] + u[k]) * g, 0.0) / w_star,
-                              0.0)
+        spread = _flats_beyond(Dl, (u[k0 + 1] + u[k]) * g, w_star)
         d = min(d, float(np.min(D[k0] + np.maximum(S, 2.0 * g + spread), initial=np.inf)))
         D[k] = d
     return float(min(np.min(D + last, initial=np.inf),

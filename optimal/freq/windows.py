@@ -122,6 +122,10 @@ class RuleEnvelope:
         What the accelerations outside phases change the speed by at most, mm/s.
     cut : numpy.ndarray of bool, shape (m + 1,)
         Breaks no phase runs through: the path ends and the holds.
+    length : numpy.ndarray, shape (m,)
+        Segment lengths, mm.
+    moving : numpy.ndarray of bool, shape (m,)
+        The segments on which an axis moves.
     """
 
     env: SegmentEnvelope
@@ -131,6 +135,8 @@ class RuleEnvelope:
     a_bar: float
     dr: float
     cut: np.ndarray
+    length: np.ndarray
+    moving: np.ndarray
 
 
 def rule_envelope(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
@@ -150,7 +156,10 @@ def rule_envelope(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndar
     cut[[0, m]] = True
     if hold_breaks is not None and np.size(hold_breaks):
         cut[np.asarray(hold_breaks, dtype=np.int64)] = True
-    return RuleEnvelope(env, u, vc, g, a_bar, FREQ_ACCEL_TOL_REL * a_bar * t_upper, cut)
+    moving = np.zeros(m, bool)
+    moving[env.used] = True
+    return RuleEnvelope(env, u, vc, g, a_bar, FREQ_ACCEL_TOL_REL * a_bar * t_upper, cut,
+                        path.length, moving)
 
 
 def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray,
@@ -205,15 +214,11 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     if sel.size == 0:
         return none
     cut = rule.cut
-    moving = np.zeros(m, bool)
-    moving[env.used] = True
     # the creep before segment k (on k - 1, at most u_k) and after it (on k + 1, at most
     # u_{k+1}): the smallest of P + X / Vc over the cells, per side
     before, after = ~cut[sel], ~cut[sel + 1]
-    side0 = _side(rule, L, moving, sel - 1, sel, x0[sel], vc[sel], leaving=True,
-                  present=before)
-    side1 = _side(rule, L, moving, sel + 1, sel + 1, x1[sel], vc[sel], leaving=False,
-                  present=after)
+    side0 = _side(rule, sel - 1, sel, x0[sel], vc[sel], leaving=True, present=before)
+    side1 = _side(rule, sel + 1, sel + 1, x1[sel], vc[sel], leaving=False, present=after)
     with np.errstate(divide="ignore"):
         far = L[sel] / lo_v[sel] + side0[1] + side1[1]
     near = L[sel] / vc[sel] + side0[0] + side1[0]
@@ -223,9 +228,8 @@ def window_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarra
     return RunFloors(lo.astype(np.int64), hi.astype(np.int64), value)
 
 
-def _side(rule: RuleEnvelope, L: np.ndarray, moving: np.ndarray, nb: np.ndarray,
-          j: np.ndarray, x: np.ndarray, vc: np.ndarray, leaving: bool, present: np.ndarray
-          ) -> tuple[np.ndarray, np.ndarray]:
+def _side(rule: RuleEnvelope, nb: np.ndarray, j: np.ndarray, x: np.ndarray, vc: np.ndarray,
+          leaving: bool, present: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Step 3 for one side of K segments: ``(min_c P(c) + X(c) / Vc, min_c P(c))`` per
     segment, s, shape (K,) each. ``nb`` the neighbour on that side, ``j`` the common
     break, ``x`` the lost time at ``c = 0`` (mm), ``vc`` the segments' speed bounds,
@@ -236,9 +240,7 @@ def _side(rule: RuleEnvelope, L: np.ndarray, moving: np.ndarray, nb: np.ndarray,
     if idx.size == 0:
         return x / vc, alone                 # no neighbour: c = 0
     # X(c) = x - c Vc reaches 0 at c = x / Vc
-    k_nb, jj = nb[idx], j[idx]
-    cells = creep_cells(rule.env, L, moving, k_nb, rule.u[jj], x[idx] / vc[idx], rule.a_bar,
-                        leaving, own_phase(rule, k_nb, jj))
+    cells = creep_cells(rule, nb[idx], j[idx], x[idx] / vc[idx], leaving)
     X = np.maximum(x[idx, None] - cells.cb * vc[idx, None], 0.0) / vc[idx, None]
     with_x[idx] = np.minimum(np.min(cells.P + X, axis=1), cells.tail)
     alone[idx] = cells.least
@@ -267,18 +269,17 @@ class CreepCells:
     least: np.ndarray
 
 
-def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: np.ndarray,
-                un: np.ndarray, c_lin: np.ndarray, a_bar: float, leaving: bool,
-                own: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-                ) -> CreepCells:
-    """The cells of step 3 on neighbours ``k_nb`` (shape (K,)), the creep at most at
-    ``un`` (mm/s): :data:`WINDOW_LINEAR_CELLS` up to ``c_lin`` (s), then growing by
-    :data:`WINDOW_CELL_GROWTH` up to the creep over the whole neighbour. ``L`` the
-    segment lengths (mm), ``moving`` which segments move, ``leaving``: the neighbour is
-    left at the break (the creep is at its end). ``own = (W, Vc, X)`` (shape (K,) each:
-    mm/s, mm/s, mm) adds step 2's bound from the neighbour's own phase beside the creep,
-    ``min(L'' / W, (L'' + X) / Vc)`` on what the creep leaves of it (:func:`own_phase`)."""
-    Ln = L[k_nb]
+def creep_cells(rule: RuleEnvelope, k_nb: np.ndarray, j: np.ndarray, c_lin: np.ndarray,
+                leaving: bool) -> CreepCells:
+    """The cells of step 3 on neighbours ``k_nb`` of a creep through breaks ``j`` (shape
+    (K,) each), the creep at most at ``u_j``: :data:`WINDOW_LINEAR_CELLS` up to ``c_lin``
+    (s), then growing by :data:`WINDOW_CELL_GROWTH` up to the creep over the whole
+    neighbour. ``leaving``: the neighbour is left at the break (the creep is at its end).
+    Each cell takes the larger of the neighbour's jerk bound and step 2's bound from its
+    own phase beside the creep (:func:`own_phase`) on what the creep leaves of it."""
+    env, moving, a_bar = rule.env, rule.moving, rule.a_bar
+    un = rule.u[j]
+    Ln = rule.length[k_nb]
     c_all = Ln / un                          # the creep covers the whole neighbour
     # cell edges: linear to c_lin, growing to c_all, then the rest
     lin = np.linspace(0.0, 1.0, WINDOW_LINEAR_CELLS + 1)[None, :] * c_lin[:, None]
@@ -303,13 +304,12 @@ def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: n
                               as0=np.maximum(env.a_out[rows], eps_end), t_cap=t_cap)
     E = np.where((L_left > 0) & moving[rows], np.nan_to_num(E, nan=0.0, posinf=0.0), 0.0)
     E = np.maximum(E, 0.0).reshape(cb.shape)
-    if own is not None:
-        # the neighbour's own phase beside the creep lies on what the creep leaves of it
-        W, Vc, X = (np.asarray(v, dtype=np.float64)[:, None] for v in own)
-        Lr = L_left.reshape(cb.shape)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            F = np.minimum(Lr / W, (Lr + X) / Vc)
-        E = np.maximum(E, np.where(np.isfinite(F) & moving[k_nb][:, None], F, 0.0))
+    # the neighbour's own phase beside the creep lies on what the creep leaves of it
+    W, Vc, X = (v[:, None] for v in own_phase(rule, k_nb, j))
+    Lr = L_left.reshape(cb.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        F = np.minimum(Lr / W, (Lr + X) / Vc)
+    E = np.maximum(E, np.where(np.isfinite(F) & moving[k_nb][:, None], F, 0.0))
     P = np.where(un[:, None] * cb >= Ln[:, None], np.minimum(ca + E, c_all[:, None]), ca + E)
     # the rest: c beyond the last edge (at least c_all, or the creep covers the neighbour)
     tail = np.minimum(edges[:, -1], c_all)
@@ -318,8 +318,8 @@ def creep_cells(env: SegmentEnvelope, L: np.ndarray, moving: np.ndarray, k_nb: n
 
 def own_phase(rule: RuleEnvelope, nb: np.ndarray, j: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(W, Vc, X)`` of :func:`creep_cells` for neighbours ``nb`` of a creep through
-    break ``j`` (shape (K,) each): a neighbour that peaks (above ``W``, its larger corner
+    """``(W, Vc, X)`` (mm/s, mm/s, mm) for neighbours ``nb`` of a creep through break
+    ``j`` (shape (K,) each): a neighbour that peaks (above ``W``, its larger corner
     bound plus ``dr``) falls to the creep (or rises from it) in a phase of its own, all
     on it, which loses ``X = (Vc - u_j - dr) g / 2`` at its largest speed ``Vc`` (step 1);
     one that does not peak takes ``L'' / W``."""
