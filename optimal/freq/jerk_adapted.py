@@ -30,7 +30,9 @@ does, and lets the jerk NLP (:mod:`optimal.jerk.backends`) find the rest again:
   stays short loses speed change rather than length (its ``dv`` shrinks round by round
   while it still lasts about 50 ms against 67 ms on ``lcnc_test_12mmflat``), so later
   rounds flatten what earlier ones could only shrink;
-* the NLP runs again on the same grid, warm started from the last motion; each round's
+* the NLP runs again on the same grid, warm started from the last motion, in the form
+  that solved the round before (:func:`optimal.jerk.backends.ipopt.solve_nlp`'s
+  ``attempts``: only the first round tries every form); each round's
   motion is judged by the checker and slowed down per rest-to-rest piece until accepted
   (:func:`optimal.freq.upper.verified`); every accepted round is a candidate, since one
   round can fix one piece and spoil another.
@@ -48,8 +50,13 @@ optimum, 7.64 s, had two phases of a dip near the start at 41 and 49 ms against 
 ``lcnc_tangent_helix`` 14.4 -> 0.96 %, ``lcnc_corner_decel`` 5.7 -> 1.99 %,
 ``lcnc_test_12mmflat`` 23 -> 13 % (174 short phases -> 139, 130, 99, 81, 30, 5, 2, 0 over
 8 rounds of about 4 s). On ``lcnc_sam_tolerance_issue`` (tiny segments at low speed) the
-rounds settle only once the doubling wiggle share flattens nearly everything (12 rounds,
-5.5 s against the filtered candidates' 3.6 s): they decide there. ``acc+freq`` (against
+rounds settle only once the doubling wiggle share flattens nearly everything, and their
+motions (5.2 s at best) lose to the ramp plan (2.70 s, :mod:`optimal.freq.ramps`); there
+a last round that IPOPT found locally infeasible took 33 s in all four forms against
+1-2 s a round, which trying only the last round's form cuts to 3 s (the brackets of
+every example and corpus program, on both machines, the same to the last digit; the
+program's whole ``compare`` oracle, medians of two runs in turn: ``jerk+freq`` 88.5 ->
+61.7 s, ``acc+freq`` 32.2 -> 15.4 s). ``acc+freq`` (against
 the adapted caps of :func:`optimal.freq.upper.eroded_plans`): ``lcnc_corner_decel``
 10.4 -> 3.8 %, ``lcnc_arc_arc_sawtooth`` 20.7 -> 5.2 %, ``lcnc_tangent_helix``
 3.2 -> 0.92 %; no change on 12mmflat and sam.
@@ -219,6 +226,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     a_hi = np.full(grid.s.size + inner.size, np.inf)
     out: list[Candidate] = []
     nlp_solve = get_nlp_backend("ipopt")
+    attempts = None          # the first round tries every form of the NLP
     for r in range(rounds):
         for p in short:
             s0, s1 = prof.s[ph.first[p]], prof.s[ph.last[p] + 1]
@@ -267,9 +275,14 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         a_lo = np.minimum(a_lo, a_hi)
         prob_r = replace(problem, a_lo=a_lo / a_unit, a_hi=a_hi / a_unit)
         c0, a0, dt0 = warm_start(path, lim, grid, prob_r, prof)
-        nlp = nlp_solve(prob_r, c0, a0, dt0)
+        nlp = nlp_solve(prob_r, c0, a0, dt0, attempts=attempts)
         if not nlp.success:
             break
+        # a later round is the same NLP with bounds moved, from this round's motion: the
+        # form that solved this one is tried alone (lcnc_sam_tolerance_issue.ngc: a last
+        # round that IPOPT found locally infeasible in every form took 33 s, against
+        # 1-2 s a round, and the rounds before it stood)
+        attempts = (nlp.attempt,)
         try:
             prof = exact_profile(prob_r, nlp.c, nlp.a, nlp.a_end, nlp.dt,
                                  path.block[grid.segment])

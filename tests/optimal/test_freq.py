@@ -203,6 +203,28 @@ def test_dip_at_a_curvature_jump_beats_the_hand_plateau(bounds):
     assert sol.upper_bound_s <= min(c.duration for c in adapted) * (1 + 1e-12)
 
 
+def test_later_rounds_of_the_adapted_nlp_try_the_form_that_solved_the_last(monkeypatch):
+    # optimal.freq.jerk_adapted: the first round tries every form of the NLP, each later
+    # one only the form that solved the round before (the same NLP with its bounds moved,
+    # from that round's motion); spied on the line-arc-line of the test above
+    import optimal.freq.jerk_adapted as ja
+    real = ja.get_nlp_backend("ipopt")
+    calls = []
+
+    def spy(*args, **kw):
+        res = real(*args, **kw)
+        calls.append((kw.get("attempts"), res.attempt, res.success))
+        return res
+    monkeypatch.setattr(ja, "get_nlp_backend", lambda name: spy)
+    lim = machine(f=10.0)
+    path = line_arc_line(10.0, 30.0, feed=150.0)
+    base = optimal.solve(path, lim, bounds="jerk", holds=NO_HOLDS, initial_intervals=N0)
+    jerk_adapted(path, lim, base.grid, base.profile, bounds="jerk+freq")
+    assert len(calls) >= 2 and calls[0][0] is None
+    for (_, attempt, ok), (asked, _, _) in zip(calls, calls[1:]):
+        assert ok and asked == (attempt,)
+
+
 def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
     # on the default machine (X, Y: A = 2 m/s^2, J = 40 m/s^3, f = 20 Hz, T = 50 ms): a
     # 20 mm line at F6000 to a dwell, then six 1.02 mm steps of a zig-zag (kinks of

@@ -215,3 +215,20 @@ def test_scp_backend_through_solve_brackets_like_ipopt():
                                                             rel=CROSS_CHECK_RTOL)
     with pytest.raises(ValueError, match="nlp_backend"):
         optimal.solve(path, lim, bounds="jerk", nlp_backend="fatrop")
+
+
+def test_ipopt_tries_only_the_attempts_it_is_given():
+    # optimal.freq.jerk_adapted re-solves with the form that solved the round before:
+    # the backend then makes that attempt alone and says which one it made; the
+    # scaled form alone (attempt 1) solves a line to the same time as the default order
+    from optimal.jerk.tolerances import MU_STRATEGIES
+    path = line_path([[0, 0, 0], [10.0, 0, 0]])
+    problem, start = setup(path, limits(), 40)
+    ref = ipopt.solve_nlp(problem, *start)
+    assert ref.success and ref.attempt == 0, ref.message
+    only = ipopt.solve_nlp(problem, *start, attempts=(1,))
+    assert only.success and only.attempt == 1, only.message
+    assert MU_STRATEGIES[1][3] and "scaled" in only.message
+    assert seconds(problem, only) == pytest.approx(seconds(problem, ref), rel=CROSS_CHECK_RTOL)
+    with pytest.raises(ValueError, match="attempts"):
+        ipopt.solve_nlp(problem, *start, attempts=())

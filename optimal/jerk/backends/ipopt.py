@@ -56,6 +56,9 @@ class NlpResult:
         IPOPT's return status.
     build_time_s, solve_time_s : float
         Graph construction and solver time, s.
+    attempt : int
+        Index in :data:`~optimal.jerk.tolerances.MU_STRATEGIES` of the last attempt made
+        (the one that solved it where ``success``; -1 where none was made).
     """
 
     success: bool
@@ -67,10 +70,11 @@ class NlpResult:
     message: str
     build_time_s: float
     solve_time_s: float
+    attempt: int = -1
 
 
 def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndarray,
-              *, print_level: int = 0) -> NlpResult:
+              *, print_level: int = 0, attempts: tuple[int, ...] | None = None) -> NlpResult:
     """Minimise the total time of the jerk grid NLP from a warm start.
 
     Parameters
@@ -83,6 +87,11 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
         Initial interval durations (dimensionless, > 0).
     print_level : int
         IPOPT's verbosity (0: silent).
+    attempts : tuple of int, optional
+        Which of :data:`~optimal.jerk.tolerances.MU_STRATEGIES` to try, in that order
+        (default: all of them). A caller that re-solves the same problem with other
+        bounds from a nearby start (:mod:`optimal.freq.jerk_adapted`) tries the form
+        that solved it last.
 
     Returns
     -------
@@ -94,8 +103,12 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
     build = solve = 0.0
     iters = 0
     N = problem.n_intervals
+    order = tuple(range(len(MU_STRATEGIES))) if attempts is None else tuple(attempts)
+    if not order:
+        raise ValueError("solve_nlp: attempts is empty")
     # the attempts in turn (MU_STRATEGIES: barrier strategy, iteration cap, graph, form)
-    for strategy, max_iter, expand, scaled in MU_STRATEGIES:
+    for attempt in order:
+        strategy, max_iter, expand, scaled = MU_STRATEGIES[attempt]
         tk = time.perf_counter()
         if scaled not in forms:
             forms[scaled] = _nlp(ca, problem, c0, a0, dt0, scaled)
@@ -122,7 +135,7 @@ def solve_nlp(problem: JerkProblem, c0: np.ndarray, a0: np.ndarray, dt0: np.ndar
                      a_end=a_all[problem.end_index], dt=xs[2 * (N + 1):3 * N + 2],
                      iterations=iters, message=f"{status} ({strategy} barrier update"
                      f"{', SX graph' if expand else ''}{', scaled' if scaled else ''})",
-                     build_time_s=build, solve_time_s=solve)
+                     build_time_s=build, solve_time_s=solve, attempt=attempt)
 
 
 def _nlp(ca, problem: JerkProblem, c0, a0, dt0, scaled: bool):
