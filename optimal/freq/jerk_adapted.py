@@ -71,7 +71,6 @@ from typing import Callable
 
 import numpy as np
 
-from reference.core.errors import ProfileError
 from reference.core.geometry import Path
 from reference.core.holds import NO_HOLDS, Holds
 from reference.core.limits import MachineLimits
@@ -79,10 +78,9 @@ from reference.core.phases import acceleration_phases, min_phase_duration, phase
 from reference.core.profile import Profile
 
 from ..grid import grid_on
-from ..jerk.backends import get_nlp_backend
 from ..jerk.tolerances import DEFAULT_JERK_MAX_GRID
 from ..jerk.transcription import JerkProblem, Rows, StepRows, build_jerk_problem
-from ..jerk.upper import exact_profile, warm_start
+from ..jerk.upper import resolved
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
 
 __all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "ADAPT_TREND_REL",
@@ -225,7 +223,6 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     a_lo = np.full(grid.s.size + inner.size, -np.inf)
     a_hi = np.full(grid.s.size + inner.size, np.inf)
     out: list[Candidate] = []
-    nlp_solve = get_nlp_backend("ipopt")
     attempts = None          # the first round tries every form of the NLP
     for r in range(rounds):
         for p in short:
@@ -274,20 +271,14 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         # stay consistent (IPOPT rejects lb > ub)
         a_lo = np.minimum(a_lo, a_hi)
         prob_r = replace(problem, a_lo=a_lo / a_unit, a_hi=a_hi / a_unit)
-        c0, a0, dt0 = warm_start(path, lim, grid, prob_r, prof)
-        nlp = nlp_solve(prob_r, c0, a0, dt0, attempts=attempts)
-        if not nlp.success:
-            break
+        new, attempt = resolved(path, lim, grid, prob_r, prof, attempts)
+        if new is None:
+            break      # IPOPT failed, or its answer is no motion: the rounds so far stand
         # a later round is the same NLP with bounds moved, from this round's motion: the
         # form that solved this one is tried alone (lcnc_sam_tolerance_issue.ngc: a last
         # round that IPOPT found locally infeasible in every form took 33 s, against
         # 1-2 s a round, and the rounds before it stood)
-        attempts = (nlp.attempt,)
-        try:
-            prof = exact_profile(prob_r, nlp.c, nlp.a, nlp.a_end, nlp.dt,
-                                 path.block[grid.segment])
-        except ProfileError:
-            break      # an NLP answer that is no motion: the rounds so far stand
+        prof, attempts = new, (attempt,)
         tags = ", ".join(t for t, on in (("wide", widen), ("D_eff/D", asymmetric)) if on)
         c = verified(f"{bounds.split('+')[0]} NLP adapted{f' ({tags})' if tags else ''}, "
                      f"round {r + 1}", path, limits, prof, bounds, holds=holds)

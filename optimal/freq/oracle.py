@@ -28,7 +28,11 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    candidate per rest-to-rest piece, joined, the ramp plan of every piece among them
    (:mod:`optimal.freq.ramps`: humps of ramps of at least ``1/f`` per segment, S-curves
    for ``jerk+freq``, budgets that leave curves their centripetal part);
-4. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
+4. for ``jerk+freq`` where the bracket is still open, the jerk NLP with the rule's own
+   rows on the fastest candidate's phases (:mod:`optimal.freq.phase_nlp`), and the
+   fastest per piece again (the lower bound of step 2 holds for every motion no slower
+   than the fastest candidate it was built for, so for the faster optimum too);
+5. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
 Units: mm, s.
@@ -58,6 +62,7 @@ from ..jerk.relaxation import RunFloors
 from .capped import capped_optimum
 from .humps import humps_piece_bounds
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
+from .phase_nlp import phase_nlp
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
 from .chains import chain_rows
@@ -343,6 +348,23 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)
+    if base == "jerk" and cands and min(x.duration for x in cands) + hold_t - lb > tol * lb:
+        # the bracket is still open: the jerk NLP with the rule's own rows on the
+        # fastest motion's phases (optimal.freq.phase_nlp), then the fastest per piece
+        # again. The lower bound stands: its rows hold for the motions no slower than
+        # the fastest candidate before, so for the optimum, which is faster still
+        if progress:
+            progress("jerk NLP with the rule's rows", 0.96)
+        tp = time.perf_counter()
+        seed = min(cands, key=lambda x: x.duration)
+        more = phase_nlp(path, limits, base_sol.grid, seed.profile, holds=holds,
+                         progress=(lambda msg: progress(msg, 0.97)) if progress else None)
+        if more:
+            cands += more
+            c = _fastest_per_piece(path, limits, cands, local, name, holds)
+            if c is not None:
+                cands.append(c)
+        t_check += time.perf_counter() - tp
     inner = (base_sol,) if acc is base_sol else (base_sol, acc)
     common = dict(grid=base_sol.grid, grid_points=base_sol.grid_points, iterations=base_sol.iterations,
                   backend=base_sol.backend, build_time_s=sum(x.build_time_s for x in inner),

@@ -163,6 +163,36 @@ class StepRows:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class PhaseRows:
+    """Runs of intervals that are to be phases of the frequency rule with at least a
+    given effective duration (:mod:`reference.core.phases`).
+
+    Run ``p`` covers intervals ``first[p] .. stop[p] - 1``, its path acceleration of
+    sign ``sign[p]`` there (the caller bounds it so through ``a_lo``, ``a_hi``). With
+    ``dv = v_1 - v_0`` its change, ``T`` its duration and ``ds`` its length, the rows are
+    ``sign (T v_1 - ds - g dv / 2) >= 0`` and ``sign (ds - T v_0 - g dv / 2) >= 0``: by
+    parts ``int (t - t_0) s'' dt = T v_1 - ds`` and ``int (t_1 - t) s'' dt = ds - T v_0``,
+    so the acceleration-weighted mean time lies at least ``g / 2`` from either end, which
+    is ``D_eff >= g`` (the lost time against either end speed of
+    :mod:`reference.core.phases`).
+
+    Attributes
+    ----------
+    first, stop : numpy.ndarray of int, shape (P,)
+        Interval ranges ``[first, stop)``.
+    sign : numpy.ndarray of int, shape (P,)
+        +1 for a rise, -1 for a fall.
+    g : numpy.ndarray, shape (P,)
+        Least effective duration (scaled time).
+    """
+
+    first: np.ndarray
+    stop: np.ndarray
+    sign: np.ndarray
+    g: np.ndarray
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class JerkProblem:
     """The dimensionless grid NLP (see the module docstring).
 
@@ -200,6 +230,9 @@ class JerkProblem:
         Only the IPOPT backend reads them (the SCP cross-check solves the problem as
         transcribed). The transcription sets none; :mod:`optimal.freq.jerk_adapted`
         sets them to lengthen phases the frequency rule finds short.
+    phases : PhaseRows, optional
+        Rows that make given runs of intervals phases of the frequency rule (only the
+        IPOPT backend reads them; :mod:`optimal.freq.phase_nlp` sets them).
     """
 
     units: Units
@@ -218,6 +251,7 @@ class JerkProblem:
     axes: tuple[str, ...]
     a_lo: np.ndarray | None = None
     a_hi: np.ndarray | None = None
+    phases: PhaseRows | None = None
 
     @property
     def n_intervals(self) -> int:

@@ -27,6 +27,7 @@ import numpy as np
 
 from reference.core.constraints import (BOUND_SETS, ConstraintReport, check_profile,
                                         scale_time, time_scale_factor)
+from reference.core.errors import ProfileError
 from reference.core.geometry import Path
 from reference.core.holds import NO_HOLDS, Holds, with_holds
 from reference.core.limits import MachineLimits
@@ -189,6 +190,24 @@ def exact_profile(problem: JerkProblem, c: np.ndarray, a: np.ndarray, a_end: np.
     j = (a_end * u.accel - a0) / h
     t = np.concatenate(([0.0], np.cumsum(h)))
     return Profile(t=t, s=problem.grid.s, v=v, a=a0, j=j, block=block)
+
+
+def resolved(path: Path, lim, grid: Grid, problem: JerkProblem, start: Profile,
+             attempts: tuple[int, ...] | None = None) -> tuple[Profile | None, int]:
+    """``problem`` solved by IPOPT from ``start`` (:func:`warm_start`): the exact profile
+    of its answer (:func:`exact_profile`) and the attempt that solved it
+    (:func:`optimal.jerk.backends.ipopt.solve_nlp`, which ``attempts`` it tries); the
+    profile is ``None`` where IPOPT fails or its answer is no motion. The re-solves of
+    :mod:`optimal.freq.jerk_adapted` and :mod:`optimal.freq.phase_nlp` share it."""
+    c0, a0, dt0 = warm_start(path, lim, grid, problem, start)
+    nlp = get_nlp_backend("ipopt")(problem, c0, a0, dt0, attempts=attempts)
+    if not nlp.success:
+        return None, nlp.attempt
+    try:
+        return exact_profile(problem, nlp.c, nlp.a, nlp.a_end, nlp.dt,
+                             path.block[grid.segment]), nlp.attempt
+    except ProfileError:
+        return None, nlp.attempt
 
 
 def profile_times_at(prof: Profile, s: np.ndarray) -> np.ndarray:

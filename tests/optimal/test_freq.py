@@ -206,23 +206,76 @@ def test_dip_at_a_curvature_jump_beats_the_hand_plateau(bounds):
 def test_later_rounds_of_the_adapted_nlp_try_the_form_that_solved_the_last(monkeypatch):
     # optimal.freq.jerk_adapted: the first round tries every form of the NLP, each later
     # one only the form that solved the round before (the same NLP with its bounds moved,
-    # from that round's motion); spied on the line-arc-line of the test above
-    import optimal.freq.jerk_adapted as ja
-    real = ja.get_nlp_backend("ipopt")
+    # from that round's motion); spied on the line-arc-line of the test above, through
+    # optimal.jerk.upper.resolved, which both re-solves use
+    import optimal.jerk.upper as ju
+    real = ju.get_nlp_backend("ipopt")
     calls = []
 
     def spy(*args, **kw):
         res = real(*args, **kw)
         calls.append((kw.get("attempts"), res.attempt, res.success))
         return res
-    monkeypatch.setattr(ja, "get_nlp_backend", lambda name: spy)
     lim = machine(f=10.0)
     path = line_arc_line(10.0, 30.0, feed=150.0)
     base = optimal.solve(path, lim, bounds="jerk", holds=NO_HOLDS, initial_intervals=N0)
+    monkeypatch.setattr(ju, "get_nlp_backend", lambda name: spy)
     jerk_adapted(path, lim, base.grid, base.profile, bounds="jerk+freq")
     assert len(calls) >= 2 and calls[0][0] is None
     for (_, attempt, ok), (asked, _, _) in zip(calls, calls[1:]):
         assert ok and asked == (attempt,)
+
+
+def _slowed(prof, lam):
+    """``prof`` run ``lam`` times slower (every phase ``lam`` times longer)."""
+    from reference.core.profile import Profile
+    return Profile(t=prof.t * lam, s=prof.s, v=prof.v / lam, a=prof.a / lam ** 2,
+                   j=prof.j / lam ** 3, block=prof.block)
+
+
+def test_phase_nlp_finds_the_closed_form_from_a_slower_motion():
+    # optimal.freq.phase_nlp on a rest-to-rest line of 30 mm at F150 (9 m/min), f = 10 Hz:
+    # v/A = 75 ms < 1/f, so the rule's optimum is the closed form of DESIGN 6,
+    # L/v + 1/f = 0.3 s. From the oracle's motion run 10 % slower (phases of 110 ms),
+    # the NLP with the rule's own rows on those phases comes back to it: its motion keeps
+    # the rule before any slowing down, and the checker accepts it
+    from optimal.freq.phase_nlp import phase_nlp
+    lim = machine(f=10.0)
+    path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
+    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    seed = _slowed(sol.profile, 1.1)
+    assert check_profile(path, lim, seed).ok(BOUND_SETS["jerk+freq"])
+    out = phase_nlp(path, lim, sol.grid, seed)
+    assert out, "no round was accepted"
+    best = min(out, key=lambda c: c.duration)
+    assert best.time_scale <= 1.0 + 1e-6
+    assert best.duration == pytest.approx(0.3, rel=1e-3)
+    assert best.duration >= 0.3 * (1 - 2 * RATIO_TOL) - 1e-9
+    rep = check_profile(path, lim, best.profile)
+    assert rep.ok(BOUND_SETS["jerk+freq"]), rep.violations(BOUND_SETS["jerk+freq"])
+
+
+@pytest.mark.parametrize("case", ["line-arc-line", "zig-zag"])
+def test_phase_nlp_keeps_the_rule_by_its_rows(case):
+    # the rows of optimal.jerk.transcription.PhaseRows are the checker's rule: on a
+    # line-arc-line (dips at the arc) and on a zig-zag of 1 mm steps (a rise and a fall
+    # per step), from the oracle's motion run 5 % slower, every round's motion keeps the
+    # rule before it is slowed down (what slows it is the arc's axis acceleration between
+    # the NLP's nodes, as for the jerk oracle's motion), is no slower than its seed and
+    # stays above the oracle's certified bound
+    from optimal.freq.phase_nlp import phase_nlp
+    if case == "line-arc-line":
+        lim, path = machine(f=10.0), line_arc_line(10.0, 30.0, feed=150.0)
+    else:
+        lim, path = machine(f=20.0), _zig_zag(4)
+    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    seed = _slowed(sol.profile, 1.05)
+    out = phase_nlp(path, lim, sol.grid, seed)
+    assert out
+    for c in out:
+        assert c.report.worst("frequency").ratio <= 1.0 + 1e-6, c.name
+        assert c.duration <= seed.duration * (1 + 1e-9)
+        assert c.duration >= sol.lower_bound_s * (1 - 1e-9)
 
 
 def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():

@@ -216,6 +216,22 @@ def _nlp(ca, problem: JerkProblem, c0, a0, dt0, scaled: bool):
             g.append(ca.DM(jr.dq) * ((e[iv] - a[iv]) / dt[iv]) + mixed + cubic)
             lo.append(-jr.limit)
             hi.append(jr.limit)
+    ph = problem.phases
+    if ph is not None and ph.first.size:
+        # the frequency rule on given runs of intervals (PhaseRows), by parts:
+        # int (t - t_0) s'' dt = T v_1 - ds and int (t_1 - t) s'' dt = ds - T v_0 (ds the
+        # run's length, which the integration rows make exact), so each row is linear in
+        # the run's speeds at its ends and bilinear with its duration (a sparse Hessian)
+        cum = np.concatenate(([0.0], np.cumsum(problem.ds)))
+        for k0, k1, sgn, gp in zip(ph.first.tolist(), ph.stop.tolist(), ph.sign.tolist(),
+                                   ph.g.tolist()):
+            dur = ca.sum1(dt[k0:k1])
+            d_s = float(cum[k1] - cum[k0])
+            dv = c[k1] - c[k0]
+            g += [sgn * (dur * c[k1] - d_s - gp * dv / 2),
+                  sgn * (d_s - dur * c[k0] - gp * dv / 2)]
+            lo += [np.zeros(1), np.zeros(1)]
+            hi += [np.full(1, np.inf), np.full(1, np.inf)]
     nlp = {"x": x, "f": ca.sum1(dt), "g": ca.vertcat(*g)}
     a_lo = problem.a_lo if problem.a_lo is not None else np.full(N + 1 + ne, -np.inf)
     a_hi = problem.a_hi if problem.a_hi is not None else np.full(N + 1 + ne, np.inf)
