@@ -17,7 +17,10 @@ wall time and the bound's time with the run and without it (the margin set to 0)
 both brackets; left out where ``../shared`` is absent. Before it, the rows of the rule in
 the jerk relaxation (:mod:`optimal.freq.windows` and :mod:`optimal.freq.chains`) on
 examples/demo.mpf and examples/slot.ngc: their time against the jerk solve, and the
-bound with them.
+bound with them. Last, the jerk NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`)
+on ``../shared/corpus/lcnc_sam_tolerance_issue.ngc`` (``jerk+freq``, default gap, where
+the bracket stays open): the oracle's wall time and bracket without it and with it, and
+the jerk solve's time; left out where ``../shared`` is absent.
 """
 
 from __future__ import annotations
@@ -80,6 +83,7 @@ def main() -> int:
     for name in ("demo.mpf", "slot.ngc"):
         window_row(machine, name)
     turn_run_row(machine)
+    phase_nlp_row(machine)
     return 0
 
 
@@ -154,6 +158,35 @@ def turn_run_row(machine) -> None:
           f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
           f"{b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})", flush=True)
 
+
+def phase_nlp_row(machine) -> None:
+    """The phase NLP's cost and effect on lcnc_sam_tolerance_issue (module docstring)."""
+    from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
+    import optimal.freq.oracle as freq_oracle
+    from reference.nc import parse_file
+
+    if not CORPUS_PRESENT:
+        print(f"{'phase NLP':>9} skipped: {NO_CORPUS}")
+        return
+    path = build_path(parse_file(CORPUS / "lcnc_sam_tolerance_issue.ngc"), machine)
+    t0 = time.perf_counter()
+    optimal.solve(path, machine.limits, bounds="jerk")
+    t_j = time.perf_counter() - t0
+    res = {}
+    real = freq_oracle.phase_nlp
+    try:
+        for label, fn in (("without", lambda *a, **k: []), ("with", real)):
+            freq_oracle.phase_nlp = fn
+            t0 = time.perf_counter()
+            sol = optimal.solve(path, machine.limits, bounds="jerk+freq")
+            res[label] = (time.perf_counter() - t0, sol)
+    finally:
+        freq_oracle.phase_nlp = real
+    (w0, a), (w1, b) = res["without"], res["with"]
+    print(f"{'phase NLP':>9} sam jerk+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}; "
+          f"the jerk solve {t_j:.1f} s); bracket [{a.lower_bound_s:.4f}, "
+          f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
+          f"{b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})", flush=True)
 
 if __name__ == "__main__":
     raise SystemExit(main())
