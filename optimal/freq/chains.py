@@ -86,27 +86,10 @@ def chain_rows(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
                floors: np.ndarray, t_upper: float,
                hold_breaks: np.ndarray | None = None,
                rule: RuleEnvelope | None = None) -> RunFloors:
-    """The rows of the module docstring.
-
-    Parameters
-    ----------
-    path : Path
-        Restricted to its moving axes.
-    lim : AxisArrays
-        Limits of ``path.axes``.
-    t_ipo : float
-        IPO cycle, s.
-    acc_grid_s : numpy.ndarray, shape (N + 1,)
-        Nodes of an ``acc`` relaxation grid (every break a node), mm.
-    floors : numpy.ndarray, shape (m,)
-        The relaxation's own floor per segment, s.
-    t_upper : float
-        The rows hold for every motion no slower than this, s (holds excluded).
-    hold_breaks : numpy.ndarray of int, optional
-        Breaks where a hold rests the motion.
-    rule : RuleEnvelope, optional
-        :func:`~optimal.freq.windows.rule_envelope` of the same arguments, where the caller has it (else made
-        here).
+    """The rows of the module docstring; arguments as
+    :func:`optimal.freq.windows.window_rows` (``floors``: the relaxation's own floor per
+    segment, s; ``rule``: the rule's bounds of the same arguments, where the caller has
+    them).
 
     Returns
     -------

@@ -131,6 +131,22 @@ def window_row(machine, name: str) -> None:
           f"{f.upper_bound_s:.4f}] {f.gap:.2%} ({f.status})", flush=True)
 
 
+def _without_and_with(module, name: str, off, path, machine, bounds: str):
+    """``(wall s, solution)`` of ``optimal.solve(path, ..., bounds)`` with ``module.name``
+    set to ``off``, then as it is (restored whatever happens)."""
+    res = []
+    real = getattr(module, name)
+    try:
+        for value in (off, real):
+            setattr(module, name, value)
+            t0 = time.perf_counter()
+            sol = optimal.solve(path, machine.limits, bounds=bounds)
+            res.append((time.perf_counter() - t0, sol))
+    finally:
+        setattr(module, name, real)
+    return res
+
+
 def turn_run_row(machine) -> None:
     """The turn run's cost and effect on the 48 sawtooth arcs (see the module docstring)."""
     from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
@@ -141,17 +157,8 @@ def turn_run_row(machine) -> None:
         print(f"{'turn run':>9} skipped: {NO_CORPUS}")
         return
     path = build_path(parse_file(CORPUS / "lcnc_arc_arc_sawtooth.ngc"), machine)
-    res = {}
-    margin = humps.HUMP_TURN_MARGIN
-    try:
-        for label, m in (("without", 0.0), ("with", margin)):
-            humps.HUMP_TURN_MARGIN = m
-            t0 = time.perf_counter()
-            sol = optimal.solve(path, machine.limits, bounds="acc+freq")
-            res[label] = (time.perf_counter() - t0, sol)
-    finally:
-        humps.HUMP_TURN_MARGIN = margin
-    (w0, a), (w1, b) = res["without"], res["with"]
+    (w0, a), (w1, b) = _without_and_with(humps, "HUMP_TURN_MARGIN", 0.0, path, machine,
+                                         "acc+freq")
     print(f"{'turn run':>9} sawtooth acc+freq: oracle {w0:.1f} -> {w1:.1f} s "
           f"(x{w1 / w0:.2f}), bound {a.bound_time_s:.1f} -> {b.bound_time_s:.1f} s "
           f"(x{b.bound_time_s / a.bound_time_s:.2f}); bracket [{a.lower_bound_s:.4f}, "
@@ -172,17 +179,8 @@ def phase_nlp_row(machine) -> None:
     t0 = time.perf_counter()
     optimal.solve(path, machine.limits, bounds="jerk")
     t_j = time.perf_counter() - t0
-    res = {}
-    real = freq_oracle.phase_nlp
-    try:
-        for label, fn in (("without", lambda *a, **k: []), ("with", real)):
-            freq_oracle.phase_nlp = fn
-            t0 = time.perf_counter()
-            sol = optimal.solve(path, machine.limits, bounds="jerk+freq")
-            res[label] = (time.perf_counter() - t0, sol)
-    finally:
-        freq_oracle.phase_nlp = real
-    (w0, a), (w1, b) = res["without"], res["with"]
+    (w0, a), (w1, b) = _without_and_with(freq_oracle, "phase_nlp", lambda *a, **k: [],
+                                         path, machine, "jerk+freq")
     print(f"{'phase NLP':>9} sam jerk+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}; "
           f"the jerk solve {t_j:.1f} s); bracket [{a.lower_bound_s:.4f}, "
           f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
