@@ -38,7 +38,7 @@ does, and lets the jerk NLP (:mod:`optimal.jerk.backends`) find the rest again:
   round can fix one piece and spoil another.
 
 Under ``acc+freq`` the same NLP runs without its jerk and acceleration-step rows
-(:func:`_without_jerk`) from the ``acc`` optimum: a motion with an acceleration linear in
+(:func:`without_jerk`) from the ``acc`` optimum: a motion with an acceleration linear in
 time between nodes, which the ``acc`` set allows. Without a jerk limit it can move a
 bounded phase beside its bounds, so it also runs with the bounds widened (``widen``).
 
@@ -84,7 +84,7 @@ from ..jerk.upper import resolved
 from .upper import ADAPT_MARGIN, ADAPT_WIGGLE_REL, Candidate, verified
 
 __all__ = ["ACC_ADAPT_INTERVALS", "ACC_ADAPT_MAX_INTERVALS", "ADAPT_TREND_REL",
-           "JERK_ADAPT_DONE_REL", "JERK_ADAPT_ROUNDS", "jerk_adapted"]
+           "JERK_ADAPT_DONE_REL", "JERK_ADAPT_ROUNDS", "jerk_adapted", "without_jerk"]
 
 #: NLP rounds of :func:`jerk_adapted` at most (each costs one jerk NLP on the base
 #: solve's final grid; the loop stops as soon as no phase is short). The corpus programs
@@ -137,7 +137,7 @@ def _trend(ph, p: int, gap_s: float) -> int:
     return int(ph.sign[p - 1])
 
 
-def _without_jerk(problem: JerkProblem) -> JerkProblem:
+def without_jerk(problem: JerkProblem) -> JerkProblem:
     """The NLP of the ``acc`` set: no jerk rows, no acceleration-step rows at breaks
     (the acceleration is still linear in time inside each interval, so it is
     continuous between the nodes of a segment, which only removes motions)."""
@@ -170,7 +170,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
         ``progress(message)`` after each round.
     bounds : {"jerk+freq", "acc+freq"}
         ``acc+freq``: the NLP without its jerk and acceleration-step rows
-        (:func:`_without_jerk`), started from the ``acc`` optimum.
+        (:func:`without_jerk`), started from the ``acc`` optimum.
     widen : bool
         Bound the acceleration also where the motion goes in ``1/f`` before and after
         each short phase. Without jerk rows the NLP can move a bounded phase beside its
@@ -215,7 +215,7 @@ def jerk_adapted(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: P
     problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, holds.break_index)
     jerk_rows = bounds != "acc+freq"
     if not jerk_rows:
-        problem = _without_jerk(problem)
+        problem = without_jerk(problem)
     a_unit = problem.units.accel
     # bounds on [a, extra]: the accelerations at the nodes (on leaving), then on arriving
     # at each interior break node (a phase ending at a break ends on that one)

@@ -28,10 +28,11 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    candidate per rest-to-rest piece, joined, the ramp plan of every piece among them
    (:mod:`optimal.freq.ramps`: humps of ramps of at least ``1/f`` per segment, S-curves
    for ``jerk+freq``, budgets that leave curves their centripetal part);
-4. for ``jerk+freq`` where the bracket is still open, the jerk NLP with the rule's own
-   rows on the fastest candidate's phases (:mod:`optimal.freq.phase_nlp`), and the
-   fastest per piece again (the lower bound of step 2 holds for every motion no slower
-   than the fastest candidate it was built for, so for the faster optimum too);
+4. where the bracket is still open, the jerk NLP (for ``acc+freq`` without its jerk
+   rows) with the rule's own rows on the fastest candidate's phases
+   (:mod:`optimal.freq.phase_nlp`), and the fastest per piece again (the lower bound of
+   step 2 holds for every motion no slower than the fastest candidate it was built for,
+   so for the faster optimum too);
 5. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -240,14 +241,23 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             c = verified(label, path, limits, prof, name, u.rest_breaks, holds)
             if c is not None:
                 cands.append(c)
+    grids: list[np.ndarray] = []
+
+    def nlp_grid() -> np.ndarray:
+        # the NLP candidates' grid (built once): the jerk oracle's final one; for
+        # acc+freq one graded as the jerk oracle's first (the acc grid is as coarse as
+        # straight lines allow)
+        if not grids:
+            grids.append(base_sol.grid if base == "jerk" else np.unique(np.concatenate((
+                jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_prof,
+                          ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid))))
+        return grids[0]
+
     if (base_prof is not None and cands
             and min(c.duration for c in cands) + hold_t - lb > tol * lb):
         # the base optimum re-solved by the NLP where it breaks the rule
-        # (optimal.freq.jerk_adapted); acc+freq on a grid graded as the jerk oracle's
-        # first one (the acc grid is as coarse as straight lines allow)
-        grid_s = base_sol.grid if base == "jerk" else np.unique(np.concatenate((
-            jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_prof,
-                      ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid)))
+        # (optimal.freq.jerk_adapted)
+        grid_s = nlp_grid()
         # (widen, asymmetric): the variants of optimal.freq.jerk_adapted, none always
         # faster; without a jerk limit the NLP also needs the widened bounds
         variants = ((False, True), (False, False)) if base == "jerk" else (
@@ -348,17 +358,20 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         t_bound += time.perf_counter() - tb
         if lb_humps + hold_t > lb:
             lb, lb_freq = lb_humps + hold_t, max(lb_freq, lb_humps)
-    if base == "jerk" and cands and min(x.duration for x in cands) + hold_t - lb > tol * lb:
-        # the bracket is still open: the jerk NLP with the rule's own rows on the
-        # fastest motion's phases (optimal.freq.phase_nlp), then the fastest per piece
-        # again. The lower bound stands: its rows hold for the motions no slower than
-        # the fastest candidate before, so for the optimum, which is faster still
+    if ((base == "jerk" or base_prof is not None) and cands
+            and min(x.duration for x in cands) + hold_t - lb > tol * lb):
+        # the bracket is still open: the jerk NLP (for acc+freq without its jerk rows)
+        # with the rule's own rows on the fastest motion's phases (optimal.freq.
+        # phase_nlp), then the fastest per piece again. The lower bound stands: its rows
+        # hold for the motions no slower than the fastest candidate before, so for the
+        # optimum, which is faster still
         if progress:
-            progress("jerk NLP with the rule's rows", 0.96)
+            progress("NLP with the rule's rows", 0.96)
         tp = time.perf_counter()
         seed = min(cands, key=lambda x: x.duration)
-        more = phase_nlp(path, limits, base_sol.grid, seed.profile, holds=holds,
-                         progress=(lambda msg: progress(msg, 0.97)) if progress else None)
+        more = phase_nlp(path, limits, nlp_grid(), seed.profile, holds=holds,
+                         progress=(lambda msg: progress(msg, 0.97)) if progress else None,
+                         bounds=name)
         if more:
             cands += more
             c = _fastest_per_piece(path, limits, cands, local, name, holds)

@@ -233,49 +233,87 @@ def _slowed(prof, lam):
                    j=prof.j / lam ** 3, block=prof.block)
 
 
-def test_phase_nlp_finds_the_closed_form_from_a_slower_motion():
+@pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
+def test_phase_nlp_finds_the_closed_form_from_a_slower_motion(bounds):
     # optimal.freq.phase_nlp on a rest-to-rest line of 30 mm at F150 (9 m/min), f = 10 Hz:
-    # v/A = 75 ms < 1/f, so the rule's optimum is the closed form of DESIGN 6,
-    # L/v + 1/f = 0.3 s. From the oracle's motion run 10 % slower (phases of 110 ms),
-    # the NLP with the rule's own rows on those phases comes back to it: its motion keeps
-    # the rule before any slowing down, and the checker accepts it
+    # v/A = 75 ms < 1/f (and under jerk+freq A/J = 20 ms), so the rule's optimum is the
+    # closed form of DESIGN 6, L/v + 1/f = 0.3 s, under both sets. From the oracle's
+    # motion run 10 % slower (phases of 110 ms), the NLP with the rule's own rows on
+    # those phases comes back to it: its motion keeps the rule before any slowing down,
+    # and the checker accepts it. Under acc+freq the NLP has no jerk rows and runs on the
+    # acc oracle's grid with nodes one IPO cycle beside each phase end (the ramp's
+    # acceleration steps there)
     from optimal.freq.phase_nlp import phase_nlp
     lim = machine(f=10.0)
     path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
-    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
     seed = _slowed(sol.profile, 1.1)
-    assert check_profile(path, lim, seed).ok(BOUND_SETS["jerk+freq"])
-    out = phase_nlp(path, lim, sol.grid, seed)
+    assert check_profile(path, lim, seed).ok(BOUND_SETS[bounds])
+    out = phase_nlp(path, lim, sol.grid, seed, bounds=bounds)
     assert out, "no round was accepted"
     best = min(out, key=lambda c: c.duration)
     assert best.time_scale <= 1.0 + 1e-6
     assert best.duration == pytest.approx(0.3, rel=1e-3)
     assert best.duration >= 0.3 * (1 - 2 * RATIO_TOL) - 1e-9
     rep = check_profile(path, lim, best.profile)
-    assert rep.ok(BOUND_SETS["jerk+freq"]), rep.violations(BOUND_SETS["jerk+freq"])
+    assert rep.ok(BOUND_SETS[bounds]), rep.violations(BOUND_SETS[bounds])
 
 
+def test_phase_nlp_grows_phases_into_constant_speed_and_keeps_them_apart():
+    # optimal.freq.phase_nlp._with_phases with growing, on a hand motion along a 100 mm
+    # line (grid of 1 mm): a rise 0 -> 10 mm/s over 0..5 mm, constant speed to 30 mm, a
+    # rise to 20 mm/s over 30..45 mm, constant to 70 mm, the fall to rest over
+    # 70..100 mm. f = 10 Hz (1/f = 0.1 s); growing by 0.6 of it (0.06 s): a 1 mm
+    # interval takes 0.1 s at 10 mm/s and 0.05 s at 20 mm/s, so only the second rise and
+    # the fall grow, by one interval each into the cruise at 20 mm/s between them.
+    # Grown without a time limit, each takes up to the middle of the cruise beside it
+    # (25 intervals: 12 and 13), and the two rises keep one constant-speed interval
+    # between them (24 of the 25 shared: 12 and 12). Never before the start, at rest
+    from optimal.freq.phase_nlp import _with_phases
+    from optimal.grid import grid_on
+    from optimal.jerk.transcription import build_jerk_problem
+    from reference.core.profile import Profile
+    lim = machine(f=10.0)
+    path = line_path([[0, 0, 0], [100.0, 0, 0]], feed=1000.0)
+    s = np.array([0.0, 5.0, 30.0, 45.0, 70.0, 100.0])
+    v = np.array([0.0, 10.0, 10.0, 20.0, 20.0, 0.0])
+    prof = Profile.from_path_velocity(s, v, np.zeros(5, np.int64))
+    grid = grid_on(path, np.linspace(0.0, 100.0, 101))
+    sub = lim.for_axes(path.axes)
+    problem = build_jerk_problem(path, sub, grid, lim.t_ipo_s, None)
+
+    def spans(grow):
+        ph = _with_phases(path, sub, grid, problem, prof, grow).phases
+        return [(int(a), int(b), int(g)) for a, b, g in zip(ph.first, ph.stop, ph.sign)]
+    assert spans(0.0) == [(0, 5, 1), (30, 45, 1), (70, 100, -1)]
+    assert spans(0.6) == [(0, 5, 1), (30, 46, 1), (69, 100, -1)]
+    assert spans(1e3) == [(0, 17, 1), (18, 57, 1), (57, 100, -1)]
+
+
+@pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
 @pytest.mark.parametrize("case", ["line-arc-line", "zig-zag"])
-def test_phase_nlp_keeps_the_rule_by_its_rows(case):
+def test_phase_nlp_keeps_the_rule_by_its_rows(case, bounds):
     # the rows of optimal.jerk.transcription.PhaseRows are the checker's rule: on a
     # line-arc-line (dips at the arc) and on a zig-zag of 1 mm steps (a rise and a fall
     # per step), from the oracle's motion run 5 % slower, every round's motion keeps the
-    # rule before it is slowed down (what slows it is the arc's axis acceleration between
-    # the NLP's nodes, as for the jerk oracle's motion), is no slower than its seed and
-    # stays above the oracle's certified bound
-    from optimal.freq.phase_nlp import phase_nlp
+    # rule before it is slowed down, is no slower than its seed and stays above the
+    # oracle's certified bound. What slows a motion down is the arc's axis acceleration
+    # between the NLP's nodes (on the line-arc-line the first motion by 1.0012); the
+    # round then runs again with those rows lowered, and its motion passes unslowed
+    from optimal.freq.phase_nlp import PHASE_REFINE_SCALE, phase_nlp
     if case == "line-arc-line":
         lim, path = machine(f=10.0), line_arc_line(10.0, 30.0, feed=150.0)
     else:
         lim, path = machine(f=20.0), _zig_zag(4)
-    sol = optimal.solve(path, lim, bounds="jerk+freq", initial_intervals=N0)
+    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
     seed = _slowed(sol.profile, 1.05)
-    out = phase_nlp(path, lim, sol.grid, seed)
+    out = phase_nlp(path, lim, sol.grid, seed, bounds=bounds)
     assert out
     for c in out:
         assert c.report.worst("frequency").ratio <= 1.0 + 1e-6, c.name
         assert c.duration <= seed.duration * (1 + 1e-9)
         assert c.duration >= sol.lower_bound_s * (1 - 1e-9)
+    assert min(out, key=lambda c: c.duration).time_scale <= 1.0 + PHASE_REFINE_SCALE
 
 
 def test_a_line_and_a_zig_zag_between_stops_under_jerk_and_frequency():
