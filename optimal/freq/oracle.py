@@ -123,6 +123,26 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
     return best
 
 
+def _acc_freq_seed(path: Path, limits: MachineLimits, acc: OptimalSolution, T_max: float,
+                   holds: Holds) -> Profile | None:
+    """The fastest of the acc+freq motion under the caps adapted to the rule
+    (:func:`optimal.freq.upper.eroded_plans`, unfiltered) and the rounds of the NLP with
+    the rule's rows under acc+freq from it, on the grid the acc+freq oracle gives that
+    NLP; ``None`` where none passes the checker."""
+    try:
+        u = eroded_plans(path, limits, T_max, 0.0, False, False, 0.0)
+    except ProfileError:
+        return None
+    c = verified("adapted caps", path, limits, u.profile, "acc+freq", u.rest_breaks, holds)
+    if c is None:
+        return None
+    grid_s = np.unique(np.concatenate((jerk_grid(path, ACC_ADAPT_INTERVALS, limits,
+                                                 acc.profile, ACC_ADAPT_MAX_INTERVALS).s,
+                                       acc.grid)))
+    out = [c] + phase_nlp(path, limits, grid_s, c.profile, holds=holds, bounds="acc+freq")
+    return min(out, key=lambda x: x.duration).profile
+
+
 def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object],
                base: str = "jerk", tol: float = DEFAULT_FREQ_GAP_TOL, holds: Holds | None = None,
                progress: ProgressFn | None = None, jerk_tol: float | None = None
@@ -369,9 +389,19 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             progress("NLP with the rule's rows", 0.96)
         tp = time.perf_counter()
         seed = min(cands, key=lambda x: x.duration)
-        more = phase_nlp(path, limits, nlp_grid(), seed.profile, holds=holds,
-                         progress=(lambda msg: progress(msg, 0.97)) if progress else None,
+        say = (lambda msg: progress(msg, 0.97)) if progress else None
+        more = phase_nlp(path, limits, nlp_grid(), seed.profile, holds=holds, progress=say,
                          bounds=name)
+        if (base == "jerk" and acc.profile is not None and T_max > 0
+                and min(x.duration for x in cands + more) + hold_t - lb > tol * lb):
+            # the phases of the acc+freq set's fastest motion of this kind (the adapted
+            # caps, then the NLP with the rule's rows under acc+freq) as a second seed:
+            # the jerk NLP then follows its phases, which the jerk set's own motions do
+            # not find (lcnc_sam_tolerance_issue 2.48 -> 2.44 s)
+            seed2 = _acc_freq_seed(path, limits, acc, T_max, holds)
+            if seed2 is not None:
+                more += phase_nlp(path, limits, base_sol.grid, seed2, holds=holds,
+                                  progress=say, bounds=name)
         if more:
             cands += more
             c = _fastest_per_piece(path, limits, cands, local, name, holds)

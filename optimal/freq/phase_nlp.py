@@ -41,14 +41,15 @@ The NLP keeps the axis acceleration at its nodes; on an arc it peaks between the
 the checker would slow the whole rest-to-rest piece down for it (lcnc_test_12mmflat,
 ``acc+freq``: by 1.024). Such a round runs again with the acceleration rows of the blocks
 it breaks lowered by the checker's ratio (:func:`_eased`, at most
-:data:`PHASE_REFINE_MAX` times). Every constraint the NLP adds only removes motions
-(growing only relaxes the rows, and the motion is judged in full), and the result is
-verified: nothing is assumed, and a round that does not help costs time only.
+:data:`PHASE_REFINE_MAX` times). Every constraint the NLP adds only removes motions, and
+every result is verified in full: nothing is assumed, and a round that does not help
+costs time only.
 
 Measured (``compare``, default machine, bracket before -> after): ``jerk+freq``
 lcnc_sam_tolerance_issue 30.9 -> 23.8 % (the NLP on the seed's phases) -> 20.0 % (the
-phases grown), lcnc_test_12mmflat 2.64 -> 2.51 -> 1.84 %; ``acc+freq`` (the NLP added
-there) sam 20.2 -> 12.6 %, 12mmflat 3.27 -> 3.03 %.
+phases grown) -> 18.0 % (with the oracle's second seed, :mod:`optimal.freq.oracle`),
+lcnc_test_12mmflat 2.64 -> 2.51 -> 1.84 %; ``acc+freq`` (the NLP added there) sam
+20.2 -> 12.6 %, 12mmflat 3.27 -> 3.00 %.
 
 Units: mm, s.
 """
@@ -133,6 +134,7 @@ def phase_nlp(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Prof
     grid = grid_on(path, grid_s)
     if grid.n_intervals > DEFAULT_JERK_MAX_GRID:
         return []
+
     def problem_on(grid: Grid) -> JerkProblem:
         problem = build_jerk_problem(path, lim, grid, limits.t_ipo_s, holds.break_index)
         return without_jerk(problem) if bounds == "acc+freq" else problem
@@ -236,10 +238,12 @@ def _grown(keep: list, grow: float, grid: Grid, prof: Profile,
     (else the checker sees one phase). A grown phase takes the largest ``period``
     (``1/f`` per grid interval, s, shape (N,)) of its intervals.
 
-    Growing only relaxes the NLP: the first extra interval of a rise at the speed
-    ``v0`` it starts with adds ``tau`` to ``T`` and ``v0 tau`` to ``ds``, so ``T v1 - ds``
-    grows by ``tau (v1 - v0) >= 0`` and ``ds - T v0`` stays (alike at the end and for a
-    fall), and the intervals' accelerations may stay as small as the trend margin."""
+    Where the grown intervals keep the phase's ``1/f``, growing only relaxes the NLP:
+    the first extra interval of a rise at the speed ``v0`` it starts with adds ``tau``
+    to ``T`` and ``v0 tau`` to ``ds``, so ``T v1 - ds`` grows by ``tau (v1 - v0) >= 0``
+    and ``ds - T v0`` stays (alike at the end and for a fall), and the intervals'
+    accelerations may stay as small as the trend margin. Where they move an axis of a
+    smaller frequency the phase must last longer; the motion is judged either way."""
     t = np.interp(grid.s, prof.s, prof.t)
     v = np.interp(grid.s, prof.s, prof.v)
     moving = (v[:-1] > VEL_TOL_MM_S) & (v[1:] > VEL_TOL_MM_S)

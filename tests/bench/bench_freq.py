@@ -17,10 +17,11 @@ wall time and the bound's time with the run and without it (the margin set to 0)
 both brackets; left out where ``../shared`` is absent. Before it, the rows of the rule in
 the jerk relaxation (:mod:`optimal.freq.windows` and :mod:`optimal.freq.chains`) on
 examples/demo.mpf and examples/slot.ngc: their time against the jerk solve, and the
-bound with them. Last, the jerk NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`)
-on ``../shared/corpus/lcnc_sam_tolerance_issue.ngc`` (``jerk+freq``, default gap, where
-the bracket stays open): the oracle's wall time and bracket without it and with it, and
-the jerk solve's time; left out where ``../shared`` is absent.
+bound with them. Last, the NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`) on
+``../shared/corpus/lcnc_sam_tolerance_issue.ngc`` (``acc+freq`` and ``jerk+freq``, default
+gap, where the bracket stays open): the oracle's wall time and bracket without it and
+with it (without it, ``jerk+freq`` still builds the acc+freq motion its second seed
+starts from), and the jerk solve's time; left out where ``../shared`` is absent.
 """
 
 from __future__ import annotations
@@ -179,12 +180,15 @@ def phase_nlp_row(machine) -> None:
     t0 = time.perf_counter()
     optimal.solve(path, machine.limits, bounds="jerk")
     t_j = time.perf_counter() - t0
-    (w0, a), (w1, b) = _without_and_with(freq_oracle, "phase_nlp", lambda *a, **k: [],
-                                         path, machine, "jerk+freq")
-    print(f"{'phase NLP':>9} sam jerk+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}; "
-          f"the jerk solve {t_j:.1f} s); bracket [{a.lower_bound_s:.4f}, "
-          f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
-          f"{b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})", flush=True)
+    for bounds in ("acc+freq", "jerk+freq"):
+        (w0, a), (w1, b) = _without_and_with(freq_oracle, "phase_nlp", lambda *a, **k: [],
+                                             path, machine, bounds)
+        print(f"{'phase NLP':>9} sam {bounds}: oracle {w0:.1f} -> {w1:.1f} s "
+              f"(x{w1 / w0:.2f}; the jerk solve {t_j:.1f} s); bracket "
+              f"[{a.lower_bound_s:.4f}, {a.upper_bound_s:.4f}] {a.gap:.2%} -> "
+              f"[{b.lower_bound_s:.4f}, {b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})",
+              flush=True)
+
 
 if __name__ == "__main__":
     raise SystemExit(main())
