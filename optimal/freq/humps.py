@@ -115,7 +115,7 @@ cell a few per cent of a period, and where the bound is near what the oracle nee
 turn run of :func:`humps_bound` cuts the cells at the turns four times finer).
 Measured on single corners (two lines at F1200 on the default machine) it comes within
 0.7 % of the verified motion; on paths of many short segments at low speed
-(lcnc_sam_tolerance_issue) it is still some 20 % below it.
+(lcnc_sam_tolerance_issue) it is still some 11 % below it (acc+freq).
 
 Units: mm, s, mm/s.
 """
