@@ -123,6 +123,14 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
     return best
 
 
+def _acc_nlp_grid(path: Path, limits: MachineLimits, acc: OptimalSolution) -> np.ndarray:
+    """The grid of the NLP candidates under acc+freq, mm: one graded as the jerk oracle's
+    first from the acc optimum, with the acc oracle's nodes (the acc grid alone is as
+    coarse as straight lines allow)."""
+    return np.unique(np.concatenate((jerk_grid(path, ACC_ADAPT_INTERVALS, limits, acc.profile,
+                                               ACC_ADAPT_MAX_INTERVALS).s, acc.grid)))
+
+
 def _acc_freq_seed(path: Path, limits: MachineLimits, acc: OptimalSolution, T_max: float,
                    holds: Holds) -> Profile | None:
     """The fastest of the acc+freq motion under the caps adapted to the rule
@@ -136,10 +144,8 @@ def _acc_freq_seed(path: Path, limits: MachineLimits, acc: OptimalSolution, T_ma
     c = verified("adapted caps", path, limits, u.profile, "acc+freq", u.rest_breaks, holds)
     if c is None:
         return None
-    grid_s = np.unique(np.concatenate((jerk_grid(path, ACC_ADAPT_INTERVALS, limits,
-                                                 acc.profile, ACC_ADAPT_MAX_INTERVALS).s,
-                                       acc.grid)))
-    out = [c] + phase_nlp(path, limits, grid_s, c.profile, holds=holds, bounds="acc+freq")
+    out = [c] + phase_nlp(path, limits, _acc_nlp_grid(path, limits, acc), c.profile,
+                          holds=holds, bounds="acc+freq")
     return min(out, key=lambda x: x.duration).profile
 
 
@@ -264,13 +270,10 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
     grids: list[np.ndarray] = []
 
     def nlp_grid() -> np.ndarray:
-        # the NLP candidates' grid (built once): the jerk oracle's final one; for
-        # acc+freq one graded as the jerk oracle's first (the acc grid is as coarse as
-        # straight lines allow)
+        # the NLP candidates' grid (built once): the jerk oracle's final one, or
+        # _acc_nlp_grid's
         if not grids:
-            grids.append(base_sol.grid if base == "jerk" else np.unique(np.concatenate((
-                jerk_grid(path, ACC_ADAPT_INTERVALS, limits, base_prof,
-                          ACC_ADAPT_MAX_INTERVALS).s, base_sol.grid))))
+            grids.append(base_sol.grid if base == "jerk" else _acc_nlp_grid(path, limits, acc))
         return grids[0]
 
     if (base_prof is not None and cands
