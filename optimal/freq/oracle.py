@@ -393,8 +393,10 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         tp = time.perf_counter()
         seed = min(cands, key=lambda x: x.duration)
         say = (lambda msg: progress(msg, 0.97)) if progress else None
+        # a round whose motion meets the bracket ends the rounds (holds excluded)
+        met_by = lb * (1.0 + tol) - hold_t
         more = phase_nlp(path, limits, nlp_grid(), seed.profile, holds=holds, progress=say,
-                         bounds=name)
+                         bounds=name, enough=met_by)
         if (base == "jerk" and acc.profile is not None and T_max > 0
                 and min(x.duration for x in cands + more) + hold_t - lb > tol * lb):
             # the phases of the acc+freq set's fastest motion of this kind (the adapted
@@ -404,7 +406,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             seed2 = _acc_freq_seed(path, limits, acc, T_max, holds)
             if seed2 is not None:
                 more += phase_nlp(path, limits, base_sol.grid, seed2, holds=holds,
-                                  progress=say, bounds=name)
+                                  progress=say, bounds=name, enough=met_by)
         if more:
             cands += more
             c = _fastest_per_piece(path, limits, cands, local, name, holds)

@@ -259,6 +259,26 @@ def test_phase_nlp_finds_the_closed_form_from_a_slower_motion(bounds):
     assert rep.ok(BOUND_SETS[bounds]), rep.violations(BOUND_SETS[bounds])
 
 
+@pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
+def test_phase_nlp_stops_at_the_optimum_and_when_the_bracket_is_met(bounds):
+    # the line of the closed form above (0.3 s): once a round's motion is within
+    # PHASE_MIN_GAIN of the closed form, the next cannot gain that much, so the rounds end
+    # at most one round after the first that reaches it; and with ``enough`` at the
+    # seed's own duration (a bracket the caller already has met), round 1 is the last
+    from optimal.freq.phase_nlp import PHASE_MIN_GAIN, phase_nlp
+    lim = machine(f=10.0)
+    path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
+    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
+    seed = _slowed(sol.profile, 1.1)
+    out = phase_nlp(path, lim, sol.grid, seed, bounds=bounds, rounds=5)
+    reached = [k for k, c in enumerate(out) if c.duration <= 0.3 * (1 + PHASE_MIN_GAIN)]
+    assert reached, [c.duration for c in out]
+    assert len(out) <= reached[0] + 2, [c.duration for c in out]
+    met = phase_nlp(path, lim, sol.grid, seed, bounds=bounds, rounds=5,
+                    enough=seed.t[-1])
+    assert [c.name for c in met] == ["phase NLP, round 1"]
+
+
 def test_phase_nlp_grows_phases_into_constant_speed_and_keeps_them_apart():
     # optimal.freq.phase_nlp._with_phases with growing, on a hand motion along a 100 mm
     # line (grid of 1 mm): a rise 0 -> 10 mm/s over 0..5 mm, constant speed to 30 mm, a
