@@ -506,13 +506,15 @@ def _crossing(packed, a, b, xa, xb):
     with np.errstate(divide="ignore", invalid="ignore"):
         t = a - xa * (b - a) / (xb - xa)
     t = np.where((t >= a) & (t <= b), t, 0.5 * (a + b))
+    act = np.arange(t.size)               # each steps until its own step is that small
     for _ in range(NEWTON_MAX_ITER):
-        p, tangent, _ = _on_pieces(packed, t)
-        nxt = np.clip(t - p[:, 0] / tangent[:, 0], a, b)
-        stop = np.all(np.abs(nxt - t) <= NEWTON_STEP_TOL * b)
-        t = nxt
-        if stop:
+        if not act.size:
             break
+        ta, aa, ba = t[act], a[act], b[act]
+        p, tangent, _ = _on_pieces(packed[act], ta)
+        nxt = np.clip(ta - p[:, 0] / tangent[:, 0], aa, ba)
+        t[act] = nxt
+        act = act[~(np.abs(nxt - ta) <= NEWTON_STEP_TOL * ba)]
     return t
 
 
@@ -539,18 +541,22 @@ def _bracket_max(packed, a, b, first, start, r_in, r_out, centre_out):
     fi, r1, r2, c2 = first[inner], r_in[inner], r_out[inner], centre_out[inner]
     x = start[inner]
     x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+    tol = NEWTON_STEP_TOL * b[inner]
     conv = np.zeros(inner.size, dtype=bool)
+    act = np.arange(inner.size)           # each steps until its own step is that small
     for _ in range(NEWTON_MAX_ITER):
-        _, slope, bend = _distance_slopes(pk, x, fi, r1, r2, c2)
-        lo = np.where(slope > 0, x, lo)
-        hi = np.where(slope > 0, hi, x)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            nxt = x - slope / bend
-        nxt = np.where((bend < 0) & (nxt >= lo) & (nxt <= hi), nxt, 0.5 * (lo + hi))
-        conv = np.abs(nxt - x) <= NEWTON_STEP_TOL * b[inner]
-        x = nxt
-        if conv.all():
+        if not act.size:
             break
+        xa, la, ha = x[act], lo[act], hi[act]
+        _, slope, bend = _distance_slopes(pk[act], xa, fi[act], r1[act], r2[act], c2[act])
+        la = np.where(slope > 0, xa, la)
+        ha = np.where(slope > 0, ha, xa)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nxt = xa - slope / bend
+        nxt = np.where((bend < 0) & (nxt >= la) & (nxt <= ha), nxt, 0.5 * (la + ha))
+        done_now = np.abs(nxt - xa) <= tol[act]
+        x[act], lo[act], hi[act], conv[act] = nxt, la, ha, done_now
+        act = act[~done_now]
     value[inner] = _distance_slopes(pk, x, fi, r1, r2, c2)[0]
     done[inner] = conv
     where[inner] = x

@@ -36,9 +36,12 @@ uses them on large programs or once they are loaded (the same numbers either way
 here every row runs them warm, the G64 side too.
 
 Per block means per program block. Rounding inserts a block at most corners (the control
-then prepares and interpolates that many more blocks), so the row also shows the time per
-*planned* block (program blocks with motion plus inserted roundings), which is the
-heuristic's cost per unit of work.
+then prepares and interpolates that many more blocks), and the heuristic plans every
+segment of it (a tangent arc is one segment, a G2 corner rounding two clothoid pieces, a
+line-arc transition five, an S-bend six, a same-way transition four), so the row also
+shows the time per *planned segment* (the path's segments: those of the program blocks
+plus those of the inserted roundings), the heuristic's cost per unit of work, by which
+the target is judged.
 """
 
 from __future__ import annotations
@@ -101,7 +104,7 @@ def paired(text64: str, text: str, machine, repeat: int = 7):
 
 def row(label: str, n: int, base, rounded) -> tuple[float, float]:
     """Print one ratio row; returns (heuristic ratio per program block, per planned
-    block)."""
+    segment)."""
     t64, c64, r64, p64 = base
     t, c, r, path = rounded
     tab = path.rounding
@@ -111,9 +114,9 @@ def row(label: str, n: int, base, rounded) -> tuple[float, float]:
     ratio_pl = (t / n_pl) / (t64 / n_pl64)
     ratio_ck = (t + c) / (t64 + c64)
     print(f"  {label:<28} heuristic {1e6 * t / n:6.1f} vs G64 {1e6 * t64 / n:6.1f} us/block"
-          f"  ratio = {ratio:.2f} (per planned block {ratio_pl:.2f});  +check ratio = "
+          f"  ratio = {ratio:.2f} (per planned segment {ratio_pl:.2f});  +check ratio = "
           f"{ratio_ck:.2f} (check {1e6 * c / n:6.1f} vs {1e6 * c64 / n:5.1f} us/block);  "
-          f"{n_in} roundings, {n_pl} vs {n_pl64} planned blocks; motion {r.time_s:.2f} s vs "
+          f"{n_in} roundings, {n_pl} vs {n_pl64} planned segments; motion {r.time_s:.2f} s vs "
           f"{r64.time_s:.2f} s", flush=True)
     return ratio, ratio_pl
 
@@ -199,9 +202,9 @@ def main(argv=None) -> None:
                       *paired(text.replace("G642 G17", "G64 G17"), text, mach))
         worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
     print(f"  rounding/G64 heuristic time (build_path + plan, without the check): worst ratio "
-          f"per program block = {worst:.2f}, per planned block = {worst_pl:.2f} "
+          f"per program block = {worst:.2f}, per planned segment = {worst_pl:.2f} "
           f"(target <= {TARGET:.2f}: {'ok' if worst_pl <= TARGET else 'ABOVE TARGET'} per "
-          f"planned block, {'ok' if worst <= TARGET else 'above'} per program block)")
+          f"planned segment, {'ok' if worst <= TARGET else 'above'} per program block)")
 
 
 if __name__ == "__main__":
