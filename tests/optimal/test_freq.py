@@ -233,6 +233,16 @@ def _slowed(prof, lam):
                    j=prof.j / lam ** 3, block=prof.block)
 
 
+def _closed_form_line(bounds: str):
+    """The rest-to-rest line of 30 mm at F150 with f = 10 Hz (closed form 0.3 s): the
+    machine, the path, the oracle's solve under ``bounds`` and its motion run 10 %
+    slower (the phase NLP's seed)."""
+    lim = machine(f=10.0)
+    path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
+    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
+    return lim, path, sol, _slowed(sol.profile, 1.1)
+
+
 @pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
 def test_phase_nlp_finds_the_closed_form_from_a_slower_motion(bounds):
     # optimal.freq.phase_nlp on a rest-to-rest line of 30 mm at F150 (9 m/min), f = 10 Hz:
@@ -244,10 +254,7 @@ def test_phase_nlp_finds_the_closed_form_from_a_slower_motion(bounds):
     # acc oracle's grid with nodes one IPO cycle beside each phase end (the ramp's
     # acceleration steps there)
     from optimal.freq.phase_nlp import phase_nlp
-    lim = machine(f=10.0)
-    path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
-    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
-    seed = _slowed(sol.profile, 1.1)
+    lim, path, sol, seed = _closed_form_line(bounds)
     assert check_profile(path, lim, seed).ok(BOUND_SETS[bounds])
     out = phase_nlp(path, lim, sol.grid, seed, bounds=bounds)
     assert out, "no round was accepted"
@@ -266,10 +273,7 @@ def test_phase_nlp_stops_at_the_optimum_and_when_the_bracket_is_met(bounds):
     # at most one round after the first that reaches it; and with ``enough`` at the
     # seed's own duration (a bracket the caller already has met), round 1 is the last
     from optimal.freq.phase_nlp import PHASE_MIN_GAIN, phase_nlp
-    lim = machine(f=10.0)
-    path = line_path([[0, 0, 0], [30.0, 0, 0]], feed=150.0)
-    sol = optimal.solve(path, lim, bounds=bounds, initial_intervals=N0)
-    seed = _slowed(sol.profile, 1.1)
+    lim, path, sol, seed = _closed_form_line(bounds)
     out = phase_nlp(path, lim, sol.grid, seed, bounds=bounds, rounds=5)
     reached = [k for k, c in enumerate(out) if c.duration <= 0.3 * (1 + PHASE_MIN_GAIN)]
     assert reached, [c.duration for c in out]
