@@ -462,8 +462,10 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     cut = np.zeros(o.size, bool)
     aim = np.log1p(-CLAMP_MARGIN)
     x_old, g_old = np.full(o.size, np.nan), np.full(o.size, np.nan)
-    passes = 1 if canonical is None else 2
-    for n_pass in range(passes):
+
+    def rounds(sh, like: bool):
+        """The clamp's rounds from ``sh`` (updates ``rate``, ``cut`` and the secant's last
+        points), each shape built ``like`` the one before where ``like``."""
         for _ in range(CLAMP_ROUNDS):
             over = np.maximum(sh.trim_in / cap_in, sh.trim_out / cap_out)
             # a cut one fits within CLAMP_MARGIN of the aim, or at the tolerance's rate
@@ -483,21 +485,20 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
             x_old[hit], g_old[hit] = x, g
             # never below the rate of the tolerance (a step back after an overshoot)
             rate[hit] = np.maximum(np.exp(x + step), sh0_rate[hit])
-            like = {} if canonical is None else {"like": take(sh, hit)}
+            kw = {"like": take(sh, hit)} if like else {}
             # only the transitions cut are re-sized, their deviation measured once below
             sh = scatter(sh, hit, shape_of(r1[hit], r2[hit], rate[hit], deviation=False,
-                                           **like))
+                                           **kw))
+        return sh
+
+    sh = rounds(sh, canonical is not None)
+    if canonical is not None and cut.any():
         again = np.flatnonzero(cut)
-        if canonical is None or not again.size or n_pass == passes - 1:
-            break
-        part = canonical(take(sh, again))
-        moved = ~((part.theta == sh.theta[again]) | (np.isnan(part.theta)
-                                                      & np.isnan(sh.theta[again])))
-        sh = scatter(sh, again, part)
-        if not moved.any():
-            break
-        canonical = None                  # the rounds from the moved pairs: the model's
-        x_old[again[moved]] = g_old[again[moved]] = np.nan
+        sh = scatter(sh, again, canonical(take(sh, again)))
+        # a moved pair's trims are another function of the rate: the rounds go on from
+        # there with the model's shapes where one no longer fits (none else is hit)
+        x_old[again] = g_old[again] = np.nan
+        sh = rounds(sh, False)
     again = np.flatnonzero(cut)
     if again.size:
         # each was last shaped at its final rate, without the deviation
