@@ -65,8 +65,8 @@ from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
 from .core.transition_samedir import (SAMEDIR_PIECES, samedir_canonical,
                                       samedir_for_deviation, samedir_measured,
                                       samedir_rows, samedir_shape)
-from .core.transition_sbend import (SBEND_PIECES, sbend_for_deviation, sbend_measured,
-                                    sbend_rows, sbend_shape, scatter, take)
+from .core.transition_sbend import (DEVIATION_REL_TOL, SBEND_PIECES, sbend_for_deviation,
+                                    sbend_measured, sbend_rows, sbend_shape, scatter, take)
 from .machine import Machine
 
 _LINE = KIND_CODES.index("line")
@@ -424,7 +424,7 @@ def _size_line_arc(path: Path, R: np.ndarray, arc: np.ndarray, line: np.ndarray,
 
 def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.ndarray,
                o: np.ndarray, dev: np.ndarray, c: float, for_deviation, shape_of,
-               measured, canonical=None):
+               measured, canonical=None, defer: bool = True):
     """Transitions ``o`` between two arcs (an S-bend, :mod:`reference.core.
     transition_sbend`, or arcs curving the same way, :mod:`reference.core.
     transition_samedir`: ``for_deviation`` and ``shape_of`` of that module, and
@@ -454,11 +454,26 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     and the answer is made the model's at its rate; where that moves a pair (the
     flatter arc's landing found at the raised rate) and a trim no longer fits, the
     rounds go on from there.
+
+    ``defer``: the sizing leaves the full measure of its answers whose trim exceeds the
+    cap to the clamp (``defer`` of :func:`reference.core.transition_sbend.
+    size_for_deviation`), which measures them at the raised rate anyway. Where that
+    measure exceeds the deviation (the maximum the sizing followed was not the highest,
+    so the tolerance's rate is above the one the rounds started from), those transitions
+    are sized again without ``defer``: the answer is the same either way, the largest
+    of the tolerance's rate and the clamp's.
     """
     r1, r2 = R[o], R_b[o]
-    sh = for_deviation(r1, r2, dev)
-    rate, sh0_rate = sh.rate.copy(), sh.rate
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
+
+    def over_cap(part, i):
+        """Whether a trim of the shapes ``part`` (transitions ``i``) exceeds its cap."""
+        return np.maximum(part.trim_in / cap_in[i], part.trim_out / cap_out[i]) > 1.0
+
+    sh = for_deviation(r1, r2, dev, defer=over_cap if defer else None)
+    deferred = (np.isnan(sh.deviation) & over_cap(sh, np.arange(o.size))) if defer \
+        else np.zeros(o.size, bool)
+    rate, sh0_rate = sh.rate.copy(), sh.rate
     cut = np.zeros(o.size, bool)
     aim = np.log1p(-CLAMP_MARGIN)
     x_old, g_old = np.full(o.size, np.nan), np.full(o.size, np.nan)
@@ -503,6 +518,16 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     if again.size:
         # each was last shaped at its final rate, without the deviation
         sh = scatter(sh, again, measured(take(sh, again)))
+    # the sizing's acceptance: within half its margin above its aim
+    accepted = (np.log(sh.deviation) - np.log(dev) - np.log1p(-DEVIATION_REL_TOL)
+                <= 0.5 * DEVIATION_REL_TOL)
+    redo = np.flatnonzero(deferred & ~accepted)
+    if redo.size:
+        part, cut_redo, _ = _size_arcs(path, R, R_b, a, b, o[redo], dev[redo], c,
+                                       for_deviation, shape_of, measured, canonical,
+                                       defer=False)
+        sh = scatter(sh, redo, part)
+        cut[redo] = cut_redo
     small = (np.isnan(sh.theta) | (sh.trim_in > cap_in) | (sh.trim_out > cap_out)
              | ~(np.minimum(np.minimum(sh.ramp_in, sh.ramp_out), sh.piece)
                  > MIN_SEGMENT_LENGTH_MM))

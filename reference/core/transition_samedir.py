@@ -454,7 +454,7 @@ def _canonical_pieces(sh: SameDirShape):
 
 
 def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
-                          search=None, newton=None, pieces=None) -> SameDirShape:
+                          search=None, newton=None, pieces=None, defer=None) -> SameDirShape:
     """The transitions that deviate from the arcs by ``deviation`` (the S-bend's sizing,
     :func:`reference.core.transition_sbend.size_for_deviation`, from the first estimate
     of :func:`reference.core.transition_sbend.ratio_guess`: ``c^2 e R^3`` measured at
@@ -473,6 +473,8 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
         Another implementation of :func:`_canonical_pieces` (the same argument and
         results, bit for bit: the compiled one of :mod:`reference.transition_kernel`);
         by default :func:`_canonical_pieces`.
+    defer : callable, optional
+        As for :func:`reference.core.transition_sbend.size_for_deviation`.
 
     Returns
     -------
@@ -487,7 +489,7 @@ def samedir_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.nda
     return size_for_deviation(shape_of, pieces or _canonical_pieces, r_out, r_in, r_out,
                               deviation, ratio_guess(_samedir_table(), r_in, r_out,
                                                      deviation),
-                              canonical=canonical, search=search)
+                              canonical=canonical, search=search, defer=defer)
 
 
 @lru_cache(maxsize=None)

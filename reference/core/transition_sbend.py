@@ -790,7 +790,7 @@ def sbend_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
 
 
 def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarray,
-                        search=None) -> SBendShape:
+                        search=None, defer=None) -> SBendShape:
     """The S-bend transitions that deviate from the arcs by ``deviation``
     (:func:`size_for_deviation` from the first estimate :func:`ratio_guess`).
 
@@ -800,6 +800,8 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
         mm (``deviation > 0``).
     search : callable, optional
         As for :func:`pieces_deviation`.
+    defer : callable, optional
+        As for :func:`size_for_deviation`.
 
     Returns
     -------
@@ -809,7 +811,7 @@ def sbend_for_deviation(r_in: np.ndarray, r_out: np.ndarray, deviation: np.ndarr
                               for v in (r_in, r_out, deviation))
     return size_for_deviation(sbend_shape, _canonical_pieces, -r_out, r_in, r_out,
                               deviation, ratio_guess(_sbend_table(), r_in, r_out, deviation),
-                              search=search)
+                              search=search, defer=defer)
 
 
 @lru_cache(maxsize=None)
@@ -895,7 +897,7 @@ def _measured(sh, pieces_of, centre_out: np.ndarray, search=None):
 
 def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.ndarray,
                        r_out: np.ndarray, deviation: np.ndarray, log_rate: np.ndarray,
-                       canonical=None, search=None):
+                       canonical=None, search=None, defer=None):
     """The transitions between two arcs whose rate makes them deviate by ``deviation``;
     the one sizing of every two-arc transition.
 
@@ -943,6 +945,16 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
     search : callable, optional
         The implementation of :func:`_deviation_where` every measure uses (as for
         :func:`pieces_deviation`).
+    defer : callable, optional
+        ``defer(part, i) -> bool (m,)``: of the answers ``part`` (transitions ``i``, the
+        model's shapes, before their full measure), those whose full measure the caller
+        takes over; they are returned with the deviation ``nan``. The block-length clamp
+        (:func:`reference.rounding_tangential._size_arcs`) raises the rate of every
+        transition whose trim exceeds its cap and measures it in full at the raised rate,
+        so the measure at this one would be thrown away (on the same-way row of
+        ``tests/bench/bench_rounding.py`` 1,819 of 7,950); where the measure there finds a
+        higher maximum than the one followed, the caller sizes it again without
+        ``defer``.
 
     Returns
     -------
@@ -987,9 +999,11 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         if canonical is not None:
             part = canonical(part)
             sh = scatter(sh, check, part)
-        dev = _measure(part, check, pieces, None)[0]
+        now = np.ones(check.size, bool) if defer is None else ~defer(part, check)
+        dev = np.full(check.size, np.nan)
+        dev[now] = _measure(take(part, np.flatnonzero(now)), check[now], pieces, None)[0]
         sh = _with_deviation(sh, check, dev)
-        lost[check] |= ~(np.abs(np.log(dev) - aim[check]) <= half)
+        lost[check[now]] |= ~(np.abs(np.log(dev[now]) - aim[check[now]]) <= half)
     rest = np.flatnonzero(lost | ~(np.abs(gx) <= TRACK_REL_TOL))
     if rest.size:
         sh = scatter(sh, rest, _size_in_full(shape_of, pieces_of, centre_out[rest],

@@ -532,3 +532,78 @@ def test_inspect_trace_and_readme_name_the_same_way_transition(tmp_path, capsys)
     assert ("Between two tangent arcs curving the same way with different radii no "
             "monotone curvature ramp lands either") in text
     assert "reference/core/transition_samedir.py" in text
+
+
+def _sized_without_defer(monkeypatch):
+    """Make ``_size_arcs`` measure every answer of the sizing at its own rate (the old
+    order: full measure, then the clamp), for a comparison."""
+    import reference.rounding_tangential as rt
+    real = rt._size_arcs
+    monkeypatch.setattr(rt, "_size_arcs", lambda *a, **k: real(*a, **{**k, "defer": False}))
+
+
+def _same_way_clamped():
+    """300 seeded same-way arcs, PATH_TRANS_POS_TOL = 0.05 mm, clamp c = 0.1 (many
+    transitions cut): program and machine."""
+    d = tomllib.loads(resources.files("reference.machines").joinpath("default.toml")
+                      .read_text())
+    for ax in d["axis"].values():
+        ax["PATH_TRANS_POS_TOL"] = 0.05
+    d["channel"]["rounding_length_clamp"] = 0.1
+    return parse_text("G17 G90 G645 SOFT F8000\n" + same_way_chain(301, 7)), \
+        machine_from_dict(d)
+
+
+def test_the_clamp_measuring_the_cut_transitions_changes_no_answer(monkeypatch):
+    """The sizing leaves the full measure of the transitions whose trim exceeds the
+    block-length clamp to the clamp, which measures them at the raised rate: every
+    number of the built path is the one of measuring each answer first (bit for bit),
+    on a chain where many are cut."""
+    prog, mach = _same_way_clamped()
+    path = build_path(prog, mach)
+    assert path.rounding.clamped.sum() >= 20
+    _sized_without_defer(monkeypatch)
+    ref = build_path(prog, mach)
+    t, r = path.rounding, ref.rounding
+    for f in ("reason", "clamped", "length_mm", "deviation_mm", "radius_mm", "distance_mm"):
+        np.testing.assert_array_equal(getattr(t, f), getattr(r, f), err_msg=f)
+    np.testing.assert_array_equal(path.s_breaks, ref.s_breaks)
+
+
+def test_a_deferred_answer_below_the_tolerances_rate_is_sized_again(monkeypatch):
+    """Where the clamp's measure of a deferred answer exceeds the tolerance (the
+    maximum the sizing followed was not the highest, so the tolerance's rate is above
+    the one the clamp started from), that transition is sized again: simulated by
+    answering the deferred transitions at the rate of three times the tolerance. The
+    result: every deviation within PATH_TRANS_POS_TOL, and the same roundings as the
+    sizing measuring each answer first (the rates within the clamp's margin)."""
+    import reference.rounding_tangential as rt
+    from reference.core.transition_sbend import scatter, take
+    prog, mach = _same_way_clamped()
+    real = rt.samedir_for_deviation
+    redone = []
+
+    def low(r1, r2, dev, defer=None, **kw):
+        if defer is None:
+            redone.append(r1.size)
+            return real(r1, r2, dev, **kw)
+        sh = real(r1, r2, dev, **kw)
+        wrong = real(r1, r2, 3.0 * dev, **kw)
+        i = np.flatnonzero(defer(wrong, np.arange(r1.size)))
+        part = take(wrong, i)
+        part = dataclasses.replace(part, deviation=np.full(i.size, np.nan))
+        return scatter(sh, i, part)
+
+    monkeypatch.setattr(rt, "samedir_for_deviation", low)
+    path = build_path(prog, mach)
+    assert redone and sum(redone) > 0
+    t = path.rounding
+    ins = t.inserted
+    assert (t.deviation_mm[ins] <= 0.05).all()
+    monkeypatch.setattr(rt, "samedir_for_deviation", real)
+    _sized_without_defer(monkeypatch)
+    r = build_path(prog, mach).rounding
+    np.testing.assert_array_equal(t.reason, r.reason)
+    np.testing.assert_array_equal(t.clamped, r.clamped)
+    np.testing.assert_allclose(t.length_mm, r.length_mm, rtol=4 * CLAMP_MARGIN, atol=1e-12)
+    np.testing.assert_allclose(t.deviation_mm, r.deviation_mm, rtol=1e-8, atol=1e-12)
