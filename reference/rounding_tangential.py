@@ -65,7 +65,7 @@ from .core.transition import (PIECES, TransitionShape, ramp_for_deviation,
 from .core.transition_samedir import (SAMEDIR_PIECES, samedir_canonical,
                                       samedir_for_deviation, samedir_measured,
                                       samedir_rows, samedir_shape)
-from .core.transition_sbend import (DEVIATION_REL_TOL, SBEND_PIECES, sbend_for_deviation,
+from .core.transition_sbend import (SBEND_PIECES, not_above_aim, sbend_for_deviation,
                                     sbend_measured, sbend_rows, sbend_shape, scatter, take)
 from .machine import Machine
 
@@ -458,7 +458,8 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     ``defer``: the sizing leaves the full measure of its answers whose trim exceeds the
     cap to the clamp (``defer`` of :func:`reference.core.transition_sbend.
     size_for_deviation`), which measures them at the raised rate anyway. Where that
-    measure exceeds the deviation (the maximum the sizing followed was not the highest,
+    measure is above what the sizing accepts (:func:`reference.core.transition_sbend.
+    not_above_aim`: the maximum the sizing followed was not the highest,
     so the tolerance's rate is above the one the rounds started from), those transitions
     are sized again without ``defer``: the answer is the same either way, the largest
     of the tolerance's rate and the clamp's.
@@ -518,10 +519,7 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     if again.size:
         # each was last shaped at its final rate, without the deviation
         sh = scatter(sh, again, measured(take(sh, again)))
-    # the sizing's acceptance: within half its margin above its aim
-    accepted = (np.log(sh.deviation) - np.log(dev) - np.log1p(-DEVIATION_REL_TOL)
-                <= 0.5 * DEVIATION_REL_TOL)
-    redo = np.flatnonzero(deferred & ~accepted)
+    redo = np.flatnonzero(deferred & ~not_above_aim(sh.deviation, dev))
     if redo.size:
         part, cut_redo, _ = _size_arcs(path, R, R_b, a, b, o[redo], dev[redo], c,
                                        for_deviation, shape_of, measured, canonical,

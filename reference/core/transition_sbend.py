@@ -122,6 +122,9 @@ TURN_ROOT_MAX_RAMP = 0.1
 #: within half of it (the deviation itself is found to about 1e-13 relative), so the
 #: tolerance is used to 1.5e-9 and never exceeded.
 DEVIATION_REL_TOL = 1e-9
+#: The sizing is done where ``log`` of the measured deviation is within this of its aim
+#: (:func:`sizing_aim`); a measure at most this above the aim is within the tolerance.
+ACCEPT_LOG_TOL = 0.5 * DEVIATION_REL_TOL
 #: A followed local maximum (:func:`size_for_deviation`) is taken to have met the aim
 #: when its ``log`` deviation is this close to it; the full measure at that rate then
 #: decides (it finds the same maximum to round-off, well inside the margin's half).
@@ -960,8 +963,8 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
     -------
     The ``shape_of`` result of the rates found, with the deviation.
     """
-    aim = np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
-    half = 0.5 * DEVIATION_REL_TOL
+    aim = sizing_aim(deviation)
+    half = ACCEPT_LOG_TOL
     x = np.array(log_rate, dtype=np.float64)
     k = x.size
     sh = shape_of(r_in, r_out, np.exp(x), deviation=False)
@@ -999,9 +1002,11 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         if canonical is not None:
             part = canonical(part)
             sh = scatter(sh, check, part)
-        now = np.ones(check.size, bool) if defer is None else ~defer(part, check)
+        later = np.zeros(check.size, bool) if defer is None else defer(part, check)
+        now = ~later
         dev = np.full(check.size, np.nan)
-        dev[now] = _measure(take(part, np.flatnonzero(now)), check[now], pieces, None)[0]
+        dev[now] = _measure(take(part, np.flatnonzero(now)) if later.any() else part,
+                            check[now], pieces, None)[0]
         sh = _with_deviation(sh, check, dev)
         lost[check[now]] |= ~(np.abs(np.log(dev[now]) - aim[check[now]]) <= half)
     rest = np.flatnonzero(lost | ~(np.abs(gx) <= TRACK_REL_TOL))
@@ -1011,6 +1016,19 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
                                              np.asarray(log_rate, np.float64)[rest],
                                              search))
     return sh
+
+
+def sizing_aim(deviation: np.ndarray) -> np.ndarray:
+    """``log`` of the deviation the sizing aims at, ``deviation (1 - DEVIATION_REL_TOL)``
+    (``deviation`` in mm, any shape)."""
+    return np.log(deviation) + np.log1p(-DEVIATION_REL_TOL)
+
+
+def not_above_aim(measured: np.ndarray, deviation: np.ndarray) -> np.ndarray:
+    """Whether measured deviations (mm) are at most :data:`ACCEPT_LOG_TOL` above the aim of
+    ``deviation`` (mm): what the sizing accepts from above, so never above ``deviation``
+    (``False`` where ``measured`` is nan)."""
+    return np.log(measured) - sizing_aim(deviation) <= ACCEPT_LOG_TOL
 
 
 def _size_in_full(shape_of, pieces_of, centre_out, r_in, r_out, aim, log_rate,
@@ -1026,7 +1044,7 @@ def _size_in_full(shape_of, pieces_of, centre_out, r_in, r_out, aim, log_rate,
     gx = np.log(dev) - aim
     x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
     for _ in range(ROOT_MAX_ITER):
-        todo = np.flatnonzero(~(np.abs(gx) <= 0.5 * DEVIATION_REL_TOL))
+        todo = np.flatnonzero(~(np.abs(gx) <= ACCEPT_LOG_TOL))
         if not todo.size:
             break
         x[todo], x_old[todo], g_old[todo] = _secant_step(x[todo], gx[todo], x_old[todo],
@@ -1150,6 +1168,7 @@ def scatter(sh, i: np.ndarray, part):
     return type(sh)(*out)
 
 
-__all__ = ["SBEND_PIECES", "SBendShape", "pieces_deviation", "pieces_rows", "sbend_deviation",
-           "sbend_for_deviation", "sbend_measured", "sbend_rows", "sbend_shape", "scatter",
-           "ratio_guess", "ratio_table", "size_for_deviation", "take"]
+__all__ = ["ACCEPT_LOG_TOL", "SBEND_PIECES", "SBendShape", "not_above_aim",
+           "pieces_deviation", "pieces_rows", "sbend_deviation", "sbend_for_deviation",
+           "sbend_measured", "sbend_rows", "sbend_shape", "scatter", "ratio_guess",
+           "ratio_table", "size_for_deviation", "sizing_aim", "take"]

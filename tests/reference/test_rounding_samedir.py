@@ -54,12 +54,14 @@ T_IPO = 0.004
 WIDE = {"PATH_TRANS_POS_TOL": 0.05}
 
 
-def bundled(name: str, tol: float):
-    """A bundled machine with PATH_TRANS_POS_TOL = ``tol`` (mm) on every axis."""
+def bundled(name: str, tol: float, **channel):
+    """A bundled machine with PATH_TRANS_POS_TOL = ``tol`` (mm) on every axis (and the
+    channel settings ``channel``)."""
     d = tomllib.loads(resources.files("reference.machines").joinpath(f"{name}.toml")
                       .read_text())
     for ax in d["axis"].values():
         ax["PATH_TRANS_POS_TOL"] = tol
+    d["channel"].update(channel)
     return machine_from_dict(d)
 
 
@@ -545,13 +547,8 @@ def _sized_without_defer(monkeypatch):
 def _same_way_clamped():
     """300 seeded same-way arcs, PATH_TRANS_POS_TOL = 0.05 mm, clamp c = 0.1 (many
     transitions cut): program and machine."""
-    d = tomllib.loads(resources.files("reference.machines").joinpath("default.toml")
-                      .read_text())
-    for ax in d["axis"].values():
-        ax["PATH_TRANS_POS_TOL"] = 0.05
-    d["channel"]["rounding_length_clamp"] = 0.1
     return parse_text("G17 G90 G645 SOFT F8000\n" + same_way_chain(301, 7)), \
-        machine_from_dict(d)
+        bundled("default", 0.05, rounding_length_clamp=0.1)
 
 
 def test_the_clamp_measuring_the_cut_transitions_changes_no_answer(monkeypatch):
