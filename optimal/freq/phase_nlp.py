@@ -30,6 +30,19 @@ constant-speed intervals beside it (:data:`PHASE_GROW` of its ``1/f`` at each en
 :func:`_grown`): a relaxation of the rows, which lets the next NLP start the change
 earlier or end it later, and the rounds stop when the phases come back unchanged.
 
+Before growing, two neighbouring phases of one sign a short constant-speed stretch apart
+(:data:`PHASE_MERGE_GAP` of their ``1/f``) become one phase (:func:`_merged`), crossed
+with its sign between them: a relaxation of the rows too (the joined phase's mean time
+lies between the two phases' own). A fall to a cap, a short stretch at it and a fall
+further need ``1/f`` for each change; as one phase both changes may be done at full
+acceleration with the cap passed in its slow middle, the motion the rule accepts in the
+second case of :mod:`reference.core.phases` (there a hand-built motion of this kind on
+lcnc_test_12mmflat's first pass was faster than every motion of the oracle). Measured
+on that pass (lines 8-14 cut out, ``acc+freq``, lower bound 3.3360 s): the upper bound
+3.3994 -> 3.3749 s (bracket 1.90 -> 1.17 %), below the hand-built motion's 3.3766 s;
+on a line falling through a feed cap to rest (tests/optimal/test_freq.py) 0.5132 ->
+0.4694 s, against 0.46875 s of the hand motion.
+
 Under ``acc+freq`` the same NLP runs without its jerk and acceleration-step rows
 (:func:`optimal.freq.jerk_adapted.without_jerk`), as the jerk-adapted rounds do there:
 its motions (acceleration linear in time between nodes) are motions of the ``acc`` set,
@@ -49,7 +62,8 @@ Measured (``compare``, default machine, bracket before -> after): ``jerk+freq``
 lcnc_sam_tolerance_issue 30.9 -> 23.8 % (the NLP on the seed's phases) -> 20.0 % (the
 phases grown) -> 18.0 % (with the oracle's second seed, :mod:`optimal.freq.oracle`),
 lcnc_test_12mmflat 2.64 -> 2.51 -> 1.84 %; ``acc+freq`` (the NLP added there) sam
-20.2 -> 12.6 %, 12mmflat 3.27 -> 3.00 %.
+20.2 -> 12.6 %, 12mmflat 3.27 -> 3.00 % -> 2.90 % (phases joined; sam has no two
+phases of one sign to join, its motion rising and falling between corners).
 
 Units: mm, s.
 """
@@ -87,6 +101,12 @@ PHASE_NLP_ROUNDS = 3
 #: the seed's phases and its motion has them again, so without growing the rounds stop
 #: there.
 PHASE_GROW = 0.5
+#: From the second round on, two neighbouring phases of one sign are joined into one
+#: (:func:`_merged`) where the constant-speed stretch between them lasts at most this
+#: many times their ``1/f``: a fall to a cap, a short stretch at it and a fall further
+#: take two phases of ``1/f`` each, and one phase through the cap may do both changes at
+#: full acceleration.
+PHASE_MERGE_GAP = 1.0
 #: A round whose motion the checker slows down by more than this share (s/s) is solved
 #: again with the acceleration rows lowered in the blocks where it breaks the axis
 #: acceleration (:func:`_eased`), at most :data:`PHASE_REFINE_MAX` times.
@@ -105,7 +125,7 @@ def phase_nlp(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Prof
               holds: Holds = NO_HOLDS, rounds: int = PHASE_NLP_ROUNDS,
               progress: Callable[[str], object] | None = None,
               bounds: str = "jerk+freq", grow: float = PHASE_GROW,
-              enough: float = 0.0) -> list[Candidate]:
+              merge: float = PHASE_MERGE_GAP, enough: float = 0.0) -> list[Candidate]:
     """The rounds of the module docstring.
 
     Parameters
@@ -128,6 +148,10 @@ def phase_nlp(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Prof
     grow : float
         :data:`PHASE_GROW`: share of a phase's ``1/f`` it grows by at each end from the
         second round on.
+    merge : float
+        :data:`PHASE_MERGE_GAP`: from the second round on, two neighbouring phases of
+        one sign are joined where the stretch between them lasts at most this many
+        times their ``1/f`` (:func:`_merged`); 0 or less: none is joined.
     enough : float
         s. The rounds stop once one's motion (holds excluded) takes at most this long:
         the caller's bracket is met and a further round would cost time only. 0: run
@@ -157,7 +181,7 @@ def phase_nlp(path: Path, limits: MachineLimits, grid_s: np.ndarray, start: Prof
     last = None
     for r in range(rounds):
         seed, g_r = prof, 0.0 if r == 0 else grow
-        prob_r = _with_phases(path, lim, grid, problem, seed, g_r)
+        prob_r = _with_phases(path, lim, grid, problem, seed, g_r, merge)
         if prob_r is None or (last is not None and _same_phases(prob_r.phases, last)):
             break      # no phase, or the last round's phases again: the same NLP
         last = prob_r.phases
@@ -280,11 +304,42 @@ def _grown(keep: list, grow: float, grid: Grid, prof: Profile,
     return out
 
 
+def _merged(keep: list, grid: Grid, prof: Profile, period: np.ndarray,
+            gap: float) -> list:
+    """The phases ``keep`` (``(first interval, stop, sign, 1/f)``, in order) with every
+    two neighbours of one sign joined into one phase where the intervals between them
+    take at most ``gap`` times the larger ``1/f`` of ``prof``'s time and ``prof`` is in
+    motion at each of their nodes. The joined phase spans both and the intervals
+    between (crossed with the phase's sign at the trend margin) and takes the largest
+    ``1/f`` of the three and of ``period`` (``1/f`` per grid interval, s, shape (N,))
+    over the intervals between.
+
+    Joining only relaxes the rows: the joined phase's acceleration-weighted mean time
+    lies between the two phases' own, so where each lay ``1/(2f)`` from its ends it lies
+    that far from the joined phase's ends too (``prof``'s crossing at constant speed
+    misses the trend margin only, a tenth of a percent of the NLP's acceleration unit).
+    What it frees: the change may be done at full acceleration on both sides of a cap
+    and the cap passed in the slow middle of one phase (the second case of
+    :mod:`reference.core.phases`), where two phases need ``1/f`` each."""
+    t = np.interp(grid.s, prof.s, prof.t)
+    v = np.interp(grid.s, prof.s, prof.v)
+    out = [keep[0]] if keep else []
+    for a, b, sg, need in keep[1:]:
+        a0, b0, sg0, need0 = out[-1]
+        if (sg == sg0 and t[a] - t[b0] <= gap * max(need, need0)
+                and bool(np.all(v[b0:a + 1] > VEL_TOL_MM_S))):
+            out[-1] = (a0, b, sg, max(need, need0, float(np.max(period[b0:a], initial=0.0))))
+        else:
+            out.append((a, b, sg, need))
+    return out
+
+
 def _with_phases(path: Path, lim, grid: Grid, problem: JerkProblem,
-                 prof: Profile, grow: float = 0.0) -> JerkProblem | None:
-    """``problem`` with the phases of ``prof`` (module docstring), grown by ``grow``
-    (:func:`_grown`): the bounds on the accelerations and the rows; ``None`` where
-    ``prof`` has no phase."""
+                 prof: Profile, grow: float = 0.0,
+                 merge: float = PHASE_MERGE_GAP) -> JerkProblem | None:
+    """``problem`` with the phases of ``prof`` (module docstring), where ``grow > 0``
+    joined by ``merge`` (:func:`_merged`) and grown by ``grow`` (:func:`_grown`): the
+    bounds on the accelerations and the rows; ``None`` where ``prof`` has no phase."""
     ph = acceleration_phases(prof)
     if ph.n == 0:
         return None
@@ -309,7 +364,10 @@ def _with_phases(path: Path, lim, grid: Grid, problem: JerkProblem,
     if not keep:
         return None
     if grow > 0:
-        keep = _grown(keep, grow, grid, prof, segment_periods(path, lim)[grid.segment])
+        period = segment_periods(path, lim)[grid.segment]
+        if merge > 0:
+            keep = _merged(keep, grid, prof, period, merge)
+        keep = _grown(keep, grow, grid, prof, period)
         sign[:] = 0
         for a, b, sg, _ in keep:
             sign[a:b] = sg

@@ -59,11 +59,12 @@ changes of one sign joined by a creep are one phase whose centroid lies in the c
 (tests/core/test_phases.py), so a fall may do most of its change at full acceleration,
 pass a corner's low cap in the creep and finish at full acceleration, where ramps spend
 ``1/f`` on each change. ``|s''| <= 2 f dv`` hardly binds there (``dv`` is the whole
-phase's change). On lcnc_test_12mmflat (default machine) this is where the bracket stays
+phase's change). On lcnc_test_12mmflat (default machine) this is where the bracket stayed
 open: on its first pass (a line and four arcs, the last of radius 2.83 mm ending at a
 1.4 mm/s corner) a hand-built motion of this kind, checked and time-scaled by 0.12 %, takes
 3.3766 s against the oracle's ramps' 3.4153 s and a lower bound of 3.3360 s, so the lower
-bound is near the optimum of the rule and the ramps are not.
+bound is near the optimum of the rule and the ramps are not. The oracle's NLP with the
+rule's rows now joins such phases (:mod:`optimal.freq.phase_nlp`) and finds 3.3749 s.
 
 Units: s, mm, Hz. numpy only.
 """
