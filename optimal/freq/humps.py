@@ -170,8 +170,12 @@ HUMP_MERGE_SHARE = 0.25
 
 #: Ceiling on the number of cells (work and memory of the programme: about
 #: ``cells x window`` float64 operations). Above it the cells get longer, which only
-#: weakens the bound.
-HUMP_MAX_CELLS = 20_000
+#: weakens the bound, and :func:`_spread` does not cut at all. Measured on
+#: lcnc_test_12mmflat (``acc+freq``, one piece of 38 s; 24,512 cells of
+#: HUMP_CELL_TIME_REL, 84,935 after the cuts of :func:`_spread`): a ceiling of 20,000
+#: gave 37.107 s of bound (its ``compare`` 38 s, 296 MB), 100,000 37.285 s (69 s, 316 MB),
+#: 400,000 37.290 s (and twice the time).
+HUMP_MAX_CELLS = 100_000
 
 #: Cells whose speed bounds differ by more than this share (``hi > (1 + x) lo``) are cut
 #: further in the programme's last run (:func:`_spread`): near corners the envelope climbs

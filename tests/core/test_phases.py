@@ -196,9 +196,10 @@ def test_two_abrupt_changes_joined_by_a_creep_are_one_accepted_phase():
     does the other half at full A again is one phase, and its effective duration (by
     hand: the two halves weigh about alike, so ``t_c`` lies near the middle of the creep
     and ``D_eff`` near ``T_creep + dv / (2 A)``) passes 1/f, although each real speed
-    change lasts ``dv / (2 A) = 1 / (4 f)``. This is the motion that keeps the
+    change lasts ``dv / (2 A) = 1 / (4 f)``. This is the motion that kept the
     bracket of lcnc_test_12mmflat open: the corner's low cap is passed in the creep,
-    and each fall is shorter than a ramp of 1/f could be."""
+    and each fall is shorter than a ramp of 1/f could be (the oracle's NLP now joins
+    such phases, optimal.freq.phase_nlp)."""
     T, A, v = 0.1, 2000.0, 100.0
     h = (v / 2) / A                          # each abrupt half, s
     c = 1e-4 * A

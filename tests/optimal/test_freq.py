@@ -395,6 +395,82 @@ def test_acc_freq_falls_through_a_feed_cap_in_one_phase():
     assert best[0.0] >= hand.t[-1] * 1.05
 
 
+def _labelled(path, dur, acc):
+    """The motion of constant-acceleration pieces (durations s, accelerations mm/s^2)
+    from rest, cut at ``path``'s block ends and labelled with their blocks."""
+    from reference.core.profile import Profile
+    prof = Profile.from_phases(dur, acc, np.zeros(len(dur)))
+    prof = prof.split_at(np.cumsum(path.length)[:-1])
+    blk = path.block[path.segment_index(0.5 * (prof.s[:-1] + prof.s[1:]))]
+    return Profile(t=prof.t, s=prof.s, v=prof.v, a=prof.a, j=prof.j, block=blk)
+
+
+def test_acc_freq_flattens_a_wiggle_between_two_caps():
+    # A rest-to-rest line of five blocks (machine(): A = 2000 mm/s^2, f = 10 Hz): 30 mm
+    # at 100 mm/s, 0.01 mm at 17 mm/s (a cap at a point), 2.8 mm at 60 mm/s, 0.01 mm at
+    # 1.5 mm/s, 20 mm at 100 mm/s. Ramps of 1/f fall to 17 mm/s, rise on the 2.8 mm to
+    # 18.75 mm/s and fall to 1.5 mm/s (a wiggle: 0.1 s each way for 1.75 mm/s), rise to
+    # 100 mm/s and fall to rest: 0.8980 s. The hand motion below crosses the 2.8 mm in
+    # one fall phase instead: from 100 to 17 mm/s at the full A, on at 17 mm/s less a
+    # creep of 0.01 mm/s^2 through both short blocks, to 1.5 mm/s at A (the phase
+    # starts creeping 10 ms before its first drop, which puts its acceleration-weighted
+    # mean time 1/(2f) from its start); then the ramps of 1/f: 0.84197 s. The checker
+    # accepts it; the oracle's lower bound must stay below it and its upper bound come
+    # within MOTION_SLACK of it. The phase NLP from the ramps finds it in its trial with
+    # the wiggle flattened (optimal.freq.phase_nlp._flattened): 0.84367 s; without the
+    # trial the phases stay those of the ramps (0.89086 s, 5.8 % slower; the oracle's
+    # bracket was 8.0 %, now 2.2 % against its lower bound of 0.82516 s)
+    from scipy.optimize import brentq
+    from optimal.freq.oracle import _acc_nlp_grid
+    from optimal.freq.phase_nlp import phase_nlp
+    from reference.core.phases import acceleration_phases
+    MOTION_SLACK = 5e-3          # as in test_acc_freq_falls_through_a_feed_cap_in_one_phase
+    lim = machine(f=10.0)
+    lengths = [30.0, 0.01, 2.8, 0.01, 20.0]
+    pts = np.zeros((6, 3))
+    pts[1:, 0] = np.cumsum(lengths)
+    path = line_path(pts, feed=np.array([100.0, 17.0, 60.0, 1.5, 100.0]))
+    A, c, pre = 2000.0, 0.01, 0.01
+    v1 = 100.0 - c * pre
+    d1 = (v1 - 17.0) / A
+    # the creep from 17 mm/s and the drop to 1.5 mm/s at A end where the 1.5 mm/s block
+    # starts (2.81 mm on); the creep goes on through that block
+    tau = brentq(lambda x: 17.0 * x - c * x * x / 2
+                 + ((17.0 - c * x) ** 2 - 1.5 ** 2) / (2 * A) - 2.81, 0.0, 1.0)
+    tau2 = brentq(lambda x: 1.5 * x - c * x * x / 2 - 0.01, 0.0, 1.0)
+    v3 = 1.5 - c * tau2
+    cruise1 = (25.0 - (100.0 * pre - c * pre * pre / 2) - (v1 + 17.0) / 2 * d1) / 100.0
+    cruise2 = (15.0 - (v3 + 100.0) / 2 * 0.1) / 100.0
+    hand = _labelled(path, [0.1, cruise1, pre, d1, tau, (17.0 - c * tau - 1.5) / A, tau2,
+                            0.1, cruise2, 0.1],
+                     [1000.0, 0.0, -c, -A, -c, -A, -c, (100.0 - v3) / 0.1, 0.0, -1000.0])
+    assert hand.s[-1] == pytest.approx(52.82, abs=1e-9)
+    assert hand.t[-1] == pytest.approx(0.84197, abs=1e-5)
+    rep = check_profile(path, lim, hand)
+    assert rep.ok(BOUND_SETS["acc+freq"]), rep.violations(BOUND_SETS["acc+freq"])
+    assert acceleration_phases(hand).n == 4
+    sol = optimal.solve(path, lim, bounds="acc+freq", initial_intervals=N0)
+    assert sol.lower_bound_s <= hand.t[-1]
+    assert sol.upper_bound_s <= hand.t[-1] * (1 + MOTION_SLACK)
+    assert check_profile(path, lim, sol.profile).ok(BOUND_SETS["acc+freq"])
+    # the ramps: the hump on the 2.8 mm peaks at (2.8 - 0.1 (17 + 1.5) / 2) / 0.1
+    v_top = (2.8 - 0.1 * 18.5 / 2) / 0.1
+    ramps = _labelled(path, [0.1, (30.0 - 5.0 - 5.85) / 100.0, 0.1, 0.01 / 17.0, 0.1, 0.1,
+                             0.01 / 1.5, 0.1, (20.0 - 5.075 - 5.0) / 100.0, 0.1],
+                      [1000.0, 0.0, -830.0, 0.0, (v_top - 17.0) / 0.1,
+                       (1.5 - v_top) / 0.1, 0.0, 985.0, 0.0, -1000.0])
+    assert ramps.s[-1] == pytest.approx(52.82, abs=1e-9)
+    assert check_profile(path, lim, ramps).ok(BOUND_SETS["acc+freq"])
+    grid = _acc_nlp_grid(path, lim, optimal.solve(path, lim, bounds="acc",
+                                                  initial_intervals=N0))
+    runs = {w: phase_nlp(path, lim, grid, ramps, bounds="acc+freq", wiggle=w)
+            for w in (0.0, 0.5)}
+    assert not any("flattened" in c.name for c in runs[0.0])
+    best = {w: min(c.duration for c in out) for w, out in runs.items()}
+    assert best[0.5] <= hand.t[-1] * (1 + MOTION_SLACK)
+    assert best[0.0] >= hand.t[-1] * 1.05
+
+
 @pytest.mark.parametrize("bounds", ["jerk+freq", "acc+freq"])
 @pytest.mark.parametrize("case", ["line-arc-line", "zig-zag"])
 def test_phase_nlp_keeps_the_rule_by_its_rows(case, bounds):
