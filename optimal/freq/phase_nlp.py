@@ -76,7 +76,9 @@ lcnc_sam_tolerance_issue 30.9 -> 23.8 % (the NLP on the seed's phases) -> 20.0 %
 phases grown) -> 18.0 % (with the oracle's second seed, :mod:`optimal.freq.oracle`),
 lcnc_test_12mmflat 2.64 -> 2.51 -> 1.84 %; ``acc+freq`` (the NLP added there) sam
 20.2 -> 12.6 %, 12mmflat 3.27 -> 3.00 % -> 2.90 % (phases joined; sam has no two
-phases of one sign to join, its motion rising and falling between corners).
+phases of one sign to join, its motion rising and falling between corners) -> 2.75 %
+(wiggles flattened; 2.26 % with the turn programme's cell ceiling raised,
+:data:`optimal.freq.humps.HUMP_MAX_CELLS`).
 
 Units: mm, s.
 """
