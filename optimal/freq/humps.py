@@ -117,6 +117,26 @@ Measured on single corners (two lines at F1200 on the default machine) it comes 
 0.7 % of the verified motion; on paths of many short segments at low speed
 (lcnc_sam_tolerance_issue) it is still some 11 % below it (acc+freq).
 
+Where that 11 % is, measured (acc+freq, default machine, the programme run on parts of
+the one rest-to-rest piece): over the first 164 mm (two long moves) 0.910 s against the
+motion's 0.939 s; over the last 4 mm, fourteen blocks of 0.1-0.5 mm with corner caps of
+0.8-8.6 mm/s, 1.023 s against 1.254 s. There the shortest path turns inside blocks and
+pays about ``g`` per stretch (from 166.53 mm to the end six stretches, 0.400 s, against
+the motion's 0.509 s). Motions sketched by hand from 166.58 mm to the end (estimates,
+not checked profiles), with phases that creep, jump and creep as the rule accepts
+(:mod:`reference.core.phases`), come to about the motion's 0.495 s, and the exploratory
+lattice search that module cites found 1.25 s on the tail: nothing faster than the
+motion is known. One suspect was tested and gained almost nothing: a fall phase
+``[t_0, t_1]`` that changes the speed by ``D_b`` before a corner (passed at ``t_x``) and
+by ``D_a`` after it has ``D_b (t_x - t_0) + D_a (t_1 - t_0) >= (D_b + D_a) g / 2`` (its
+acceleration-weighted mean time is at least ``g/2`` after its start), so a fall from a
+peak far above a cap just after it lasts long. A prototype of the programme that carried
+the peak's speed in levels (as step 4c carries the valley's) and charged every fall that
+passes a cap this bound raised the piece's bound by 0.001 s only (1.9332 -> 1.9342 s,
+with 6 and 12 levels of ratio 0.8, the bound taken at the least cap between peak and
+valley): its shortest path then peaks at about the cap's speed and pays the same ``g``
+per stretch. Which side is weak there, and by how much, is open.
+
 Units: mm, s, mm/s.
 """
 
@@ -196,6 +216,13 @@ HUMP_SPREAD_ROUNDS = 6
 #: lcnc_arc_arc_sawtooth (``acc+freq``, default machine; bracket 2.06 % without the run):
 #: 0 cells either side 1.91 %, 1: 1.70 %, 2 and 3: 1.67 %; a second run adds nothing.
 #: (Uniform cells of 1 % of a period instead of 2 %: 1.82 %, at 14 times the work.)
+#: Those figures are under a HUMP_MAX_CELLS of 20,000. Under 100,000 the fine run's cuts
+#: of :func:`_spread` reach 1.70 % on the sawtooth by themselves (93,410 cells; its
+#: bound 5.1752 s is above the one that meets the bracket, 5.1601 s), so the run does
+#: not follow there; on lcnc_test_12mmflat it would pass the ceiling (84,935 cells before
+#: it) and is left out. Allowed a ceiling of 200,000, the cuts go on (144,566 cells,
+#: bound 37.2849 -> 37.2899 s) and the turn run after them adds nothing, at 1.7 times
+#: the oracle's wall time (57.7 -> 98.6 s).
 HUMP_TURN_WIDTH = 2
 
 #: See HUMP_TURN_WIDTH. Eight instead of four: 1.67-1.74 %, no better.
