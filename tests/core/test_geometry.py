@@ -34,6 +34,19 @@ def random_arc(rng, plane, clockwise, turns=0, helix=True):
     return start, end, c, (u, v), clockwise, turns
 
 
+def arcs_helices_and_a_spiral(rng):
+    """Six arc pieces of blocks 0..5 in G17, turning both ways: three helices, two
+    plane arcs and a spiral (its end radius 0.3 mm off)."""
+    pieces = []
+    for k in range(6):
+        start, end, c, pl, cw, turns = random_arc(rng, "G17", bool(k % 2), 0,
+                                                  helix=k < 3)
+        if k == 5:
+            end = end + 0.3 * (end - c) / np.linalg.norm((end - c)[:2]) * GEO
+        pieces.append(arc_segment(start, end, c, pl, cw, turns, GEO, k, 1.0))
+    return pieces
+
+
 def fd_check(seg, rng):
     L = seg.length
     s = rng.uniform(0.05 * L, 0.95 * L, 20)
@@ -132,13 +145,7 @@ def test_tangents_alone_are_the_tangents_of_evaluate_and_the_finite_differences(
     evaluate's second output, and the central difference of the positions (an
     independent check of the formula)."""
     rng = np.random.default_rng(11)
-    pieces = []
-    for k in range(6):
-        start, end, c, pl, cw, turns = random_arc(rng, "G17", bool(k % 2), 0,
-                                                  helix=k < 3)
-        if k == 5:                       # a spiral: the end radius 0.3 mm off
-            end = end + 0.3 * (end - c) / np.linalg.norm((end - c)[:2]) * GEO
-        pieces.append(arc_segment(start, end, c, pl, cw, turns, GEO, k, 1.0))
+    pieces = arcs_helices_and_a_spiral(rng)
     pts = rng.uniform(-20, 20, (4, 5))
     pieces.append(line_segments(pts[:-1], pts[1:], GEO, np.arange(6, 9)))
     p = path_from_pieces(AX, pieces)
@@ -158,6 +165,51 @@ def test_tangents_alone_are_the_tangents_of_evaluate_and_the_finite_differences(
     ends = p.s_breaks[1:-1]
     np.testing.assert_allclose(t_in, p.tangents(ends, segment=at), atol=1e-12)
     assert np.array_equal(t_out, p.tangents(ends, segment=at + 1))
+
+
+def test_junction_derivatives_are_evaluate_at_both_ends_and_the_finite_differences():
+    """Path.junction_derivatives (the first two derivatives alone, as the planner's
+    corner stage asks for them) on lines, arcs, helices, a spiral and clothoid pairs:
+    bit for bit the full evaluation's second and third outputs at each segment's local
+    ends (the position and third derivative left out change nothing), evaluate's at
+    the global breaks (bit for bit at a segment's start; at its end the global position
+    turned local differs by round-off), and the one-sided differences of the tangents
+    there (an independent check of the curvature formulas)."""
+    from reference.core.geometry import KIND_CODES, _eval_helical, clothoid_pieces
+    rng = np.random.default_rng(12)
+    pieces = arcs_helices_and_a_spiral(rng)
+    # three clothoid pairs (each a rising and a falling piece) in tilted planes
+    t1 = rng.normal(size=(3, 5)) * GEO
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    t2 = rng.normal(size=(3, 5)) * GEO
+    t2 /= np.linalg.norm(t2, axis=1)[:, None]
+    pieces.append(clothoid_pieces(rng.uniform(-20, 20, (3, 5)), t1, t2,
+                                  rng.uniform(0.5, 3.0, 3), np.arange(6, 9),
+                                  KIND_CODES.index("rounding")))
+    pts = rng.uniform(-20, 20, (4, 5))
+    pieces.append(line_segments(pts[:-1], pts[1:], GEO, np.arange(9, 12)))
+    p = path_from_pieces(AX, pieces)
+    assert (p.dradius != 0).any() and np.count_nonzero(p.sharpness) == 6
+    t_in, t_out, k_in, k_out = p.junction_derivatives()
+    at = np.arange(p.n_segments - 1)
+    cols = (p.origin, p.e1, p.e2, p.d, p.radius, p.omega, p.theta0)
+    full_in = _eval_helical(*cols, at, p.length[:-1], p.dradius, p.length, p.sharpness)
+    full_out = _eval_helical(*cols, at + 1, np.zeros(at.size), p.dradius, p.length,
+                             p.sharpness)
+    assert np.array_equal(t_in, full_in[1]) and np.array_equal(k_in, full_in[2])
+    assert np.array_equal(t_out, full_out[1]) and np.array_equal(k_out, full_out[2])
+    ends = p.s_breaks[1:-1]
+    before = p.evaluate(ends, segment=at)
+    after = p.evaluate(ends, segment=at + 1)
+    np.testing.assert_allclose(t_in, before[1], atol=1e-12)
+    np.testing.assert_allclose(k_in, before[2], atol=1e-12)
+    assert np.array_equal(t_out, after[1]) and np.array_equal(k_out, after[2])
+    h = 1e-6
+    fd_in = (before[1] - p.evaluate(ends - h, segment=at)[1]) / h
+    fd_out = (p.evaluate(ends + h, segment=at + 1)[1] - after[1]) / h
+    scale = 1.0 + np.abs(np.concatenate((k_in, k_out))).max()
+    np.testing.assert_allclose(k_in, fd_in, atol=1e-4 * scale)
+    np.testing.assert_allclose(k_out, fd_out, atol=1e-4 * scale)
 
 
 def test_restricted_path_keeps_the_moving_axes_exactly():
