@@ -217,14 +217,14 @@ def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None
         phi = theta0[idx][:, None] + wc * s[:, None]
         c, sn = np.cos(phi), np.sin(phi)
         along = E2 * c - E1 * sn           # unit tangential direction of the circle
-        if tangent_only:
-            return None, (rc * wc) * along + DL, None, None
-        radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
-        if two_derivatives:
-            return None, (rc * wc) * along + DL, -(rc * wc * wc) * radial, None
-        q = origin.take(idx, axis=0) + rc * radial + DL * s[:, None]
         dq = (rc * wc) * along + DL
+        if tangent_only:
+            return None, dq, None, None
+        radial = E1 * c + E2 * sn          # unit radial direction (zero rows for lines)
         ddq = -(rc * wc * wc) * radial
+        if two_derivatives:
+            return None, dq, ddq, None
+        q = origin.take(idx, axis=0) + rc * radial + DL * s[:, None]
         dddq = -(rc * wc * wc * wc) * along
         return q, dq, ddq, dddq
     # With spirals: q = o + A R + d s, q' = B T + C R + d, q'' = D R + E T,
@@ -240,12 +240,12 @@ def _eval_helical(origin, e1, e2, d, radius, omega, theta0, idx, s, dradius=None
     c, sn = np.cos(phi)[:, None], np.sin(phi)[:, None]
     radial = E1 * c + E2 * sn
     along = E2 * c - E1 * sn
-    q = origin.take(idx, axis=0) + A[:, None] * radial + DL * s[:, None]
     dq = B[:, None] * along + C[:, None] * radial + DL
     ddq = D[:, None] * radial + E[:, None] * along
-    dddq = F[:, None] * along + G[:, None] * radial
     if two_derivatives:
         return None, dq, ddq, None
+    q = origin.take(idx, axis=0) + A[:, None] * radial + DL * s[:, None]
+    dddq = F[:, None] * along + G[:, None] * radial
     return q, dq, ddq, dddq
 
 
