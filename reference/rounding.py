@@ -276,7 +276,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     mode_id = attrs["mode_id"][ka]
     accel_id = attrs["accel_id"]
     soft_id = attrs["accel_names"].index("SOFT") if "SOFT" in attrs["accel_names"] else -1
-    mode = tuple(mode_arr.tolist())
+    mode = tuple(map(names.__getitem__, mode_id.tolist()))    # the names, not new strings
     reason = np.full(a.size, -1, dtype=np.int64)
 
     def decide(mask: np.ndarray, why: str) -> None:
@@ -305,9 +305,11 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         # at the global break position, as the arcs' rows evaluate it (not
         # Path.junction_tangents, which takes the segment's own length: the two
         # differ by round-off)
+        # (both sides in one call: the same elementwise numbers, half the dispatch)
         s_c = path.s_breaks[a[near_arc] + 1]
-        t1_arc = path.tangents(s_c, segment=a[near_arc])
-        t2_arc = path.tangents(s_c, segment=a[near_arc] + 1)
+        t12 = path.tangents(np.concatenate((s_c, s_c)),
+                            segment=np.concatenate((a[near_arc], a[near_arc] + 1)))
+        t1_arc, t2_arc = t12[:near_arc.size], t12[near_arc.size:]
         tang_arc[near_arc] = is_tangential(t1_arc, t2_arc, FEASIBLE)
     other = np.zeros(a.size, bool)
     if not geo.all():
@@ -952,6 +954,8 @@ def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) 
     """
     z = np.zeros_like(d)
     ok = open_ & (d > 0)
+    if not ok.any():                      # no corner to size (e.g. all next to arcs)
+        return _Shape(z, z.copy(), z.copy(), z.copy(), z.copy(), z.copy())
     # the pair's shape where it is one (elementwise: the same numbers as on all rows)
     d_1, e_1 = np.ones_like(d), np.ones_like(d)
     c = np.flatnonzero(g2 & ok)           # the other rows read neither

@@ -194,17 +194,26 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     decide(~(line_arc | arc_line | arc_arc), "corner next to an inserted block (TRC, "
            "TLIFT): rounding not modelled yet")
     E1, E2 = path.e1.take(arc, axis=0), path.e2.take(arc, axis=0)
-    t_line = path.d.take(line, axis=0)
-    # the line in the arc's plane (OFF_PLANE_MAX)
-    off = row_norms(t_line - row_dots(t_line, E1)[:, None] * E1
-                    - row_dots(t_line, E2)[:, None] * E2)
-    # between two arcs (``arc`` is the first, ``line`` the second): the second's plane
-    # vectors in the first's plane
     E1b, E2b = path.e1.take(b, axis=0), path.e2.take(b, axis=0)
-    off_b = np.maximum(
-        row_norms(E1b - row_dots(E1b, E1)[:, None] * E1 - row_dots(E1b, E2)[:, None] * E2),
-        row_norms(E2b - row_dots(E2b, E1)[:, None] * E1 - row_dots(E2b, E2)[:, None] * E2))
-    off = np.where(arc_arc, off_b, off)
+    # how far out of the arc's plane (OFF_PLANE_MAX), each test only on its own
+    # corners (elementwise: the same numbers as on all of them)
+    off = np.empty(k)
+    la = np.flatnonzero(~arc_arc)
+    if la.size:
+        # the line in the arc's plane
+        t_line = path.d.take(line[la], axis=0)
+        e1, e2 = E1[la], E2[la]
+        off[la] = row_norms(t_line - row_dots(t_line, e1)[:, None] * e1
+                            - row_dots(t_line, e2)[:, None] * e2)
+    two = np.flatnonzero(arc_arc)
+    if two.size:
+        both = _gather(two, k)
+        # between two arcs (``arc`` is the first, ``line`` the second): the second's
+        # plane vectors in the first's plane
+        e1, e2, e1b, e2b = E1[both], E2[both], E1b[both], E2b[both]
+        off[both] = np.maximum(
+            row_norms(e1b - row_dots(e1b, e1)[:, None] * e1 - row_dots(e1b, e2)[:, None] * e2),
+            row_norms(e2b - row_dots(e2b, e1)[:, None] * e1 - row_dots(e2b, e2)[:, None] * e2))
     decide(~circle | ~(off <= OFF_PLANE_MAX),
            "corner next to a helix or spiral, or out of the arc's plane: rounding not "
            "modelled yet")
@@ -217,13 +226,6 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     at = np.where(line_arc, 0.0, path.length[arc])
     phi = path.theta0[arc] + w * at
     radial = np.column_stack((np.cos(phi), np.sin(phi)))      # plane coords
-    corner = path.origin.take(arc, axis=0) + R[:, None] * (
-        E1 * radial[:, :1] + E2 * radial[:, 1:])
-    t2d = np.column_stack((row_dots(t_line, E1), row_dots(t_line, E2)))
-    t2d /= np.where(row_norms(t2d) > 0, row_norms(t2d), 1.0)[:, None]
-    t2d = np.where(line_arc[:, None], t2d, -t2d)
-    centre = -R[:, None] * radial
-    sense = np.where(line_arc, np.sign(w), -np.sign(w))
     c = machine.channel.rounding_length_clamp
     # the two elements in the construction's order (line-arc: the line first)
     cap_first = c * path.length[np.where(arc_arc, a, line)]
@@ -239,16 +241,23 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     fams = []
     la_o = np.flatnonzero(~arc_arc[o])
     if la_o.size:
+        # the line's direction in the arc's plane, the arc's centre and sense
         i = o[la_o]
-        fams.append((la_o, _LINE_CIRCLE, (*t2d[i].T, *centre[i].T, R[i], sense[i])))
+        t_line = path.d.take(line[i], axis=0)
+        t2d = np.column_stack((row_dots(t_line, E1[i]), row_dots(t_line, E2[i])))
+        t2d /= np.where(row_norms(t2d) > 0, row_norms(t2d), 1.0)[:, None]
+        t2d = np.where(line_arc[i, None], t2d, -t2d)
+        centre = -R[i, None] * radial[i]
+        sense = np.where(line_arc[i], np.sign(w[i]), -np.sign(w[i]))
+        fams.append((la_o, _LINE_CIRCLE, (*t2d.T, *centre.T, R[i], sense)))
     aa_o = np.flatnonzero(arc_arc[o])
     if aa_o.size:
-        i = o[aa_o]
+        i = _gather(o[aa_o], k)
         fams.append((aa_o, _CIRCLE_CIRCLE,
                      _circle_pair(path, a[i], b[i], E1[i], E2[i], E1b[i], E2b[i], R[i],
                                   radial[i])))
     for sub_o, fam, cols in fams:
-        i = o[sub_o]
+        i = _gather(o[sub_o], k)
         ro, r_cap, tol_ok, (kept, f_kept) = _radius_by_mode(
             fam, cols, how[i], targets["dist"][i], targets["radius"][i],
             targets["axis_tol"][i], targets["contour"][i], targets["g0"][i], E1[i], E2[i],
@@ -288,53 +297,60 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
     sel = np.searchsorted(o, o2) if o.size else np.zeros(0, np.int64)
     if o2.size:
         f = fil if sel.size == o.size else _take(fil, sel)
-        ro = r[o2]
-        E1o, E2o = E1[o2], E2[o2]
+        # every corner still open (the common case): views, not copies of each column
+        at = slice(None) if o2.size == k else o2
+        ro = r[at]
+        E1o, E2o = E1[at], E2[at]
         rho = np.sqrt(E1o ** 2 + E2o ** 2)             # each axis' weight in the plane
         moving = rho > 0
         wr = np.where(moving, rho, 1.0)
-        t1o, t2o = t1[o2], t2[o2]
+        t1o, t2o = t1[at], t2[at]
         a1, a2 = np.abs(t1o), np.abs(t2o)
         # not tangential: round_corners sent only the corners its test (the same rule,
         # the same tangents) found not tangential
-        v_g64[o2] = junction_speed_cap(t1o, t2o, lim.jump, FEASIBLE,
-                                       np.zeros(o2.size, bool))[0]
-        aa = arc_arc[o2]
-        soft = accel[o2] == "SOFT"
+        v64o = junction_speed_cap(t1o, t2o, lim.jump, FEASIBLE,
+                                  np.zeros(o2.size, bool))[0]
+        v_g64[o2] = v64o
+        aa = arc_arc[at]
+        soft = accel[at] == "SOFT"
+        ao, bo = a[at], b[at]
         # the elements' own radii in the construction's order (inf: the line)
-        R_first = np.where(aa, R[o2], np.inf)
-        R_second = np.where(aa, path.radius[b[o2]], R[o2])
+        R_first = np.where(aa, R[at], np.inf)
+        R_second = np.where(aa, path.radius[bo], R[at])
         with np.errstate(divide="ignore", invalid="ignore"):
             v_axis = np.minimum(row_min(lim.v_max[None, :] / a1),
                                 row_min(lim.v_max[None, :] / a2))
-            v_prog = np.minimum(np.minimum(path.feed[a[o2]], path.feed[b[o2]]), v_axis)
+            v_prog = np.minimum(np.minimum(path.feed[ao], path.feed[bo]), v_axis)
             # at most one segment per IPO cycle on either side (5.3), as the heuristic
             # caps them: the speed each side runs at beside the corner
             # (reference.rounding._line_speeds)
-            ipo_in, ipo_out = path.length[a[o2]] / t_ipo, path.length[b[o2]] / t_ipo
-        v_arc = _arc_speed(lim, R_second, moving, wr, soft, centripetal_share, jerk_share)
+            ipo_in, ipo_out = path.length[ao] / t_ipo, path.length[bo] / t_ipo
+        terms = _arc_speed_terms(lim, moving, wr, soft, centripetal_share, jerk_share)
+        v_arc = _arc_speed(R_second, *terms)
         v_arc_first = np.full(o2.size, np.inf)
         if aa.any():
-            v_arc_first[aa] = _arc_speed(lim, R_first[aa], moving[aa], wr[aa], soft[aa],
-                                         centripetal_share, jerk_share)
+            v_arc_first[aa] = _arc_speed(R_first[aa], *(x[aa] for x in terms))
         length = ro * f.sweep
         # centripetal and, under SOFT, the path jerk on the fillet (third path
         # derivative 1/r^2), as on any arc; one IPO cycle per inserted block (5.3), the
         # feed; under SOFT the curvature jumps at its ends
         vr = np.minimum(np.minimum(v_prog, length / t_ipo),
-                        _arc_speed(lim, ro, moving, wr, soft, centripetal_share, jerk_share))
+                        _arc_speed(ro, *terms))
         if soft.any():
             # 6.3: the fillet's curvature vector jumps from the first element's (the
             # line's 0) at one end and to the second's at the other (q'' = (centre -
             # P) / radius^2)
-            def world(v2):
-                return E1o * v2[:, :1] + E2o * v2[:, 1:]
+            def world(v2, j=slice(None)):
+                return E1o[j] * v2[:, :1] + E2o[j] * v2[:, 1:]
             k_fs = world((f.centre - f.start) / (ro * ro)[:, None])
             k_fe = world((f.centre - f.end) / (ro * ro)[:, None])
             k_ae = world((f.centre_second - f.end) / (R_second * R_second)[:, None])
+            # from the first arc's (a line's: 0), only where the first is an arc
             k_as = np.zeros_like(k_fs)
             if aa.any():
-                k_as[aa] = world((f.centre_first - f.start) / (R_first * R_first)[:, None])[aa]
+                j = _gather(np.flatnonzero(aa), aa.size)
+                k_as[j] = world((f.centre_first[j] - f.start[j])
+                                / (R_first[j] * R_first[j])[:, None], j)
             v_k = np.minimum(
                 curvature_jump_speed_cap(k_as, k_fs, lim.path_trans_jerk, t_ipo),
                 curvature_jump_speed_cap(k_fe, k_ae, lim.path_trans_jerk, t_ipo))
@@ -342,19 +358,20 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         v_round[o2] = vr
         sub = np.zeros(k, bool)
         ignore = machine.channel.ignore_ovl_factor_for_adis
-        ovl = np.isin(mode[o2], OVERLOAD_CHECKED_MODES) & (not ignore)
-        sub[o2] = ovl & (v_g64[o2] >= np.minimum(v_prog, np.minimum(ipo_in, ipo_out)))
+        mode_o = mode[at]
+        ovl = np.isin(mode_o, OVERLOAD_CHECKED_MODES) & (not ignore)
+        sub[o2] = ovl & (v64o >= np.minimum(v_prog, np.minimum(ipo_in, ipo_out)))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
         # G643, and G641/G642/G645 with MD20490 = TRUE, round whatever G64 costs
         # (always_rounds), but not with an inserted block between two very short ones
-        always = always_rounds(mode[o2], ignore)
+        always = always_rounds(mode_o, ignore)
         sub[:] = False
-        sub[o2] = always & ~np.isin(mode[o2], INTERNAL_MODES) & very_short_blocks(
-            path.length[a[o2]], path.length[b[o2]], v_prog, t_ipo)
+        sub[o2] = always & ~np.isin(mode_o, INTERNAL_MODES) & very_short_blocks(
+            path.length[ao], path.length[bo], v_prog, t_ipo)
         decide(sub, "rounding would slow the program down (between two very short blocks)")
         # the time estimate of the line-line corners, each side ramping to its own
         # speed (an arc side to its own limit), the fillet passed at v_round
-        forward = line_arc[o2] | aa
+        forward = line_arc[at] | aa
         v_line = v_prog
         v_first = np.minimum(v_line, v_arc_first)
         v_second = np.minimum(v_line, v_arc)
@@ -367,14 +384,14 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
             j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
         cut_in = np.where(forward, f.trim_first, f.trim_second)
         cut_out = np.where(forward, f.trim_second, f.trim_first)
-        radius_mode = np.isin(mode[o2], ("RND", "RNDM"))
+        radius_mode = np.isin(mode_o, ("RND", "RNDM"))
         sub[:] = False
         # what the fillet leaves of the two elements (one IPO cycle each, 5.3)
-        left_in = path.length[a[o2]] - cut_in
-        left_out = path.length[b[o2]] - cut_out
+        left_in = path.length[ao] - cut_in
+        left_out = path.length[bo] - cut_out
         sub[o2] = ~(time_loss(v_in, v_out, vr, acc_in, acc_out, j_in, j_out, length,
                               cut_in, cut_out, left_in, left_out, t_ipo)
-                    < time_loss(v_in, v_out, v_g64[o2], acc_in, acc_out, j_in, j_out,
+                    < time_loss(v_in, v_out, v64o, acc_in, acc_out, j_in, j_out,
                                 0.0, 0.0)) & ~radius_mode & ~always
         decide(sub, "rounding would be slower than G64")
 
@@ -394,7 +411,11 @@ def arc_corners(path: Path, machine: Machine, a: np.ndarray, ka: np.ndarray,
         radius_out[ins] = r[ins]
         length_out[ins] = r[ins] * f.sweep
         dev_out[ins] = row_norms(f.deviation)
-        rows = _fillet_rows(corner[ins], E1[ins], E2[ins], f, r[ins], fw, ka[ins])
+        # the corner in the world: the arc's end (line-arc: its start)
+        rad = radial[ins]
+        corner = path.origin.take(arc[ins], axis=0) + R[ins, None] * (
+            E1[ins] * rad[:, :1] + E2[ins] * rad[:, 1:])
+        rows = _fillet_rows(corner, E1[ins], E2[ins], f, r[ins], fw, ka[ins])
     return ArcCorners(reason, trim_in, trim_out, radius_out, length_out, dev_out,
                       clamped & (reason == 0), v_g64, v_round, rows)
 
@@ -508,6 +529,13 @@ _CIRCLE_CIRCLE = _Family(
     r_deviation=lambda e, *cols: circle_fillet_radius_for_deviation(e, *_cc(cols)))
 
 
+def _gather(idx: np.ndarray, k: int) -> np.ndarray | slice:
+    """``idx`` (sorted, distinct rows of ``k``) as an index that gathers without
+    copying where it takes every row: the full slice then, so the columns are passed
+    as views (the common case: every corner of one family and one open decision)."""
+    return slice(None) if idx.size == k else idx
+
+
 def _empty_fillet(k: int) -> _Fillet:
     z, z2 = np.zeros(k), np.zeros((k, 2))
     return _Fillet(np.zeros(k, bool), z, z.copy(), z2, z2.copy(), z2.copy(), z2.copy(),
@@ -561,19 +589,21 @@ def _radius_by_mode(fam: _Family, cols: tuple, how: np.ndarray, dist: np.ndarray
     kept = np.zeros(k, bool)
     f_kept = None
     if tl.size:
-        r_guess = fam.r_deviation(dev[tl], *(col[tl] for col in cols))
+        tl_at = _gather(tl, k)
+        r_guess = fam.r_deviation(dev[tl_at], *(col[tl_at] for col in cols))
         g = np.flatnonzero((r_guess > R_MIN_MM) & np.isfinite(r_guess) & ~dyn_cap[tl])
         if g.size:
             tg = tl[g]
+            tg_at = _gather(tg, k)
             r_g = np.exp(np.log(r_guess[g]) - ROOT_XATOL / 2.0)
-            f_g = fam.fillet(r_g, *(col[tg] for col in cols))
-            lr = _tol_log_ratio(f_g.deviation, f_g.valid, E1[tg], E2[tg],
-                                tol[tg] * g0[tg, None], cont[tg] * g0[tg])
+            f_g = fam.fillet(r_g, *(col[tg_at] for col in cols))
+            lr = _tol_log_ratio(f_g.deviation, f_g.valid, E1[tg_at], E2[tg_at],
+                                tol[tg_at] * g0[tg_at, None], cont[tg_at] * g0[tg_at])
             inside = 1.0 - GUESS_BELOW_CAP
             with np.errstate(invalid="ignore"):
                 hit = ((lr <= 0.0) & (lr >= -2.0 * ROOT_XATOL) & f_g.valid
-                       & (f_g.trim_first <= inside * cap_first[tg])
-                       & (f_g.trim_second <= inside * cap_second[tg]))
+                       & (f_g.trim_first <= inside * cap_first[tg_at])
+                       & (f_g.trim_second <= inside * cap_second[tg_at]))
             kept[tg[hit]] = True
             ro[tg[hit]] = r_g[hit]
             # in corner order, without copying where every corner was judged (the
@@ -740,18 +770,36 @@ def _secant_root(ratio: Callable, cols: tuple, x0: np.ndarray, f0: np.ndarray,
         return r, ratio(np.log(r), *cols)
 
 
-def _arc_speed(lim, radius: np.ndarray, moving: np.ndarray, wr: np.ndarray,
-               soft: np.ndarray, centripetal_share: float, jerk_share: float) -> np.ndarray:
-    """What the heuristic grants an arc of ``radius`` in the fillet's plane: centripetal,
-    under SOFT also the path jerk ``rho_i v^3 / R^2``, mm/s, shape (k,)."""
+def _arc_speed_terms(lim, moving: np.ndarray, wr: np.ndarray, soft: np.ndarray,
+                     centripetal_share: float, jerk_share: float
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per corner, the radius-free factors of :func:`_arc_speed`: the smallest axis term
+    of ``centripetal_share a_i / rho_i`` (1/s^2) and, under SOFT, of ``jerk_share j_i /
+    rho_i`` (1/s^3, ``inf`` under BRISK), and ``soft``, each shape (k,). The axis
+    minima do not depend on the radius (a positive factor of every term), so they are
+    taken once per corner for the fillet and both elements."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        # the root of the smallest axis term (the roots grow with their argument: the
-        # same minimum, one root per corner instead of one per axis)
-        v_arc = np.sqrt(row_min(np.where(moving, centripetal_share * lim.a_max[None, :]
-                                         * radius[:, None] / wr, np.inf)))
-        return np.where(soft, np.minimum(v_arc, np.cbrt(row_min(np.where(
-            moving, jerk_share * lim.j_max[None, :] * (radius * radius)[:, None] / wr,
-            np.inf)))), v_arc)
+        k_acc = row_min(np.where(moving, centripetal_share * lim.a_max[None, :] / wr,
+                                 np.inf))
+        k_jerk = np.full(soft.shape, np.inf)
+        if soft.any():
+            k_jerk[soft] = row_min(np.where(moving[soft],
+                                            jerk_share * lim.j_max[None, :] / wr[soft],
+                                            np.inf))
+    return k_acc, k_jerk, soft
+
+
+def _arc_speed(radius: np.ndarray, k_acc: np.ndarray, k_jerk: np.ndarray,
+               soft: np.ndarray) -> np.ndarray:
+    """What the heuristic grants an arc of ``radius`` (mm, > 0, ``inf``: a line) in the
+    fillet's plane: centripetal ``v^2 rho_i / R <= c a_i``, under SOFT also the path jerk
+    ``rho_i v^3 / R^2 <= s j_i``, mm/s, shape (k,); the factors from
+    :func:`_arc_speed_terms`. The roots grow with their argument, so the root of the
+    smallest axis term is the smallest root: one root per corner, not one per axis."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        v_arc = np.sqrt(k_acc * radius)
+        return np.where(soft, np.minimum(v_arc, np.cbrt(k_jerk * (radius * radius))),
+                        v_arc)
 
 
 def _log_length_ratio(x: np.ndarray, *cols, n_geo: int, fillet: Callable) -> np.ndarray:

@@ -54,7 +54,7 @@ from functools import partial
 
 import numpy as np
 
-from .core.arrays import row_min
+from .core.arrays import row_any, row_min
 from .core.geometry import KIND_CODES, Path
 from .core.limits import AxisArrays
 from .core.rounding import REASON_CODE, break_windows, leftovers
@@ -173,7 +173,7 @@ def line_arc_pairs(path: Path, a: np.ndarray):
 
     def is_circle(i: np.ndarray) -> np.ndarray:
         return ((path.dradius[i] == 0) & (path.sharpness[i] == 0)
-                & ~(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL).any(axis=1))
+                & ~row_any(np.abs(path.d.take(i, axis=0)) > MOVING_AXIS_TOL))
 
     circle = is_circle(arc) & np.where(arc_arc, is_circle(b), True)
     return b, line_arc, arc_line, arc_arc, arc, line, circle

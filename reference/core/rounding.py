@@ -649,7 +649,9 @@ def _circle_pair_frame(c1: np.ndarray, r1: np.ndarray, s1: np.ndarray, c2: np.nd
     the way that circle does) of :func:`circle_circle_fillet`."""
     u1 = -c1 / r1[:, None]
     u2 = -c2 / r2[:, None]
-    s = np.sign(_cross2(s1[:, None] * _perp(u1), s2[:, None] * _perp(u2)))
+    # the sign of t_1 x t_2 (t_j = s_j perp(u_j)): s_1 s_2 (u_1 x u_2), the same number
+    # (perp and the senses +-1 only swap and negate the products)
+    s = np.sign(s1 * s2 * _cross2(u1, u2))
     return u1, u2, s, np.where(s == s1, 1.0, -1.0), np.where(s == s2, 1.0, -1.0)
 
 
@@ -764,9 +766,10 @@ def circle_circle_fillet(r: np.ndarray, c1: np.ndarray, r1: np.ndarray, s1: np.n
         e_end = iota2[:, None] * u2
         sweep = np.mod(s * np.arctan2(_cross2(radial, e_end), row_dots(radial, e_end)),
                        2.0 * np.pi)
-        t1 = s1[:, None] * _perp(u01)
-        t2 = s2[:, None] * _perp(u02)
-        theta = 2.0 * np.arctan2(row_norms(t2 - t1), row_norms(t2 + t1))
+        # the corner's deflection between t_j = s_j perp(u_0j): |t_2 -+ t_1| = |s_2 u_02
+        # -+ s_1 u_01| (perp turns a vector: the same squares, summed in the other order)
+        w1, w2 = s1[:, None] * u01, s2[:, None] * u02
+        theta = 2.0 * np.arctan2(row_norms(w2 - w1), row_norms(w2 + w1))
         expected = theta + s * (s1 * ang1 + s2 * ang2)
         # nearest point to C: on the radius towards C where it meets the fillet's span
         to_c = -O / row_norms(O)[:, None]

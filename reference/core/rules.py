@@ -296,9 +296,11 @@ def curvature_jump_speed_cap(k_in: np.ndarray, k_out: np.ndarray, path_trans_jer
         return np.zeros(0)
     jumps = dk > CURVATURE_JUMP_TOL_PER_MM
     with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.where(jumps, np.sqrt(np.asarray(path_trans_jerk)[None, :] * t_ipo
-                                    / np.where(jumps, dk, 1.0)), np.inf)
-    return row_min(v) if v.shape[1] else np.full(dk.shape[0], np.inf)
+        v2 = np.where(jumps, np.asarray(path_trans_jerk)[None, :] * t_ipo
+                      / np.where(jumps, dk, 1.0), np.inf)
+    # one root per row: the root is monotone and correctly rounded, so the root of the
+    # smallest square is the smallest root, bit for bit
+    return np.sqrt(row_min(v2)) if v2.shape[1] else np.full(dk.shape[0], np.inf)
 
 
 # ===================================================================== axis kinematics
