@@ -122,6 +122,42 @@ def test_block_times_sum_to_duration_and_hold_goes_to_dwell_block():
     np.testing.assert_allclose(prof.segment_times(p), [2.0, 2.0])
 
 
+
+def test_segment_times_of_some_segments_against_the_closed_form():
+    """A rest-to-rest trapezoid over 50 lines of 1 mm (ramps of 0.1 s at 1000 mm/s^2 to
+    100 mm/s, 5 mm each): the time of segment ``[j, j + 1]`` is ``T(j + 1) - T(j)`` with
+    ``T(s) = sqrt(2 s / a)`` on the rise, ``0.1 + (s - 5) / v`` at cruise and the mirror
+    on the fall. Asked for some segments only (as the block rows ask for those of the
+    blocks with roundings), each comes out so, the others 0; and
+    ``block_and_segment_times`` gives the same."""
+    n = 50
+    x = np.arange(n + 1, dtype=float)
+    pts = np.column_stack((x, np.zeros(n + 1), np.zeros(n + 1)))
+    spans = (BlockSpan(0, 1, "", "G1", 0.0, float(n), 0, n),)
+    p = path_from_pieces(("X", "Y", "Z"),
+                         [line_segments(pts[:-1], pts[1:], GEO, np.zeros(n, np.int64))],
+                         blocks=spans)
+    prof = Profile.from_phases([0.1, 0.4, 0.1], [1000.0, 0.0, -1000.0], [0.0, 0.0, 0.0])
+    a, v = 1000.0, 100.0
+
+    def T(s):
+        s = np.asarray(s, float)
+        return np.where(s <= 5.0, np.sqrt(2.0 * s / a),
+                        np.where(s <= 45.0, 0.1 + (s - 5.0) / v,
+                                 0.6 - np.sqrt(2.0 * np.maximum(n - s, 0.0) / a)))
+
+    exact = T(x[1:]) - T(x[:-1])
+    rng = np.random.default_rng(7)
+    for segs in (np.array([0, n - 1]), np.array([4, 5, 6]), np.arange(n),
+                 *(np.unique(rng.integers(0, n, size=k)) for k in (1, 5, 20))):
+        got = prof.segment_times(p, segs)
+        np.testing.assert_allclose(got[segs], exact[segs], rtol=1e-12, atol=1e-15)
+        rest = np.setdiff1d(np.arange(n), segs)
+        assert np.all(got[rest] == 0.0)
+        bt, st = prof.block_and_segment_times(p, segs)
+        np.testing.assert_array_equal(st, got)
+        assert bt[0] == pytest.approx(0.6, rel=1e-14)
+
 @pytest.mark.parametrize("kw, match", [
     (dict(t=[0, np.nan], s=[0, 1], v=[0, 0], a=[0], j=[0], block=[0]), r"t\[1\] is not finite"),
     (dict(t=[0, 1, 0.5], s=[0, 1, 2], v=[0, 0, 0], a=[0, 0], j=[0, 0], block=[0, 0]),
