@@ -35,6 +35,13 @@ load once per process (about 0.5 s, shown on its own line, not in the rows); the
 uses them on large programs or once they are loaded (the same numbers either way), so
 here every row runs them warm, the G64 side too.
 
+The rows also move between processes, not only between runs of one: the G64 side of the
+same-way row read 7.0, 7.4 and 8.5 us/block in three runs of this script on one idle
+machine (its per-segment ratio 1.44 .. 1.22), and ``round_corners`` on the arc-arc row
+took 21.4 ms or 19.2 ms in the same process depending on the C allocator's thresholds
+(``MALLOC_MMAP_THRESHOLD_``: whether the large numpy temporaries come back as fresh,
+page-faulting mappings). Read a row near the target over a few runs.
+
 Per block means per program block. Rounding inserts a block at most corners (the control
 then prepares and interpolates that many more blocks), and the heuristic plans every
 segment of it (a tangent arc is one segment, a G2 corner rounding two clothoid pieces, a
