@@ -478,19 +478,16 @@ class Profile:
             k, tc, sc = cut
             t = np.insert(self.t, k + 1, tc)
             s = np.insert(self.s, k + 1, sc)
-        if segments is None:
+        n_iv = s.size - 1
+        if segments is not None:
+            segments = np.asarray(segments, dtype=np.int64)
+            wanted = np.zeros(path.n_segments, dtype=bool)
+            wanted[segments] = True
+        if segments is None or n_iv <= 0 or segments.size > _FEW_SEGMENTS_SHARE * path.n_segments:
             moving = s[1:] > s[:-1]
             seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
-            return np.bincount(seg[moving], weights=np.diff(t)[moving],
-                               minlength=path.n_segments)
-        segments = np.asarray(segments, dtype=np.int64)
-        wanted = np.zeros(path.n_segments, dtype=bool)
-        wanted[segments] = True
-        n_iv = s.size - 1
-        if n_iv <= 0 or segments.size > _FEW_SEGMENTS_SHARE * path.n_segments:
-            moving = (s[1:] > s[:-1])
-            seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
-            moving &= wanted[seg]
+            if segments is not None:
+                moving &= wanted[seg]
             return np.bincount(seg[moving], weights=np.diff(t)[moving],
                                minlength=path.n_segments)
         # few segments: only the intervals that can have their mid-point in one of them
@@ -504,7 +501,7 @@ class Profile:
         lo[segments == 0] = 0                       # segment_index clamps the path ends
         hi[segments == path.n_segments - 1] = n_iv
         lo, hi = np.clip(lo, 0, n_iv), np.clip(hi, 0, n_iv)
-        mark = (np.bincount(lo, minlength=n_iv + 1) - np.bincount(hi, minlength=n_iv + 1))
+        mark = np.bincount(lo, minlength=n_iv + 1) - np.bincount(hi, minlength=n_iv + 1)
         iv = np.flatnonzero(np.cumsum(mark[:-1]) > 0)
         s0, s1 = s[iv], s[iv + 1]
         seg = path.segment_index(0.5 * (s0 + s1))
