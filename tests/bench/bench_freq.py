@@ -25,7 +25,9 @@ bound with them. Last, the NLP with the rule's rows (:mod:`optimal.freq.phase_nl
 ``../shared/corpus/lcnc_sam_tolerance_issue.ngc`` (``acc+freq`` and ``jerk+freq``, default
 gap, where the bracket stays open): the oracle's wall time and bracket without it and
 with it (without it, ``jerk+freq`` still builds the acc+freq motion its second seed
-starts from), and the jerk solve's time; left out where ``../shared`` is absent.
+starts from), and the jerk solve's time; left out where ``../shared`` is absent. Before
+it, the peak speed levels of the turn programme on ``lcnc_test_12mmflat.ngc``
+(``acc+freq``): the oracle and its bound with one level and with the default two.
 """
 
 from __future__ import annotations
@@ -88,6 +90,7 @@ def main() -> int:
     for name in ("demo.mpf", "slot.ngc"):
         window_row(machine, name)
     turn_run_row(machine)
+    peak_levels_row(machine)
     phase_nlp_row(machine)
     return 0
 
@@ -152,23 +155,37 @@ def _without_and_with(module, name: str, off, path, machine, bounds: str):
     return res
 
 
-def turn_run_row(machine) -> None:
-    """The turn run's cost and effect on the 48 sawtooth arcs (see the module docstring)."""
+def _toggle_row(machine, label: str, program: str, module, name: str, off) -> None:
+    """One row: ``acc+freq`` on a corpus program with ``module.name`` set to ``off`` and
+    as it is: the oracle's wall time, the bound's time and the bracket of each."""
     from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
-    import optimal.freq.humps as humps
     from reference.nc import parse_file
 
     if not CORPUS_PRESENT:
-        print(f"{'turn run':>9} skipped: {NO_CORPUS}")
+        print(f"{label:>9} skipped: {NO_CORPUS}")
         return
-    path = build_path(parse_file(CORPUS / "lcnc_arc_arc_sawtooth.ngc"), machine)
-    (w0, a), (w1, b) = _without_and_with(humps, "HUMP_TURN_MARGIN", 0.0, path, machine,
-                                         "acc+freq")
-    print(f"{'turn run':>9} sawtooth acc+freq: oracle {w0:.1f} -> {w1:.1f} s "
+    path = build_path(parse_file(CORPUS / program), machine)
+    (w0, a), (w1, b) = _without_and_with(module, name, off, path, machine, "acc+freq")
+    print(f"{label:>9} {program} acc+freq: oracle {w0:.1f} -> {w1:.1f} s "
           f"(x{w1 / w0:.2f}), bound {a.bound_time_s:.1f} -> {b.bound_time_s:.1f} s "
           f"(x{b.bound_time_s / a.bound_time_s:.2f}); bracket [{a.lower_bound_s:.4f}, "
-          f"{a.upper_bound_s:.4f}] {a.gap:.2%} -> [{b.lower_bound_s:.4f}, "
+          f"{a.upper_bound_s:.4f}] {a.gap:.2%} ({a.status}) -> [{b.lower_bound_s:.4f}, "
           f"{b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})", flush=True)
+
+
+def turn_run_row(machine) -> None:
+    """The turn run's cost and effect on the 48 sawtooth arcs (see the module docstring)."""
+    import optimal.freq.humps as humps
+    _toggle_row(machine, "turn run", "lcnc_arc_arc_sawtooth.ngc", humps, "HUMP_TURN_MARGIN",
+                0.0)
+
+
+def peak_levels_row(machine) -> None:
+    """The turn programme's peak speed levels (step 4d of :mod:`optimal.freq.humps`) on
+    lcnc_test_12mmflat (``acc+freq``, default gap): one level (the rise's and the fall's
+    top speeds chosen apart) against the default two."""
+    import optimal.freq.humps as humps
+    _toggle_row(machine, "peaks", "lcnc_test_12mmflat.ngc", humps, "HUMP_PEAK_LEVELS", 1)
 
 
 def phase_nlp_row(machine) -> None:
