@@ -167,7 +167,19 @@ the peak's speed in levels (as step 4c carries the valley's) and charged every f
 passes a cap this bound raised the piece's bound by 0.001 s only (1.9332 -> 1.9342 s,
 with 6 and 12 levels of ratio 0.8, the bound taken at the least cap between peak and
 valley): its shortest path then peaks at about the cap's speed and pays the same ``g``
-per stretch. Which side is weak there, and by how much, is open.
+per stretch. Two further tries gained nothing there either (measured 2026-12-07, not
+kept). A bound on the top speed a stretch reaches in its distance: a rise's phases gain
+``int (w - w_a) dt >= sum_P dv_P tail_P``, the same weights as the lost time, so
+``int_u^V gamma / 2 <= d_max + (2 delta - u_lo) T``, with ``d_max`` from the valley
+cell's start to the peak cell's end, ``u_lo`` the valley level's lower end and
+``gm <= T <= T_up`` (falls mirrored, with the leads). It is valid, but it left every
+bound the same with two peak levels (sam 1.93299 s, lcnc_arc_arc_sawtooth 5.17477 s,
+lcnc_test_12mmflat 37.58713 s on their fine cells). With six peak levels of ratio 0.6
+sam reached only 1.93597 s (eight of 0.7: 1.93629 s), because the shortest path moves
+its turns and still pays about ``g`` per stretch. On the upper side, a local search moved each phase boundary
+of the NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`) by 1, 3 and 6 grid
+nodes. Over about 200 s it took sam from 2.3286 to 2.3237 s (0.2 %). Which side is
+weak there, and by how much, is open.
 
 Units: mm, s, mm/s.
 """
@@ -299,7 +311,8 @@ HUMP_SPEED_LEVELS = 7
 #: 37.593 s with two at 0.3, 37.468 s at 0.2; three or four levels gave no more.
 HUMP_PEAK_RATIO = 0.3
 
-#: See HUMP_PEAK_RATIO.
+#: See HUMP_PEAK_RATIO. At most HUMP_SPEED_LEVELS: a valley's predecessor carries its
+#: peak level in the speed field of :func:`optimal.freq.humps_kernel.pack`.
 HUMP_PEAK_LEVELS = 2
 
 #: A stretch may be cut into pieces of at least this many periods (step 4). A cut forgets
