@@ -311,8 +311,7 @@ HUMP_SPEED_LEVELS = 7
 #: 37.593 s with two at 0.3, 37.468 s at 0.2; three or four levels gave no more.
 HUMP_PEAK_RATIO = 0.3
 
-#: See HUMP_PEAK_RATIO. At most HUMP_SPEED_LEVELS: a valley's predecessor carries its
-#: peak level in the speed field of :func:`optimal.freq.humps_kernel.pack`.
+#: See HUMP_PEAK_RATIO.
 HUMP_PEAK_LEVELS = 2
 
 #: A stretch may be cut into pieces of at least this many periods (step 4). A cut forgets
@@ -591,7 +590,8 @@ def hump_plan(env: Envelope, drift: float = 0.0,
             peaks.append(cell)
         x = (pv[q, k, cell] if kind == _VALLEY else pp[q, k, cell] if kind == _PEAK
              else pc[kind - _RISE_CUT, cell])
-        kind, q, k, cell = unpack(x, HUMP_SLACK_LEVELS.size, HUMP_SPEED_LEVELS)
+        kind, q, k, cell = unpack(x, HUMP_SLACK_LEVELS.size,
+                                  max(HUMP_SPEED_LEVELS, HUMP_PEAK_LEVELS))
     return HumpPlan(T, np.array(valleys[::-1], np.int64), np.array(peaks[::-1], np.int64))
 
 

@@ -228,9 +228,9 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
     pred_valley : numpy.ndarray of int64, shape (NQ, K, N)
     pred_peak : numpy.ndarray of int64, shape (NQ, KV, N)
     pred_cut : numpy.ndarray of int64, shape (2, N)
-        Predecessor of every state, packed by :func:`pack` (``-1`` where none); a
-        valley's predecessor peak carries its peak level in the speed field, cuts have
-        speed and slack level 0.
+        Predecessor of every state, packed by :func:`pack` with ``K = max(K, KV)``
+        (``-1`` where none); a valley's predecessor peak carries its peak level in the
+        speed field, cuts have speed and slack level 0.
     """
     N = hi.size
     NQ = levels.size
@@ -238,6 +238,8 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
     inf = np.inf
     valley = np.full((NQ, K, N), inf)
     KV = n_peak
+    # predecessors pack a valley level or a peak level in one field (pack): its base
+    KP = max(K, KV)
     peak = np.full((NQ, KV, N), inf)
     cut = np.full((2, N), inf)
     pv = np.full((NQ, K, N), -1, np.int64)
@@ -294,7 +296,7 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                         G = _stretch_floor(d, u, base_u, pbot[kv] * hi[c], ptop[kv] * hi[c],
                                            gm, stW, stG, stQ, n_w)
                         _relax(valley, k, i, v_f[i, k], v_n[i, k], G, R, turn_t[i],
-                               turn_t[c], charge, levels, peak, pp, kv, c, VALLEY, K)
+                               turn_t[c], charge, levels, peak, pp, kv, c, VALLEY, KP)
                     # a cut at the start of cell c, once the piece holds `chain` periods
                     if R >= chain * gm:
                         for m in range(v_n[i, k]):
@@ -302,7 +304,7 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                             x = valley[f, k, i] + R + charge[f] * turn_t[i]
                             if x < cut[0, c]:
                                 cut[0, c] = x
-                                pc[0, c] = pack(VALLEY, f, k, i, NQ, K)
+                                pc[0, c] = pack(VALLEY, f, k, i, NQ, KP)
                 # from a rising cut at cell i's start: cells i .. c-1, an R-only piece
                 Rc = R + ds_over(s, i, min(hi[i], suf))
                 if cut[0, i] < inf:
@@ -310,10 +312,10 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                     for kv in range(KV):
                         if x < peak[0, kv, c]:
                             peak[0, kv, c] = x
-                            pp[0, kv, c] = pack(RISE_CUT, 0, 0, i, NQ, K)
+                            pp[0, kv, c] = pack(RISE_CUT, 0, 0, i, NQ, KP)
                     if Rc >= chain * gm and x < cut[0, c]:
                         cut[0, c] = x
-                        pc[0, c] = pack(RISE_CUT, 0, 0, i, NQ, K)
+                        pc[0, c] = pack(RISE_CUT, 0, 0, i, NQ, KP)
                 R = Rc
                 suf = min(suf, lo[i])
                 gmin = gm
@@ -353,7 +355,7 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                                            ptop[kv] * hi[c] + peak_slack, gmin,
                                            stW, stG, stQ, n_w)
                         _relax(peak, kv, c, p_f[kv], p_n[kv], G, F, turn_t[c],
-                               turn_t[j], charge, levels, valley, pv, k, j, PEAK, K)
+                               turn_t[j], charge, levels, valley, pv, k, j, PEAK, KP)
                 if F >= chain * gmin:
                     for kv in range(KV):
                         for m in range(p_n[kv]):
@@ -361,7 +363,7 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                             x = peak[f, kv, c] + F + charge[f] * turn_t[c]
                             if x < cut[1, j]:
                                 cut[1, j] = x
-                                pc[1, j] = pack(PEAK, f, kv, c, NQ, K)
+                                pc[1, j] = pack(PEAK, f, kv, c, NQ, KP)
                 if cut[1, c] < inf:
                     x = cut[1, c] + F2
                     # an R-only piece: tight; the valley's speed in any level its bound
@@ -372,10 +374,10 @@ def programme(s: np.ndarray, hi: np.ndarray, hi_m: np.ndarray, lo: np.ndarray,
                             continue
                         if x < valley[0, k, j]:
                             valley[0, k, j] = x
-                            pv[0, k, j] = pack(FALL_CUT, 0, 0, c, NQ, K)
+                            pv[0, k, j] = pack(FALL_CUT, 0, 0, c, NQ, KP)
                     if F2 >= chain * gmin and x < cut[1, j]:
                         cut[1, j] = x
-                        pc[1, j] = pack(FALL_CUT, 0, 0, c, NQ, K)
+                        pc[1, j] = pack(FALL_CUT, 0, 0, c, NQ, KP)
                 # cell j is between the peak and the next valleys
                 F += ds_over(s, j, min(hi[j], pre))
                 pre = min(pre, lo[j])
