@@ -467,9 +467,11 @@ def _size_arcs(path: Path, R: np.ndarray, R_b: np.ndarray, a: np.ndarray, b: np.
     r1, r2 = R[o], R_b[o]
     cap_in, cap_out = c * path.length[a[o]], c * path.length[b[o]]
 
-    def over_cap(part, i):
-        """Whether a trim of the shapes ``part`` (transitions ``i``) exceeds its cap."""
-        return np.maximum(part.trim_in / cap_in[i], part.trim_out / cap_out[i]) > 1.0
+    def over_cap(part, i, slack=0.0):
+        """Whether a trim of the shapes ``part`` (transitions ``i``) exceeds its cap by
+        more than the factor ``exp(slack)`` (``slack`` shape (m,) or a float)."""
+        return np.maximum(part.trim_in / cap_in[i], part.trim_out / cap_out[i]) \
+            > np.exp(slack)
 
     sh = for_deviation(r1, r2, dev, defer=over_cap if defer else None)
     deferred = (np.isnan(sh.deviation) & over_cap(sh, np.arange(o.size))) if defer \

@@ -132,6 +132,16 @@ TRACK_REL_TOL = 0.1 * DEVIATION_REL_TOL
 #: Steps of the sizing that follow a local maximum (4-6 in practice); a transition not
 #: settled by then is sized with the full search at every step.
 TRACK_MAX_ITER = 20
+#: A transition still being sized is handed over to the caller's ``defer`` (the
+#: block-length clamp) once its trim exceeds the cap by more than ``2 |g|`` plus this
+#: (``log``; ``g`` the last measure's ``log`` deviation less the aim): the rate of the
+#: tolerance is then within ``|g| / 2`` of the present one at the deviation's slope of
+#: -2 (within ``2 |g|`` for any slope the steps accept, down to -0.5), the trims shrink
+#: about like ``1 / rate``, so the clamp's rate is the higher and the answer (the
+#: larger of the two rates) is the clamp's. This margin covers the slope's spread at
+#: the first estimate; where the clamp's measure shows the tolerance's rate higher
+#: after all (the maximum followed was not the highest), the caller sizes it again.
+DEFER_LOG_MARGIN = 0.01
 #: Largest ``theta`` searched, rad: a larger one would mean a rounding that replaces
 #: more than a quarter turn of each arc (the block-length clamp acts long before).
 THETA_MAX = 0.5 * np.pi
@@ -949,15 +959,20 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         The implementation of :func:`_deviation_where` every measure uses (as for
         :func:`pieces_deviation`).
     defer : callable, optional
-        ``defer(part, i) -> bool (m,)``: of the answers ``part`` (transitions ``i``, the
-        model's shapes, before their full measure), those whose full measure the caller
-        takes over; they are returned with the deviation ``nan``. The block-length clamp
-        (:func:`reference.rounding_tangential._size_arcs`) raises the rate of every
-        transition whose trim exceeds its cap and measures it in full at the raised rate,
-        so the measure at this one would be thrown away (on the same-way row of
-        ``tests/bench/bench_rounding.py`` 1,819 of 7,950); where the measure there finds a
-        higher maximum than the one followed, the caller sizes it again without
-        ``defer``.
+        ``defer(part, i, slack) -> bool (m,)``: of the shapes ``part`` (transitions
+        ``i``; ``slack`` shape (m,), ``log``), those the caller takes over: whose trim
+        exceeds its cap by more than the factor ``exp(slack)``. It is asked of the
+        answers (the model's shapes, before their full measure; ``slack`` 0) and, with
+        the slack of :data:`DEFER_LOG_MARGIN`, of the shapes of every step still short
+        of the aim (those are then not sized further). The ones taken over are
+        returned with the deviation ``nan``, at the rate they were left at. The
+        block-length clamp (:func:`reference.rounding_tangential._size_arcs`) raises
+        the rate of every transition whose trim exceeds its cap and measures it in full
+        at the raised rate, so the measure at this one would be thrown away, and so
+        would the steps towards it (on the same-way row of
+        ``tests/bench/bench_rounding.py`` 1,819 of 7,950 transitions); where the
+        measure there finds a higher maximum than the one followed, the caller sizes
+        it again without ``defer``.
 
     Returns
     -------
@@ -983,10 +998,25 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         gx[i] = np.log(dev) - aim[i]
         return dev
 
+    early = np.zeros(k, bool)                # left to the caller while still sized
+
+    def hand_over(i, part):
+        """Marks ``early`` those of transitions ``i`` (shape ``part``, just measured)
+        whose trim exceeds its cap even at the rate of the tolerance as far off as the
+        last measure leaves it (``2 |gx| + DEFER_LOG_MARGIN`` in ``log c``)."""
+        if defer is None:
+            return
+        open_ = np.flatnonzero(np.isfinite(gx[i]) & ~(np.abs(gx[i]) <= TRACK_REL_TOL)
+                               & ~lost[i])
+        if open_.size:
+            slack = 2.0 * np.abs(gx[i[open_]]) + DEFER_LOG_MARGIN
+            early[i[open_]] = defer(take(part, open_), i[open_], slack)
+
     sh = _with_deviation(sh, np.arange(k), follow(np.arange(k), sh))
+    hand_over(np.arange(k), sh)
     x_old, g_old = np.full_like(x, np.nan), np.full_like(x, np.nan)
     for _ in range(TRACK_MAX_ITER):
-        todo = np.flatnonzero(~(np.abs(gx) <= TRACK_REL_TOL) & ~lost)
+        todo = np.flatnonzero(~(np.abs(gx) <= TRACK_REL_TOL) & ~lost & ~early)
         if not todo.size:
             break
         x[todo], x_old[todo], g_old[todo] = _secant_step(x[todo], gx[todo], x_old[todo],
@@ -995,21 +1025,26 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
         part = shape_of(r_in[todo], r_out[todo], np.exp(x[todo]), deviation=False, **like)
         sh = scatter(sh, todo, _with_deviation(part, np.arange(todo.size),
                                                follow(todo, part)))
+        hand_over(todo, part)
+    # handed over while still sized: the caller measures them at its own rate
+    if early.any():
+        sh = _with_deviation(sh, np.flatnonzero(early), np.nan)
     # the full search at each answer (the model's shape) decides
-    check = np.flatnonzero(~lost & (np.abs(gx) <= TRACK_REL_TOL))
+    check = np.flatnonzero(~lost & ~early & (np.abs(gx) <= TRACK_REL_TOL))
     if check.size:
         part = take(sh, check)
         if canonical is not None:
             part = canonical(part)
             sh = scatter(sh, check, part)
-        later = np.zeros(check.size, bool) if defer is None else defer(part, check)
+        later = (np.zeros(check.size, bool) if defer is None
+                 else defer(part, check, np.zeros(check.size)))
         now = ~later
         dev = np.full(check.size, np.nan)
         dev[now] = _measure(take(part, np.flatnonzero(now)) if later.any() else part,
                             check[now], pieces, None)[0]
         sh = _with_deviation(sh, check, dev)
         lost[check[now]] |= ~(np.abs(np.log(dev[now]) - aim[check[now]]) <= half)
-    rest = np.flatnonzero(lost | ~(np.abs(gx) <= TRACK_REL_TOL))
+    rest = np.flatnonzero(lost | (~early & ~(np.abs(gx) <= TRACK_REL_TOL)))
     if rest.size:
         sh = scatter(sh, rest, _size_in_full(shape_of, pieces_of, centre_out[rest],
                                              r_in[rest], r_out[rest], aim[rest],
