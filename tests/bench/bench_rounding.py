@@ -40,7 +40,10 @@ same-way row read 7.0, 7.4 and 8.5 us/block in three runs of this script on one 
 machine (its per-segment ratio 1.44 .. 1.22), and ``round_corners`` on the arc-arc row
 took 21.4 ms or 19.2 ms in the same process depending on the C allocator's thresholds
 (``MALLOC_MMAP_THRESHOLD_``: whether the large numpy temporaries come back as fresh,
-page-faulting mappings). Read a row near the target over a few runs.
+page-faulting mappings). So a row within ``RECHECK_BAND`` of the target is measured
+again in ``RECHECK_PROCESSES`` fresh processes of this script (``--row K``) and judged
+by the median of its measures (the same-way row of 10^4 arcs read 1.44 .. 1.53 in five
+processes one after the other, 1.36 in the one before them).
 
 Per block means per program block. Rounding inserts a block at most corners (the control
 then prepares and interpolates that many more blocks), and the heuristic plans every
@@ -53,9 +56,15 @@ the target is judged.
 
 from __future__ import annotations
 
+import json
+import statistics
+import subprocess
 import sys
 import time
 import tomllib
+from dataclasses import dataclass
+from functools import partial
+from typing import Callable
 from importlib import resources
 from pathlib import Path as FsPath
 
@@ -70,6 +79,11 @@ from reference.planner import plan  # noqa: E402
 from reference.prepare import build_path  # noqa: E402
 
 TARGET = 1.30
+#: A row whose per-segment ratio lands within this of the target is measured again in
+#: RECHECK_PROCESSES fresh processes and judged by the median of all its measures: the
+#: rows move between processes by more than between runs of one (module docstring).
+RECHECK_BAND = 0.15
+RECHECK_PROCESSES = 4
 sys.path.insert(0, str(HERE.parent / "reference"))
 # tests/: shared_inputs, the one place that says where ../shared is (corpus_sinumerik
 # reads the corpus through it)
@@ -137,81 +151,123 @@ def _with_trans_tol(name: str, tol_mm: float):
     return machine_from_dict(d)
 
 
-def main(argv=None) -> None:
-    argv = sys.argv[1:] if argv is None else argv
-    n = 2000 if "--quick" in argv else 10000
+@dataclass(frozen=True)
+class Spec:
+    """One row: its label, program blocks, the G64 program and the rounded one (texts),
+    and the machine (built when measured)."""
+    label: str
+    blocks: int
+    text64: str | None
+    text: str | None
+    machine: Callable[[], object]
+
+
+def specs(n: int) -> list[Spec]:
+    """The rows, in print order, for programs of ``n`` blocks (the short-segment rows:
+    the corpus program's 3000; their texts None where ../shared is absent)."""
+    out = []
+    body = polyline(n, 13)
+    for accel in ("BRISK", "SOFT"):
+        head = f"G90 {accel} F6000\nG1 X0 Y0\nG1 "
+        text64 = head.replace("G90", "G90 G64") + body
+        for mode in ("G641 ADIS=0.2", "G642 CTOL=0.02", "G642", "G645 CTOL=0.02"):
+            out.append(Spec(f"{accel} {mode}, {n} blocks", n, text64,
+                            head.replace("G90", f"G90 {mode}") + body, load_machine))
+    # G645 at tangential line-arc transitions (a seeded chain of lines and tangent arcs)
+    chain = line_arc_chain(n, 5)
+    for accel in ("BRISK", "SOFT"):
+        head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
+        out.append(Spec(f"{accel} G645 line-arc, {n} blocks", n, head.format("G64") + chain,
+                        head.format("G645") + chain, load_machine))
+    # G645 at tangential S-bends (a seeded chain of tangent arcs curving alternately;
+    # MD33120 0.05 mm on the default machine's X, Y so that most of them are rounded)
+    head = "G17 G90 {} SOFT F8000\n"
+    tol = partial(_with_trans_tol, "default", 0.05)
+    sbends = s_bend_chain(n, 5)
+    out.append(Spec(f"SOFT G645 S-bends, {n} blocks", n, head.format("G64") + sbends,
+                    head.format("G645") + sbends, tol))
+    # G645 between tangent arcs curving the same way (radii 5..200 mm; the same MD33120)
+    same = same_way_chain(n, 5)
+    out.append(Spec(f"SOFT G645 same-way arcs, {n} blocks", n, head.format("G64") + same,
+                    head.format("G645") + same, tol))
+    # corners next to arcs (each line leaves its arc at a 30..60 degree corner), and
+    # corners between two arcs (each arc leaves the one before at a 30..60 degree corner)
+    for what, prog in (("arc corners", line_arc_chain(n, 5, kink_deg=60.0)),
+                       ("arc-arc corners", arc_chain(n, 5))):
+        for accel, mode in (("BRISK", "G642 CTOL=0.02"), ("BRISK", "G641 ADIS=0.2"),
+                            ("SOFT", "G645 CTOL=0.02")):
+            head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
+            out.append(Spec(f"{accel} {mode} {what}", n, head.format("G64") + prog,
+                            head.format(mode) + prog, load_machine))
+    # the short-segment program is a corpus file: without ../shared its rows are left out
+    text = short_segments_g642() if CORPUS_PRESENT else None
+    for name in ("default", "linuxcnc_xyz"):
+        label = f"short segments G642 {load_machine(name).name[:12]}"
+        out.append(Spec(label, 3000, text and text.replace("G642 G17", "G64 G17"), text,
+                        partial(load_machine, name)))
+    return out
+
+
+def _warm_up() -> float:
+    """Loads the compiled kernels (see the module docstring); seconds it took."""
     t0 = time.perf_counter()
     from reference import transition_kernel  # noqa: F401 - loaded once, then warm
     from reference.planner import lookahead_kernel  # noqa: F401
     plan(parse_text("G90 SOFT F6000\nG1 X0 Y0\nG1 X1\nG1 Y1\n"), load_machine(), check=False)
     build_path(parse_text("G17 G90 G645 SOFT F8000\n" + s_bend_chain(6, 5)),
                _with_trans_tol("default", 0.05))
+    return time.perf_counter() - t0
+
+
+def _per_segment(spec: Spec) -> float:
+    """The row ``spec`` measured once more in this process: its heuristic ratio per
+    planned segment."""
+    (t64, _, _, p64), (t, _, _, path) = paired(spec.text64, spec.text, spec.machine())
+    return (t / path.n_segments) / (t64 / p64.n_segments)
+
+
+def _in_fresh_processes(k: int, n: int) -> list[float]:
+    """Row ``k`` of :func:`specs` measured in :data:`RECHECK_PROCESSES` fresh processes
+    of this script, one after the other: the per-segment ratio of each."""
+    args = [sys.executable, str(FsPath(__file__).resolve()), "--row", str(k), "--n", str(n)]
+    out = []
+    for _ in range(RECHECK_PROCESSES):
+        res = subprocess.run(args, capture_output=True, text=True, check=True)
+        out.append(float(json.loads(res.stdout.strip().splitlines()[-1])["per_segment"]))
+    return out
+
+
+def main(argv=None) -> None:
+    argv = sys.argv[1:] if argv is None else argv
+    n = 2000 if "--quick" in argv else 10000
+    if "--n" in argv:
+        n = int(argv[argv.index("--n") + 1])
+    if "--row" in argv:                   # one row in this process (a recheck's child)
+        _warm_up()
+        spec = specs(n)[int(argv[argv.index("--row") + 1])]
+        print(json.dumps({"label": spec.label, "per_segment": _per_segment(spec)}))
+        return
     print(f"  compiled LookAhead loops and deviation search: loaded once per process in "
-          f"{time.perf_counter() - t0:.2f} s (not in the rows)")
-    body = polyline(n, 13)
-    machine = load_machine()
+          f"{_warm_up():.2f} s (not in the rows)")
     worst = worst_pl = 0.0
-    for accel in ("BRISK", "SOFT"):
-        head = f"G90 {accel} F6000\nG1 X0 Y0\nG1 "
-        text64 = head.replace("G90", "G90 G64") + body
-        for mode in ("G641 ADIS=0.2", "G642 CTOL=0.02", "G642", "G645 CTOL=0.02"):
-            r, r_pl = row(f"{accel} {mode}, {n} blocks", n,
-                          *paired(text64, head.replace("G90", f"G90 {mode}") + body, machine))
-            worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # G645 at tangential line-arc transitions (a seeded chain of lines and tangent arcs)
-    chain = line_arc_chain(n, 5)
-    for accel in ("BRISK", "SOFT"):
-        head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
-        r, r_pl = row(f"{accel} G645 line-arc, {n} blocks", n,
-                      *paired(head.format("G64") + chain, head.format("G645") + chain,
-                              machine))
-        worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # G645 at tangential S-bends (a seeded chain of tangent arcs curving alternately;
-    # MD33120 0.05 mm on the default machine's X, Y so that most of them are rounded)
-    sbends = s_bend_chain(n, 5)
-    head = "G17 G90 {} SOFT F8000\n"
-    r, r_pl = row(f"SOFT G645 S-bends, {n} blocks", n,
-                  *paired(head.format("G64") + sbends, head.format("G645") + sbends,
-                          _with_trans_tol("default", 0.05)))
-    worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # G645 between tangent arcs curving the same way (radii 5..200 mm; the same MD33120)
-    same = same_way_chain(n, 5)
-    r, r_pl = row(f"SOFT G645 same-way arcs, {n} blocks", n,
-                  *paired(head.format("G64") + same, head.format("G645") + same,
-                          _with_trans_tol("default", 0.05)))
-    worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # corners next to arcs (each line leaves its arc at a 30..60 degree corner)
-    kinked = line_arc_chain(n, 5, kink_deg=60.0)
-    for accel, mode in (("BRISK", "G642 CTOL=0.02"), ("BRISK", "G641 ADIS=0.2"),
-                        ("SOFT", "G645 CTOL=0.02")):
-        head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
-        r, r_pl = row(f"{accel} {mode} arc corners", n,
-                      *paired(head.format("G64") + kinked, head.format(mode) + kinked,
-                              machine))
-        worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # corners between two arcs (each arc leaves the one before at a 30..60 degree corner)
-    arcs = arc_chain(n, 5)
-    for accel, mode in (("BRISK", "G642 CTOL=0.02"), ("BRISK", "G641 ADIS=0.2"),
-                        ("SOFT", "G645 CTOL=0.02")):
-        head = f"G17 G90 {{}} {accel} F6000\nG1 X0 Y0\n"
-        r, r_pl = row(f"{accel} {mode} arc-arc corners", n,
-                      *paired(head.format("G64") + arcs, head.format(mode) + arcs,
-                              machine))
-        worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
-    # the short-segment program is a corpus file: without ../shared its rows are left out
-    text = short_segments_g642() if CORPUS_PRESENT else None
-    for name in (None, "linuxcnc_xyz"):
-        mach = load_machine(name) if name else load_machine()
-        if text is None:
-            print(f"  {'short segments G642 ' + mach.name[:12]:<28} skipped: {NO_CORPUS}")
+    for k, spec in enumerate(specs(n)):
+        if spec.text is None:
+            print(f"  {spec.label:<28} skipped: {NO_CORPUS}")
             continue
-        r, r_pl = row(f"short segments G642 {mach.name[:12]}", 3000,
-                      *paired(text.replace("G642 G17", "G64 G17"), text, mach))
+        r, r_pl = row(spec.label, spec.blocks,
+                      *paired(spec.text64, spec.text, spec.machine()))
+        if abs(r_pl - TARGET) <= RECHECK_BAND:
+            more = _in_fresh_processes(k, n)
+            r_pl = statistics.median([r_pl] + more)
+            print(f"  {'':<28} per planned segment in {1 + len(more)} processes: median "
+                  f"{r_pl:.2f} ({', '.join(f'{x:.2f}' for x in more)} in the fresh ones)",
+                  flush=True)
         worst, worst_pl = max(worst, r), max(worst_pl, r_pl)
     print(f"  rounding/G64 heuristic time (build_path + plan, without the check): worst ratio "
           f"per program block = {worst:.2f}, per planned segment = {worst_pl:.2f} "
           f"(target <= {TARGET:.2f}: {'ok' if worst_pl <= TARGET else 'ABOVE TARGET'} per "
-          f"planned segment, {'ok' if worst <= TARGET else 'above'} per program block)")
+          f"planned segment, {'ok' if worst <= TARGET else 'above'} per program block; "
+          f"rows within {RECHECK_BAND:.2f} of it judged by the median over processes)")
 
 
 if __name__ == "__main__":
