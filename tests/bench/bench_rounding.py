@@ -64,9 +64,9 @@ import time
 import tomllib
 from dataclasses import dataclass
 from functools import partial
-from typing import Callable
 from importlib import resources
 from pathlib import Path as FsPath
+from typing import Callable
 
 
 HERE = FsPath(__file__).resolve().parent
@@ -131,8 +131,7 @@ def row(label: str, n: int, base, rounded) -> tuple[float, float]:
     tab = path.rounding
     n_in = int(tab.inserted.sum()) if tab is not None else 0
     n_pl, n_pl64 = path.n_segments, p64.n_segments
-    ratio = t / t64
-    ratio_pl = (t / n_pl) / (t64 / n_pl64)
+    ratio, ratio_pl = _ratios(base, rounded)
     ratio_ck = (t + c) / (t64 + c64)
     print(f"  {label:<28} heuristic {1e6 * t / n:6.1f} vs G64 {1e6 * t64 / n:6.1f} us/block"
           f"  ratio = {ratio:.2f} (per planned segment {ratio_pl:.2f});  +check ratio = "
@@ -219,11 +218,17 @@ def _warm_up() -> float:
     return time.perf_counter() - t0
 
 
+def _ratios(base, rounded) -> tuple[float, float]:
+    """Heuristic time ratio of the rounded program to the G64 one (:func:`paired`'s two
+    results) per program block and per planned segment."""
+    t64, p64, t, path = base[0], base[3], rounded[0], rounded[3]
+    return t / t64, (t / path.n_segments) / (t64 / p64.n_segments)
+
+
 def _per_segment(spec: Spec) -> float:
     """The row ``spec`` measured once more in this process: its heuristic ratio per
     planned segment."""
-    (t64, _, _, p64), (t, _, _, path) = paired(spec.text64, spec.text, spec.machine())
-    return (t / path.n_segments) / (t64 / p64.n_segments)
+    return _ratios(*paired(spec.text64, spec.text, spec.machine()))[1]
 
 
 def _in_fresh_processes(k: int, n: int) -> list[float]:
