@@ -157,8 +157,10 @@ pays about ``g`` per stretch (from 166.53 mm to the end six stretches, 0.400 s, 
 the motion's 0.509 s). Motions sketched by hand from 166.58 mm to the end (estimates,
 not checked profiles), with phases that creep, jump and creep as the rule accepts
 (:mod:`reference.core.phases`), come to about the motion's 0.495 s, and the exploratory
-lattice search that module cites found 1.25 s on the tail: nothing faster than the
-motion is known. One suspect was tested and gained almost nothing: a fall phase
+lattice search that module cites found 1.25 s on the tail. Those were the motion's
+numbers before :mod:`optimal.freq.free_phases`: its NLP with the phases' ends free in
+path position takes the whole program from 2.3261 to 2.1505 s (checked), so on sam the
+upper side was the weaker one. The 4.1 % still open lies on both sides. One suspect was tested and gained almost nothing: a fall phase
 ``[t_0, t_1]`` that changes the speed by ``D_b`` before a corner (passed at ``t_x``) and
 by ``D_a`` after it has ``D_b (t_x - t_0) + D_a (t_1 - t_0) >= (D_b + D_a) g / 2`` (its
 acceleration-weighted mean time is at least ``g/2`` after its start), so a fall from a
@@ -178,8 +180,8 @@ lcnc_test_12mmflat 37.58713 s on their fine cells). With six peak levels of rati
 sam reached only 1.93597 s (eight of 0.7: 1.93629 s), because the shortest path moves
 its turns and still pays about ``g`` per stretch. On the upper side, a local search moved each phase boundary
 of the NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`) by 1, 3 and 6 grid
-nodes. Over about 200 s it took sam from 2.3286 to 2.3237 s (0.2 %). Which side is
-weak there, and by how much, is open.
+nodes. Over about 200 s it took sam from 2.3286 to 2.3237 s (0.2 %); the free phase
+ends (above) gained 7.5 %.
 
 Units: mm, s, mm/s.
 """

@@ -32,7 +32,12 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    rows) with the rule's own rows on the fastest candidate's phases
    (:mod:`optimal.freq.phase_nlp`), and the fastest per piece again (the lower bound of
    step 2 holds for every motion no slower than the fastest candidate it was built for,
-   so for the faster optimum too);
+   so for the faster optimum too); for ``acc+freq``, where it is open still, the rule's
+   rows in path position with the phases' ends free between the breaks, and a search
+   over where they lie, from the fastest motion (:mod:`optimal.freq.free_phases`; its
+   motion of each piece counts where the checker accepts it in that motion). Tried as a
+   second seed of the ``jerk+freq`` NLP it did not help (lcnc_sam_tolerance_issue
+   2.4375 -> 2.4430 s, the oracle 3.5 times slower), so it is not run there;
 5. status ``optimal`` when ``(upper - lower) / lower <= tol``, else ``gap_not_met`` with
    both valid bounds; ``solver_error`` when no candidate could be verified.
 
@@ -64,12 +69,13 @@ from .capped import capped_optimum
 from .humps import humps_piece_bounds
 from .jerk_adapted import ACC_ADAPT_INTERVALS, ACC_ADAPT_MAX_INTERVALS, jerk_adapted
 from .phase_nlp import phase_nlp
+from .free_phases import FREE_ACCEPT_SCALE, free_phase_motions
 from .lower import freq_lower_bound, rest_pieces, segment_periods
 from .ramps import ramp_plan
 from .chains import chain_rows
 from .windows import rule_envelope, window_lower_bound, window_rows
-from .upper import (ERODED_REST_SHARE, candidate_windows, eroded_plans, fir_filtered,
-                    piece_times, pieced, scaled, verified)
+from .upper import (ERODED_REST_SHARE, Candidate, candidate_windows, eroded_plans,
+                    fir_filtered, piece_times, pieced, scaled, verified)
 
 ProgressFn = Callable[..., object]
 
@@ -121,6 +127,37 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
             break
         choice = new
     return best
+
+
+def _free_phase_candidate(path: Path, limits: MachineLimits, seed, holds: Holds,
+                          enough: float, progress=None):
+    """``seed`` (a verified candidate) with each rest-to-rest piece replaced by the
+    fastest motion of :func:`optimal.freq.free_phases.free_phase_motions` that the
+    checker accepts in it (judged with ``seed``'s other pieces and the holds, not slowed
+    down by more than round-off); ``None`` where none is faster. ``enough``: s, holds
+    excluded, where the search may stop."""
+    pieces = rest_pieces(path)
+    accepted: dict[int, Candidate] = {}
+
+    def joined(k: int, prof: Profile):
+        choice = np.zeros(pieces.shape[0], np.int64)
+        choice[k] = 1
+        return pieced(path, [seed], {k: prof}, choice)
+
+    def accept(k: int, prof: Profile) -> bool:
+        p = joined(k, prof)
+        c = verified("free phase ends", path, limits, p, "acc+freq", holds=holds) \
+            if p is not None else None
+        return c is not None and c.time_scale <= 1.0 + FREE_ACCEPT_SCALE
+
+    found = free_phase_motions(path, limits.for_axes(path.axes), seed.profile,
+                               accept=accept, enough=enough, progress=progress)
+    if not found:
+        return None
+    choice = np.array([1 if k in found else 0 for k in range(pieces.shape[0])], np.int64)
+    prof = pieced(path, [seed], found, choice)
+    return (verified("free phase ends", path, limits, prof, "acc+freq", holds=holds)
+            if prof is not None else None)
 
 
 def _acc_nlp_grid(path: Path, limits: MachineLimits, acc: OptimalSolution) -> np.ndarray:
@@ -410,6 +447,15 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         if more:
             cands += more
             c = _fastest_per_piece(path, limits, cands, local, name, holds)
+            if c is not None:
+                cands.append(c)
+        if base == "acc" and min(x.duration for x in cands) + hold_t - lb > tol * lb:
+            # still open: the rule's rows in path position with the phases' ends free
+            # between the breaks, and a search over where they lie (optimal.freq.
+            # free_phases), from the fastest motion; the same lower bound stands
+            c = _free_phase_candidate(path, limits, min(cands, key=lambda x: x.duration),
+                                      holds, met_by,
+                                      (lambda msg: progress(msg, 0.98)) if progress else None)
             if c is not None:
                 cands.append(c)
         t_check += time.perf_counter() - tp

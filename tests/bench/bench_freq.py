@@ -27,7 +27,9 @@ gap, where the bracket stays open): the oracle's wall time and bracket without i
 with it (without it, ``jerk+freq`` still builds the acc+freq motion its second seed
 starts from), and the jerk solve's time; left out where ``../shared`` is absent. Before
 it, the peak speed levels of the turn programme on ``lcnc_test_12mmflat.ngc``
-(``acc+freq``): the oracle and its bound with one level and with the default two.
+(``acc+freq``): the oracle and its bound with one level and with the default two. After
+it, the search over free phase ends (:mod:`optimal.freq.free_phases`) on the same program
+(``acc+freq``): the oracle's wall time and bracket without it and with it.
 """
 
 from __future__ import annotations
@@ -92,6 +94,7 @@ def main() -> int:
     turn_run_row(machine)
     peak_levels_row(machine)
     phase_nlp_row(machine)
+    free_phases_row(machine)
     return 0
 
 
@@ -209,6 +212,25 @@ def phase_nlp_row(machine) -> None:
               f"[{a.lower_bound_s:.4f}, {a.upper_bound_s:.4f}] {a.gap:.2%} -> "
               f"[{b.lower_bound_s:.4f}, {b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})",
               flush=True)
+
+
+def free_phases_row(machine) -> None:
+    """The free phase ends' cost and effect on lcnc_sam_tolerance_issue (``acc+freq``,
+    default gap; module docstring): the oracle without the search and with it."""
+    from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
+    import optimal.freq.oracle as freq_oracle
+    from reference.nc import parse_file
+
+    if not CORPUS_PRESENT:
+        print(f"{'free ends':>9} skipped: {NO_CORPUS}")
+        return
+    path = build_path(parse_file(CORPUS / "lcnc_sam_tolerance_issue.ngc"), machine)
+    (w0, a), (w1, b) = _without_and_with(freq_oracle, "_free_phase_candidate",
+                                         lambda *a, **k: None, path, machine, "acc+freq")
+    print(f"{'free ends':>9} sam acc+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}); "
+          f"bracket [{a.lower_bound_s:.4f}, {a.upper_bound_s:.4f}] {a.gap:.2%} -> "
+          f"[{b.lower_bound_s:.4f}, {b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})",
+          flush=True)
 
 
 if __name__ == "__main__":
