@@ -35,24 +35,29 @@ describes, and the motion is judged by the checker before it counts):
   (where the two parts peak at different points).
 
 Search (:func:`free_phase_motions`), per piece, the slowest pieces first: the first
-layout is the seed's phases with the runs of one sign joined (a relaxation, as in
-:func:`optimal.freq.phase_nlp._merged`). Where its NLP does not beat the seed, the seed's
-phases already lie where the rule wants them and the piece is left. Else, while the
-budget lasts (:data:`FREE_MAX_SOLVES` per piece, :data:`FREE_MAX_TOTAL_SOLVES` in all),
+layout is the seed's phases with the runs of one sign joined (as
+:func:`optimal.freq.phase_nlp._merged` joins them; the model has no constant-speed
+stretch, a joined phase creeps across it). Where its NLP does not beat the seed, the
+search takes that as a sign that the seed's phases already lie where the rule wants them
+and leaves the piece (a zig-zag of 60 moves at one plateau, tests/optimal/
+test_freq_humps.py: 40 moves in 25 s, none faster). Else, while the
+budget lasts (:data:`FREE_MAX_SOLVES` per piece, :data:`FREE_NODE_BUDGET` in all),
 the moves of :func:`_moves`, the first one that gains :data:`FREE_MIN_GAIN` and that the
 caller's checker accepts is taken, and the moves from there. Moves that did not help
 before, with the same codes around them, come last (:func:`_move_key`): after a gain
-elsewhere in the piece they seldom help now. Every result is a motion; the oracle keeps
+elsewhere in the piece they seldom help now. The best layout is solved once more on the
+finer nodes of :data:`FREE_FINE_FRACTIONS`. Every result is a motion; the oracle keeps
 those the checker accepts.
 
 Measured (``acc+freq``, default machine): on lcnc_sam_tolerance_issue (19 segments, two
 pieces; the bracket the other candidates leave is 12.57 %) the first layout alone takes
 the upper bound from 2.3261 to 2.2010 s (6.52 %); 20 solves give 2.1732 s (5.17 %), 40
-(the default) 2.1505 s (4.08 %), the oracle 8 s -> 28 s (80 solves: the same 2.1505 s). A scratch NLP written
-independently of this one (phases in path position, a randomised search over layouts
-for some 500 s) had found 2.1604 s there. On the line of five blocks with a wiggle
-between two point caps (tests) the search drops the wiggle and finds 0.83639 s, faster
-than the hand motion of 0.84197 s, and the oracle meets its bracket (2.24 -> 1.36 %).
+(the default) 2.1505 s (4.08 %), 80 the same; the last solve on finer nodes then
+2.1482 s (3.96 %), the oracle 8 s -> 28 to 37 s. A scratch NLP written independently of
+this one (phases in path position, a randomised search over layouts for some 500 s) had
+found 2.1604 s there. On the line of five blocks with a wiggle between two point caps
+(tests) the search drops the wiggle: 0.83639 s, 0.83564 s on finer nodes, faster than the
+hand motion of 0.84197 s, and the oracle meets its bracket (2.24 -> 1.27 %).
 
 Units: mm, s, mm/s.
 """
@@ -67,20 +72,31 @@ import numpy as np
 from reference.core.errors import ProfileError
 from reference.core.geometry import Path, axis_tangent_amplitudes, plane_amplitudes
 from reference.core.limits import AxisArrays
-from reference.core.phases import FREQ_ACCEL_TOL_REL, acceleration_phases
+from reference.core.phases import FREQ_ACCEL_TOL_REL, Phases, acceleration_phases
 from reference.core.profile import Profile
 
 from ..problem import junction_speed_caps
 from .lower import rest_pieces, segment_periods
 
-__all__ = ["FREE_ACCEPT_SCALE", "FREE_FRACTIONS", "FREE_MAX_SOLVES", "FREE_MAX_TOTAL_SOLVES",
-           "FreePhaseNLP", "Layout", "PieceModel", "creep_accel", "free_phase_motions", "layout_nlp", "layout_profile",
-           "piece_model", "seed_layout", "solve_layout"]
+__all__ = ["FREE_ACCEPT_SCALE", "FREE_FINE_FRACTIONS", "FREE_FRACTIONS", "FREE_MAX_SOLVES",
+           "FREE_NODE_BUDGET", "FreePhaseNLP", "Layout", "PieceModel", "creep_accel",
+           "free_phase_motions", "layout_nlp", "layout_profile", "piece_model",
+           "seed_layout", "solve_layout"]
 
 #: Node places between two events, as shares of the stretch: finer next to each event,
 #: where the motion changes its speed most (a phase holding a corner's cap up to the
 #: corner changes right after it).
 FREE_FRACTIONS = np.array([0.0, 0.01, 0.05, 0.2, 0.5, 0.8, 0.95, 0.99, 1.0])
+#: The nodes of the last solve on a piece's best layout (:func:`free_phase_motions`):
+#: those of :data:`FREE_FRACTIONS` refined towards the events, and even steps of 1/16
+#: between. Measured, against the search's own motion: the line through a feed cap of
+#: tests/optimal/test_freq.py 0.47045 -> 0.46876 s (its hand motion 0.46875 s), the
+#: five-block wiggle 0.83639 -> 0.83564 s, lcnc_sam_tolerance_issue's last piece
+#: 2.01721 -> 2.01490 s (one solve of 2.9 s); clustered steps alone reached 0.46912 s
+#: on the first, even steps of 1/32 alone 2.02325 s on the last.
+FREE_FINE_FRACTIONS = np.union1d(
+    np.array([0.0, 0.002, 0.01, 0.03, 0.07, 0.15, 0.3, 0.5, 0.7, 0.85, 0.93, 0.97, 0.99,
+              0.998, 1.0]), np.linspace(0.0, 1.0, 17))
 #: The least path acceleration inside a phase, as a multiple of the checker's threshold
 #: (:data:`reference.core.phases.FREQ_ACCEL_TOL_REL` of the profile's largest ``|s''|``,
 #: which is at most ``sqrt(n)`` times the largest axis limit on the path): a creep the
@@ -100,17 +116,26 @@ FREE_END_GAP_REL = 1e-4
 FREE_V_FLOOR_MM_S = 1e-3
 #: NLP solves per piece at most (the first layout's included). Measured on
 #: lcnc_sam_tolerance_issue (module docstring): 1, 20, 40 solves 2.2010, 2.1732,
-#: 2.1505 s; 80 the same 2.1505 s (no move from there gains).
+#: 2.1505 s; 80 the same 2.1505 s (no move from there gains; the oracle then
+#: solves the layout on finer nodes, 2.1482 s).
 FREE_MAX_SOLVES = 40
-#: NLP solves over the whole path at most (a program of many rest-to-rest pieces).
-FREE_MAX_TOTAL_SOLVES = 200
+#: NLP nodes summed over all solves on the whole path at most (a program of many
+#: rest-to-rest pieces, or long ones): a solve costs 1.5 to 3 ms per node (measured on
+#: lcnc_sam_tolerance_issue's last piece, some 240 nodes, 0.3 to 1.5 s a solve), so
+#: 45 to 90 s at most. The search there takes 40 solves, 9,700 nodes.
+FREE_NODE_BUDGET = 30_000
 #: IPOPT iterations per solve at most; a solve that stops there counts as failed. On
 #: lcnc_sam_tolerance_issue the solves that succeed take 20 to 200 iterations, those
 #: that do not run on to 600 and more (at some 8 ms each) without a faster motion.
 FREE_MAX_ITER = 200
-#: Pieces with more breaks than this are left to the other candidates (the NLP grows
-#: with breaks times phases, and the search with its phase ends).
-FREE_MAX_BREAKS = 400
+#: IPOPT iterations at most of the last solve on finer nodes: started from a motion of
+#: the coarse nodes it has further to go (the five-block wiggle of the tests, from the
+#: oracle's seed: not done in 200).
+FREE_FINE_MAX_ITER = 600
+#: Pieces with more breaks than this are left to the other candidates: the NLP grows
+#: with breaks and phase ends (up to some 3 of each per break, 8 nodes each), and its
+#: solves would take the whole of :data:`FREE_NODE_BUDGET` in a few.
+FREE_MAX_BREAKS = 200
 #: A motion of a piece counts where the checker slows it (joined into the seed) by at
 #: most this share (s/s): round-off at ratio 1 on the rows the NLP keeps with its margins.
 FREE_ACCEPT_SCALE = 1e-9
@@ -195,25 +220,45 @@ def creep_accel(lim: AxisArrays) -> float:
     return float(FREE_CREEP_FACTOR * FREQ_ACCEL_TOL_REL * np.sqrt(a.size) * np.max(a))
 
 
-def piece_model(path: Path, lim: AxisArrays, lo: int, hi: int) -> PieceModel:
-    """The :class:`PieceModel` of segments ``[lo, hi)`` of ``path`` (a rest-to-rest
-    piece: the path stops at both ends), limits ``lim`` in the path's axis order."""
+@dataclass(frozen=True, slots=True, eq=False)
+class _PathLimits:
+    """The per-segment and per-break arrays of :class:`PieceModel` over the whole path
+    (computed once for all its pieces)."""
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    v_seg: np.ndarray
+    v_break: np.ndarray
+    period: np.ndarray
+    creep: float
+
+
+def _path_limits(path: Path, lim: AxisArrays) -> _PathLimits:
     D, Pv = axis_tangent_amplitudes(path)
     amp = plane_amplitudes(path)
     rho = np.sqrt(path.e1 ** 2 + path.e2 ** 2)
-    dq_sup = (D + Pv)[lo:hi]
-    ddq_sup = (rho * amp.curvature[:, None])[lo:hi]
+    dq_sup = D + Pv
+    ddq_sup = rho * amp.curvature[:, None]
     a = np.asarray(lim.a_max, np.float64)[None, :]
     vmax = np.asarray(lim.v_max, np.float64)[None, :]
-    with np.errstate(divide="ignore"):
-        v_ax = np.where(dq_sup > 0, vmax / np.where(dq_sup > 0, dq_sup, 1.0), np.inf)
-    v_seg = np.minimum(v_ax.min(axis=1), path.feed[lo:hi])
-    v_cap, _ = junction_speed_caps(path, lim, permissive=False)
-    v_break = v_cap[lo:hi + 1].copy()
+    v_ax = np.where(dq_sup > 0, vmax / np.where(dq_sup > 0, dq_sup, 1.0), np.inf)
+    v_seg = np.minimum(v_ax.min(axis=1, initial=np.inf), path.feed)
+    v_break, _ = junction_speed_caps(path, lim, permissive=False)
+    return _PathLimits(dq_sup / a, ddq_sup / a, v_seg, v_break,
+                       segment_periods(path, lim), creep_accel(lim))
+
+
+def piece_model(path: Path, lim: AxisArrays, lo: int, hi: int,
+                data: _PathLimits | None = None) -> PieceModel:
+    """The :class:`PieceModel` of segments ``[lo, hi)`` of ``path`` (a rest-to-rest
+    piece: the path stops at both ends), limits ``lim`` in the path's axis order;
+    ``data``: the path's arrays when the caller has them (:func:`free_phase_motions`
+    builds them once for every piece)."""
+    d = _path_limits(path, lim) if data is None else data
+    v_break = d.v_break[lo:hi + 1].copy()
     v_break[[0, -1]] = 0.0
-    return PieceModel(lo, hi, path.s_breaks[lo:hi + 1].copy(), v_break, v_seg,
-                      dq_sup / a, ddq_sup / a, segment_periods(path, lim)[lo:hi],
-                      creep_accel(lim))
+    return PieceModel(lo, hi, path.s_breaks[lo:hi + 1].copy(), v_break, d.v_seg[lo:hi],
+                      d.alpha[lo:hi], d.beta[lo:hi], d.period[lo:hi], d.creep)
 
 
 def _valid(codes: tuple[int, ...], C: int) -> bool:
@@ -233,15 +278,18 @@ def _code_of(model: PieceModel, s: float) -> int:
     tol = FREE_END_GAP_REL * np.diff(sb)
     if 1 <= k and s - sb[k] <= tol[k]:
         return 2 * k
-    if k + 1 <= sb.size - 2 and sb[k + 1] - s <= tol[k] and k + 1 <= model.n_breaks:
+    if k + 1 <= model.n_breaks and sb[k + 1] - s <= tol[k]:
         return 2 * (k + 1)
     return 2 * k + 1
 
 
-def seed_layout(model: PieceModel, prof: Profile) -> tuple[tuple[int, ...], np.ndarray] | None:
+def seed_layout(model: PieceModel, prof: Profile, phases: Phases | None = None
+                ) -> tuple[tuple[int, ...], np.ndarray] | None:
     """The phase ends of ``prof`` on the piece, runs of one sign joined: codes and
-    positions (mm), or ``None`` where the motion has no rise followed by a fall there."""
-    ph = acceleration_phases(prof)
+    positions (mm), or ``None`` where the motion has no rise followed by a fall there.
+    ``phases``: :func:`~reference.core.phases.acceleration_phases` of ``prof`` when the
+    caller has them."""
+    ph = acceleration_phases(prof) if phases is None else phases
     s0, s1 = model.s_break[0], model.s_break[-1]
     ps = prof.s[ph.first]
     pe = prof.s[ph.last + 1]
@@ -327,7 +375,8 @@ class FreePhaseNLP:
 
 
 def layout_nlp(model: PieceModel, codes: tuple[int, ...], sigma0: np.ndarray,
-               v_of: Callable[[np.ndarray], np.ndarray]) -> FreePhaseNLP | None:
+               v_of: Callable[[np.ndarray], np.ndarray],
+               fractions: np.ndarray = FREE_FRACTIONS) -> FreePhaseNLP | None:
     """The :class:`FreePhaseNLP` of the piece with its phase ends at ``codes`` (module
     docstring), started from the ends ``sigma0`` (mm, shape (P - 1,); those of free ends
     are clipped into their gaps) and the speeds ``v_of(s)`` (mm/s); ``None`` where a
@@ -353,7 +402,7 @@ def layout_nlp(model: PieceModel, codes: tuple[int, ...], sigma0: np.ndarray,
         for n, j in enumerate(free):
             if codes[j] == 2 * k + 1:
                 events.append((float(x0[k]), float(gap_len[k]), n, None, j, k))
-    nf = FREE_FRACTIONS.size - 1
+    nf = fractions.size - 1
     K = (len(events) - 1) * nf
     s0 = np.zeros(K + 1)
     M = np.zeros((K + 1, U))
@@ -373,7 +422,7 @@ def layout_nlp(model: PieceModel, codes: tuple[int, ...], sigma0: np.ndarray,
                 M[i, n0] = l0
             break
         c1, l1, n1 = events[e + 1][:3]
-        for f in FREE_FRACTIONS[:-1]:
+        for f in fractions[:-1]:
             s0[i] = (1 - f) * c0 + f * c1
             if n0 >= 0:
                 M[i, n0] += (1 - f) * l0
@@ -425,14 +474,15 @@ def layout_nlp(model: PieceModel, codes: tuple[int, ...], sigma0: np.ndarray,
 
 def solve_layout(model: PieceModel, codes: tuple[int, ...], sigma0: np.ndarray,
                  v_of: Callable[[np.ndarray], np.ndarray], *,
-                 max_iter: int = FREE_MAX_ITER) -> Layout:
+                 max_iter: int = FREE_MAX_ITER,
+                 fractions: np.ndarray = FREE_FRACTIONS) -> Layout:
     """The fastest motion of the piece with its phase ends at ``codes``
     (:func:`layout_nlp`, solved by :func:`optimal.freq.backends.ipopt.solve_free_phases`);
     time ``inf`` where the caps leave no room."""
     from .backends.ipopt import solve_free_phases
 
     codes = tuple(int(c) for c in codes)
-    nlp = layout_nlp(model, codes, sigma0, v_of)
+    nlp = layout_nlp(model, codes, sigma0, v_of, fractions)
     if nlp is None:
         return Layout(codes, np.asarray(sigma0, np.float64), np.zeros(0), np.zeros(0),
                       np.inf, False)
@@ -552,7 +602,7 @@ def _sigma_for(codes: tuple[int, ...], lay: Layout, model: PieceModel) -> np.nda
 
 def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
                        max_solves: int = FREE_MAX_SOLVES,
-                       max_total: int = FREE_MAX_TOTAL_SOLVES, enough: float = 0.0,
+                       node_budget: int = FREE_NODE_BUDGET, enough: float = 0.0,
                        accept: Callable[[int, Profile], bool] | None = None,
                        progress: Callable[[str], object] | None = None
                        ) -> dict[int, Profile]:
@@ -568,9 +618,9 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
     seed : Profile
     max_solves : int
         :data:`FREE_MAX_SOLVES`: NLP solves per piece at most.
-    max_total : int
-        :data:`FREE_MAX_TOTAL_SOLVES`: NLP solves over all pieces at most (the slowest
-        pieces first).
+    node_budget : int
+        :data:`FREE_NODE_BUDGET`: NLP nodes summed over the solves of all pieces at most
+        (the slowest pieces first).
     enough : float
         s. The search stops once ``seed`` with the motions found so far takes at most
         this long (the caller's bracket is met); 0: only the budget stops it.
@@ -591,24 +641,28 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
     seg_t = seed.segment_times(path)
     out: dict[int, Profile] = {}
     gained = 0.0                                  # s, by the pieces done so far
-    total = 0                                     # solves so far
+    spent = 0                                     # nodes solved so far
     # the slowest pieces first: the budget goes where the most time is
     piece_t = np.add.reduceat(seg_t, pieces[:, 0]) if pieces.size else np.zeros(0)
+    data, phases = None, None                     # built for the first piece searched
     for k in np.argsort(-piece_t, kind="stable"):
         k = int(k)
         lo, hi = int(pieces[k, 0]), int(pieces[k, 1])
+        if spent >= node_budget or seed.duration - gained <= enough:
+            break
         if hi - lo - 1 > FREE_MAX_BREAKS:
             continue
-        model = piece_model(path, lim, lo, hi)
-        start = seed_layout(model, seed)
+        if data is None:
+            data, phases = _path_limits(path, lim), acceleration_phases(seed)
+        model = piece_model(path, lim, lo, hi, data)
+        start = seed_layout(model, seed, phases)
         if start is None:
             continue
-        t_seed = float(np.sum(seg_t[lo:hi]))
+        t_seed = float(piece_t[k])
         v_seed = (lambda s: np.interp(s, seed.s, seed.v))
-        if total >= max_total or seed.duration - gained <= enough:
-            break
         best = solve_layout(model, start[0], start[1], v_seed)
         solves = 1
+        spent += best.s.size
         best_prof = None
         if best.ok and best.time_s < t_seed * (1 - FREE_MIN_GAIN):
             p = layout_profile(path, model, best)
@@ -619,11 +673,10 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
         elif not best.ok:
             best = Layout(best.codes, best.sigma, best.s, best.v, np.inf, False)
         tried, failed = {best.codes}, set()
-        # the search follows only where freeing the ends of the seed's own phases gains:
-        # where it does not, the seed's phases already lie where the rule wants them
-        # (a zig-zag of 60 moves at one plateau: 40 moves in 25 s, none faster)
+        # the search follows only where freeing the ends of the seed's own phases gains
+        # (module docstring)
         improved = best_prof is not None
-        while improved and solves < max_solves and total + solves < max_total and \
+        while improved and solves < max_solves and spent < node_budget and \
                 seed.duration - gained - (t_seed - min(best.time_s, t_seed)) > enough:
             improved = False
             # moves that did not help before, with the same codes around them, last:
@@ -633,7 +686,7 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
             moves = [m for m in moves if m[1] not in failed] + \
                 [m for m in moves if m[1] in failed]
             for codes, key in moves:
-                if solves >= max_solves or total + solves >= max_total:
+                if solves >= max_solves or spent >= node_budget:
                     break
                 tried.add(codes)
                 failed.add(key)
@@ -642,6 +695,7 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
                          if np.isfinite(cur.time_s) else v_seed)
                 lay = solve_layout(model, codes, _sigma_for(codes, cur, model), v_cur)
                 solves += 1
+                spent += lay.s.size
                 if not lay.ok or lay.time_s >= min(best.time_s, t_seed) * (1 - FREE_MIN_GAIN):
                     continue
                 p = layout_profile(path, model, lay)
@@ -650,8 +704,17 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
                 failed.discard(key)
                 best, best_prof, improved = lay, p, True
                 break
-        total += solves
         if best_prof is not None:
+            # the best layout once more on finer nodes: its motion's acceleration steps
+            # then fall nearer where it wants them
+            lay = solve_layout(model, best.codes, best.sigma,
+                               lambda s, c=best: np.interp(s, c.s, c.v),
+                               fractions=FREE_FINE_FRACTIONS, max_iter=FREE_FINE_MAX_ITER)
+            spent += lay.s.size
+            if lay.ok and lay.time_s < best.time_s:
+                p = layout_profile(path, model, lay)
+                if p is not None and (accept is None or accept(k, p)):
+                    best, best_prof = lay, p
             out[k] = best_prof
             gained += t_seed - best.time_s
         if progress:

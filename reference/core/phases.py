@@ -51,7 +51,7 @@ this rule is a motion no adaptation produces, and the oracle's verified motions,
 from ramps or keeping the phases of one (:mod:`optimal.freq.phase_nlp`, the jerk NLP with
 this rule as its rows), stay above it. The oracle's NLP with the phases' ends free in path
 position (:mod:`optimal.freq.free_phases`) finds such motions: on that program 2.3261 ->
-2.1505 s under ``acc+freq``. The rule is a rule on time, not a guarantee of a smooth
+2.1482 s under ``acc+freq``. The rule is a rule on time, not a guarantee of a smooth
 acceleration spectrum. A rule that also bounds the acceleration within a phase by its
 change (``|s''| <= 2 f dv``, which linear ramps and S-curves of ``1/f`` meet) would close
 this; it is not adopted (issue 12 defines the rule by the phases' durations).

@@ -420,7 +420,7 @@ def test_acc_freq_flattens_a_wiggle_between_two_caps():
     # the wiggle flattened (optimal.freq.phase_nlp._flattened): 0.84367 s; without the
     # trial the phases stay those of the ramps (0.89086 s, 5.8 % slower; the oracle's
     # bracket was 8.0 %, then 2.2 % against its lower bound of 0.82516 s; the free phase
-    # ends, optimal.freq.free_phases, now take it to 1.36 %: tests/optimal/
+    # ends, optimal.freq.free_phases, now take it to 1.27 %: tests/optimal/
     # test_freq_free_phases.py)
     from scipy.optimize import brentq
     from optimal.freq.oracle import _acc_nlp_grid
