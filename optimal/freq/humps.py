@@ -162,9 +162,10 @@ numbers before :mod:`optimal.freq.free_phases`: its NLP with the phases' ends fr
 path position takes the whole program from 2.3261 to 2.1482 s (checked), so on sam the
 upper side was the weaker one. Where the 3.96 % still open lies is not known. One
 suspect was tested and gained almost nothing: a fall phase ``[t_0, t_1]`` that changes
-the speed by ``D_b`` before a corner (passed at ``t_x``) and by ``D_a`` after it has ``D_b (t_x - t_0) + D_a (t_1 - t_0) >= (D_b + D_a) g / 2`` (its
-acceleration-weighted mean time is at least ``g/2`` after its start), so a fall from a
-peak far above a cap just after it lasts long. A prototype of the programme that carried
+the speed by ``D_b`` before a corner (passed at ``t_x``) and by ``D_a`` after it has
+``D_b (t_x - t_0) + D_a (t_1 - t_0) >= (D_b + D_a) g / 2`` (its acceleration-weighted
+mean time is at least ``g/2`` after its start), so a fall from a peak far above a cap
+just after it lasts long. A prototype of the programme that carried
 the peak's speed in levels (as step 4c carries the valley's) and charged every fall that
 passes a cap this bound raised the piece's bound by 0.001 s only (1.9332 -> 1.9342 s,
 with 6 and 12 levels of ratio 0.8, the bound taken at the least cap between peak and
