@@ -179,10 +179,10 @@ cell's start to the peak cell's end, ``u_lo`` the valley level's lower end and
 bound the same with two peak levels (sam 1.93299 s, lcnc_arc_arc_sawtooth 5.17477 s,
 lcnc_test_12mmflat 37.58713 s on their fine cells). With six peak levels of ratio 0.6
 sam reached only 1.93597 s (eight of 0.7: 1.93629 s), because the shortest path moves
-its turns and still pays about ``g`` per stretch. On the upper side, a local search moved each phase boundary
-of the NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`) by 1, 3 and 6 grid
-nodes. Over about 200 s it took sam from 2.3286 to 2.3237 s (0.2 %); the free phase
-ends (above) gained 7.5 %.
+its turns and still pays about ``g`` per stretch. On the upper side, a local search
+moved each phase boundary of the NLP with the rule's rows (:mod:`optimal.freq.phase_nlp`)
+by 1, 3 and 6 grid nodes. Over about 200 s it took sam from 2.3286 to 2.3237 s (0.2 %);
+the free phase ends (above) gained 7.6 %.
 
 Units: mm, s, mm/s.
 """
