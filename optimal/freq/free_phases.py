@@ -524,8 +524,8 @@ def _moves(lay: Layout, model: PieceModel) -> list[tuple[int, ...]]:
     all at once, then each of these alone; then each end on a break moved into the gap
     on either side (the change before the corner or after it); then each phase dropped
     with its two ends (its neighbours, of one sign, joined), the smallest speed change
-    first. Measured on lcnc_sam_tolerance_issue: the gains came from ends moved off
-    corners and from phases dropped, in about equal parts."""
+    first. Measured on lcnc_sam_tolerance_issue's last piece (40 solves): three ends
+    moved off corners gained 0.045 s, one phase dropped 0.005 s."""
     codes = list(lay.codes)
     sb = model.s_break
     eps = FREE_END_GAP_REL * np.diff(sb)

@@ -129,15 +129,16 @@ def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: di
     return best
 
 
-def _free_phase_candidate(path: Path, limits: MachineLimits, seed, holds: Holds,
-                          enough: float, progress=None):
+def _free_phase_candidate(path: Path, limits: MachineLimits, seed: Candidate,
+                          holds: Holds, enough: float,
+                          progress: Callable[[str], object] | None = None
+                          ) -> Candidate | None:
     """``seed`` (a verified candidate) with each rest-to-rest piece replaced by the
     fastest motion of :func:`optimal.freq.free_phases.free_phase_motions` that the
     checker accepts in it (judged with ``seed``'s other pieces and the holds, not slowed
     down by more than round-off); ``None`` where none is faster. ``enough``: s, holds
     excluded, where the search may stop."""
     pieces = rest_pieces(path)
-    accepted: dict[int, Candidate] = {}
 
     def joined(k: int, prof: Profile):
         choice = np.zeros(pieces.shape[0], np.int64)
