@@ -147,3 +147,43 @@ def test_layout_codes():
     # the key of a move: what changes, with one end of context on either side
     assert _move_key((1, 2, 3, 5, 7), (1, 2, 4, 5, 7)) == ((2, 3, 5), (2, 4, 5))
     assert _move_key((1, 2, 3, 5, 7), (1, 5, 7)) == ((1, 2, 3, 5), (1, 5))
+
+
+@pytest.mark.parametrize("case", ["line-arc-line R2", "line-arc-line R0.5", "blended 0",
+                                  "blended 1"])
+def test_arc_rows_are_conservative(case):
+    # On arcs the model bounds |q'_j| |s''| + |q''_j| v^2 by the segment's suprema of
+    # both parts: every motion of the NLP must pass the checker (which samples the axis
+    # acceleration between the nodes), here one rise and one fall from a slow flat start
+    # (the layout with its end in the first gap and in the last)
+    from oracle_cases import line_arc_line, random_blended_polyline
+    lim = machine(f=10.0)
+    path = {"line-arc-line R2": lambda: line_arc_line(2.0, 10.0, feed=100.0),
+            "line-arc-line R0.5": lambda: line_arc_line(0.5, 3.0, feed=150.0),
+            "blended 0": lambda: random_blended_polyline(12, 0),
+            "blended 1": lambda: random_blended_polyline(12, 1)}[case]()
+    model = piece_model(path, lim.for_axes(path.axes), 0, path.n_segments)
+    C = model.n_breaks
+    sb = model.s_break
+    for codes, mid in (((1,), 0.5 * (sb[0] + sb[1])), ((2 * C + 1,), 0.5 * (sb[-2] + sb[-1]))):
+        lay = solve_layout(model, codes, np.array([mid]), lambda s: np.ones_like(s),
+                           max_iter=3000)
+        assert lay.ok
+        rep = check_profile(path, lim, layout_profile(path, model, lay))
+        assert rep.ok(ACC_FREQ), rep.violations(ACC_FREQ)
+
+
+def test_a_short_arc_takes_two_periods():
+    # A half circle of radius 1 mm at F80 (machine(): 10 Hz): a rise and a fall of at
+    # least 1/f each, and at the peak pi / 0.1 = 31.4 mm/s (below the feed; centripetal
+    # 987 mm/s^2 and the path acceleration 628 mm/s^2 within A) the two meet: exactly
+    # 2/f = 0.2 s, the NLP neither below it nor above by more than its margins
+    from oracle_cases import semicircle
+    lim = machine(f=10.0)
+    path = semicircle(1.0, feed=80.0)
+    model = piece_model(path, lim.for_axes(path.axes), 0, path.n_segments)
+    lay = solve_layout(model, (1,), np.array([0.5 * path.total_length]),
+                       lambda s: np.ones_like(s), max_iter=3000)
+    prof = layout_profile(path, model, lay)
+    assert lay.ok and 0.2 * (1 - 1e-12) <= prof.duration <= 0.2 * (1 + CLOSED_FORM_SLACK)
+    assert check_profile(path, lim, prof).ok(ACC_FREQ)
