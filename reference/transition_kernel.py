@@ -149,9 +149,9 @@ def _distance(x: float, y: float, first: bool, r_in: float, r_out: float,
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _slopes(packed, t, s, first, r_in, r_out, centre_out, sc, buf):  # pragma: no cover
-    """``_distance_slopes`` at one distance: the distance, its slope and its bend."""
-    _point(packed, t, s, sc, buf, True)
+def _slopes_at(buf, first, r_in, r_out, centre_out):  # pragma: no cover - compiled
+    """``_distance_slopes`` of the point ``buf`` (``_point`` with its derivatives): the
+    distance, its slope and its bend."""
     x, y = buf[0], buf[1]
     yc = r_in if first else centre_out
     r = r_in if first else r_out
@@ -164,6 +164,13 @@ def _slopes(packed, t, s, first, r_in, r_out, centre_out, sc, buf):  # pragma: n
     slope = sign * qt / norm
     bend = sign * ((1.0 + qa) / norm - qt * qt / (norm * norm * norm))
     return abs(num) / (norm + r), slope, bend
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _slopes(packed, t, s, first, r_in, r_out, centre_out, sc, buf):  # pragma: no cover
+    """``_distance_slopes`` at one distance: the distance, its slope and its bend."""
+    _point(packed, t, s, sc, buf, True)
+    return _slopes_at(buf, first, r_in, r_out, centre_out)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -182,11 +189,13 @@ def _argmax(d: np.ndarray) -> int:  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _bracket_max(packed, rows, a, b, first, start, r_in, r_out,
-                 centre_out):  # pragma: no cover - compiled
+def _bracket_max(packed, rows, a, b, first, start, r_in, r_out, centre_out,
+                 d_a, g_a, d_b, g_b):  # pragma: no cover - compiled
     """``_bracket_max`` over the parts ``[a, b]`` of transitions ``rows`` (shape (m,)
-    each): value, converged, where; the Newton steps of each inner part run until its
-    own step is below the tolerance (or NEWTON_MAX_ITER)."""
+    each), the distance and its slope at both ends of each given (``d_a, g_a, d_b,
+    g_b``, shape (m,): the search has the points already): value, converged, where; the
+    Newton steps of each inner part run until its own step is below the tolerance (or
+    NEWTON_MAX_ITER)."""
     m = rows.size
     sc = np.empty(2)
     buf = np.empty(6)
@@ -195,14 +204,9 @@ def _bracket_max(packed, rows, a, b, first, start, r_in, r_out,
     done = np.ones(m, dtype=np.bool_)
     inner = np.zeros(m, dtype=np.bool_)
     for i in range(m):
-        t = rows[i]
-        d_a, g_a, _ = _slopes(packed, t, a[i], first[i], r_in[t], r_out[t], centre_out[t],
-                              sc, buf)
-        d_b, g_b, _ = _slopes(packed, t, b[i], first[i], r_in[t], r_out[t], centre_out[t],
-                              sc, buf)
-        at_a = g_a <= 0
-        at_b = (not at_a) and g_b >= 0
-        value[i] = d_a if at_a else (d_b if at_b else -np.inf)
+        at_a = g_a[i] <= 0
+        at_b = (not at_a) and g_b[i] >= 0
+        value[i] = d_a[i] if at_a else (d_b[i] if at_b else -np.inf)
         where[i] = a[i] if at_a else b[i]
         inner[i] = not (at_a or at_b)
     idx = np.flatnonzero(inner)
@@ -373,23 +377,45 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
     hi = np.empty(k)
     x_lo = np.empty(k)
     x_hi = np.empty(k)
+    # the window's ends once, with the distance and its slope on the part each ends
+    # (the part from lo takes lo's circle; the part to hi the same unless the window
+    # crosses x = 0, where the second part takes the outgoing circle)
+    d_lo, g_lo = np.empty(k), np.empty(k)
+    d_hi, g_hi = np.empty(k), np.empty(k)
     for t in range(k):
         lo[t] = _max(at[t] - h[t], 0.0)
         hi[t] = _min(at[t] + h[t], total[t])
-        _point(packed, t, lo[t], sc, buf, False)
+        _point(packed, t, lo[t], sc, buf, True)
         x_lo[t] = buf[0]
-        _point(packed, t, hi[t], sc, buf, False)
+        d_lo[t], g_lo[t], _ = _slopes_at(buf, x_lo[t] <= 0, r_in[t], r_out[t],
+                                         centre_out[t])
+        _point(packed, t, hi[t], sc, buf, True)
         x_hi[t] = buf[0]
+        d_hi[t], g_hi[t], _ = _slopes_at(buf, x_lo[t] <= 0 and not x_hi[t] > 0, r_in[t],
+                                         r_out[t], centre_out[t])
     split = np.flatnonzero((x_lo <= 0) & (x_hi > 0))
     cross = _crossing(packed, split, lo[split], hi[split], x_lo[split], x_hi[split])
+    # the crossing once, for the end of the first part and the start of the second
+    d_c1, g_c1 = np.empty(split.size), np.empty(split.size)
+    d_c2, g_c2 = np.empty(split.size), np.empty(split.size)
+    for n in range(split.size):
+        t = split[n]
+        _point(packed, t, cross[n], sc, buf, True)
+        d_c1[n], g_c1[n], _ = _slopes_at(buf, True, r_in[t], r_out[t], centre_out[t])
+        d_c2[n], g_c2[n], _ = _slopes_at(buf, False, r_in[t], r_out[t], centre_out[t])
     mid = hi.copy()
     mid[split] = cross
+    d_mid, g_mid = d_hi.copy(), g_hi.copy()
+    d_mid[split] = d_c1
+    g_mid[split] = g_c1
     rows = np.concatenate((np.arange(k), split))
     a = np.concatenate((lo, cross))
     b = np.concatenate((mid, hi[split]))
     first = np.concatenate((x_lo <= 0, np.zeros(split.size, dtype=np.bool_)))
-    value, done, at_value = _bracket_max(packed, rows, a, b, first, at[rows], r_in, r_out,
-                                         centre_out)
+    value, done, at_value = _bracket_max(
+        packed, rows, a, b, first, at[rows], r_in, r_out, centre_out,
+        np.concatenate((d_lo, d_c2)), np.concatenate((g_lo, g_c2)),
+        np.concatenate((d_mid, d_hi[split])), np.concatenate((g_mid, g_hi[split])))
     # the window's part with the larger value (the first part where they tie)
     for i in range(rows.size):
         t = rows[i]
