@@ -659,8 +659,8 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
         if start is None:
             continue
         t_seed = float(piece_t[k])
-        v_seed = (lambda s: np.interp(s, seed.s, seed.v))
-        best = solve_layout(model, start[0], start[1], v_seed)
+        best = solve_layout(model, start[0], start[1],
+                            lambda s: np.interp(s, seed.s, seed.v))
         solves = 1
         spent += best.s.size
         best_prof = None
@@ -668,16 +668,12 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
             p = layout_profile(path, model, best)
             if p is not None and (accept is None or accept(k, p)):
                 best_prof = p
-            else:
-                best = Layout(best.codes, best.sigma, best.s, best.v, np.inf, False)
-        elif not best.ok:
-            best = Layout(best.codes, best.sigma, best.s, best.v, np.inf, False)
         tried, failed = {best.codes}, set()
         # the search follows only where freeing the ends of the seed's own phases gains
-        # (module docstring)
+        # (module docstring); from here on ``best`` is an accepted motion
         improved = best_prof is not None
         while improved and solves < max_solves and spent < node_budget and \
-                seed.duration - gained - (t_seed - min(best.time_s, t_seed)) > enough:
+                seed.duration - gained - (t_seed - best.time_s) > enough:
             improved = False
             # moves that did not help before, with the same codes around them, last:
             # after a gain elsewhere they seldom help now
@@ -690,13 +686,11 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
                     break
                 tried.add(codes)
                 failed.add(key)
-                cur = best
-                v_cur = ((lambda s, c=cur: np.interp(s, c.s, c.v))
-                         if np.isfinite(cur.time_s) else v_seed)
-                lay = solve_layout(model, codes, _sigma_for(codes, cur, model), v_cur)
+                lay = solve_layout(model, codes, _sigma_for(codes, best, model),
+                                   lambda s, c=best: np.interp(s, c.s, c.v))
                 solves += 1
                 spent += lay.s.size
-                if not lay.ok or lay.time_s >= min(best.time_s, t_seed) * (1 - FREE_MIN_GAIN):
+                if not lay.ok or lay.time_s >= best.time_s * (1 - FREE_MIN_GAIN):
                     continue
                 p = layout_profile(path, model, lay)
                 if p is None or (accept is not None and not accept(k, p)):
@@ -718,6 +712,7 @@ def free_phase_motions(path: Path, lim: AxisArrays, seed: Profile, *,
             out[k] = best_prof
             gained += t_seed - best.time_s
         if progress:
+            t_new = best.time_s if best_prof is not None else t_seed
             progress(f"free phase ends, piece {k + 1}/{pieces.shape[0]}: "
-                     f"{t_seed:.4f} -> {min(best.time_s, t_seed):.4f} s ({solves} solves)")
+                     f"{t_seed:.4f} -> {t_new:.4f} s ({solves} solves)")
     return out
