@@ -615,9 +615,10 @@ def humps_bound(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
 
 def humps_piece_bounds(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
                        beat: float = 0.0, segment_floor: np.ndarray | None = None,
-                       enough: float = math.inf) -> np.ndarray:
+                       enough: float = math.inf, node_caps: np.ndarray | None = None
+                       ) -> np.ndarray:
     """Lower bound on the time of each rest-to-rest piece under ``acc+freq`` (holds
-    excluded), s.
+    excluded), s; under ``jerk+freq`` with ``node_caps``.
 
     Per rest-to-rest piece (:func:`optimal.freq.lower.rest_pieces`) the larger of the
     ``acc`` relaxation's time on the piece and the turn programme on the piece's cells,
@@ -655,6 +656,13 @@ def humps_piece_bounds(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
         each turn of the fine run's shortest paths (:data:`HUMP_TURN_WIDTH`) cut into
         :data:`HUMP_TURN_SPLIT`, the programme run again on the same pieces. Effort only,
         as ``beat``: the bound holds for any cells (step 1 holds on every cell).
+    node_caps : numpy.ndarray, shape (N + 1,), optional
+        Upper bounds of the speed at the grid's nodes valid for every motion the bound
+        is for (mm/s; for ``jerk+freq`` the reach envelope,
+        :func:`optimal.jerk.lower.reach_speed_caps`): they lower ``b_hat`` of step 1.
+        The tents stay valid (each motion has ``b(s_k) <= b_hat_k`` and the slope bound
+        ``M_k`` of the ``acc`` problem, whose motions include these), so the programme
+        then bounds the time of every such motion.
 
     Returns
     -------
@@ -666,6 +674,10 @@ def humps_piece_bounds(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     if path.n_segments == 0 or not math.isfinite(t_upper):
         return np.zeros(pieces.shape[0])
     bounds = speed_envelope_bounds(path, lim, grid)
+    if node_caps is not None:
+        caps = np.asarray(node_caps, dtype=np.float64)
+        b_cap = np.where(np.isfinite(caps), caps * caps, np.inf)
+        bounds = (np.minimum(bounds[0], b_cap),) + tuple(bounds[1:])
     t = _tents(path, lim, grid, bounds)
     drift = FREQ_ACCEL_TOL_REL * t.accel * t_upper
     if not np.any(t.period > 0) or not math.isfinite(drift):

@@ -57,6 +57,7 @@ from reference.core.errors import ProfileError
 from reference.core.geometry import Path
 from reference.core.holds import NO_HOLDS, Holds, dwell_holds, with_holds, without_holds
 from reference.core.limits import MachineLimits
+from reference.core.tolerances import MIN_SEGMENT_LENGTH_MM
 from reference.core.profile import Profile
 from reference.core.rows import block_motion, block_rows
 
@@ -64,6 +65,7 @@ from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
 from ..grid import grid_on
 from ..jerk.oracle import jerk_grid
+from ..jerk.lower import reach_nodes, reach_speed_caps, segment_envelope, speed_bounds
 from ..jerk.relaxation import RunFloors
 from .capped import capped_optimum
 from .humps import humps_piece_bounds
@@ -81,6 +83,22 @@ ProgressFn = Callable[..., object]
 
 #: Default requested gap (DESIGN/issue: 2 % where achievable).
 DEFAULT_FREQ_GAP_TOL = 2e-2
+
+
+def _reach_grid(work: Path, lim, t_ipo: float, acc_grid, t_upper: float):
+    """The ``acc`` grid with the nodes of :func:`optimal.jerk.lower.reach_nodes`, and the
+    reach caps (:func:`optimal.jerk.lower.reach_speed_caps`) at its nodes, mm/s: the
+    ``jerk+freq`` turn programme's envelope (:func:`optimal.freq.humps.humps_piece_bounds`,
+    ``node_caps``)."""
+    acc_s = np.asarray(getattr(acc_grid, "s", acc_grid), dtype=np.float64)
+    _, b_break, b_seg = speed_bounds(work, lim, t_ipo, acc_s)
+    env = segment_envelope(work, lim, t_ipo, b_break, b_seg)
+    extra = reach_nodes(work, env)
+    # not within the segment-length floor of a node there (no vanishing intervals)
+    k = np.clip(np.searchsorted(acc_s, extra), 1, acc_s.size - 1)
+    gap = np.minimum(extra - acc_s[k - 1], acc_s[k] - extra)
+    grid = grid_on(work, np.union1d(acc_s, extra[gap > MIN_SEGMENT_LENGTH_MM]))
+    return grid, reach_speed_caps(work, env, grid.s, t_upper)
 
 
 def _fastest_per_piece(path: Path, limits: MachineLimits, cands: list, local: dict,
@@ -382,9 +400,15 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         # the bound that meets the bracket (holds excluded): where the programme comes
         # near it, it cuts its cells finer where its motion turns (the turn run)
         enough = (t_best + hold_t) / (1.0 + tol) - hold_t
-        env_grid = grid_on(work, acc.grid)
+        env_grid, caps = grid_on(work, acc.grid), None
+        if base == "jerk":
+            # the jerk set's reach out of every break (optimal.jerk.lower step 7) as
+            # node caps of the programme's envelope, on nodes added where it bends;
+            # valid for the motions no slower than t_best, so for both runs below
+            env_grid, caps = _reach_grid(work, sub_lim, limits.t_ipo_s, acc.grid, t_best)
         per_piece = humps_piece_bounds(work, sub_lim, env_grid, t_up, lb - hold_t,
-                                       base_sol.segment_lower_bounds_s, enough=enough)
+                                       base_sol.segment_lower_bounds_s, enough=enough,
+                                       node_caps=caps)
         raw, t_valid = float(np.sum(per_piece)), t_up
         lb_humps = min(raw, t_up)
         if raw >= t_up and t_up < t_best:
@@ -396,7 +420,8 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
             # verified 1.467 s it shows 1.414 s, the zig-zag's own ramps)
             per_piece = humps_piece_bounds(work, sub_lim, env_grid, t_best,
                                            max(lb - hold_t, lb_humps),
-                                           base_sol.segment_lower_bounds_s, enough=enough)
+                                           base_sol.segment_lower_bounds_s, enough=enough,
+                                           node_caps=caps)
             raw, t_valid = float(np.sum(per_piece)), t_best
             lb_humps = max(lb_humps, min(raw, t_best))
         if (win_rows is not None and raw < t_valid

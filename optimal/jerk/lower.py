@@ -87,6 +87,27 @@ Why the bound holds
    limits only remove motions). Rest at stops is ``v = 0`` exactly, as in the ``acc``
    relaxation.
 
+7. *Reach envelope* (:func:`reach_speed_caps`, used by the ``jerk+freq`` turn programme,
+   :mod:`optimal.freq.humps`). On segment ``g``, at distance ``y`` from its start break
+   ``k``, every jerk-feasible motion that lasts at most ``T_up`` has ``v <= P(y)``, the
+   ``p`` with ``D(p) = y``, where ``D(p) = int_vb^p u / ahat(u) du``, ``vb`` the speed
+   bound at the break, ``ahat(u) = min(A + eps, sqrt(alpha + 2 J u))`` and
+   ``alpha = a_out^2 + 2 J eps T_up + 2 eps A + eps^2`` (``A``, ``J``, ``eps`` and the
+   break's allowance ``a_out`` of step 4). Write ``s'' = c + sigma`` with ``sigma`` the
+   steps inside the segment summed so far (``|sigma| <= eps``) and ``c`` absolutely
+   continuous, ``|c'| <= J``, ``|c| <= a_out`` just after the break. Where ``c > 0``,
+   ``(c^2)' = 2 c c' <= 2 J c <= 2 J (s'' + eps)``; integrated from the last time
+   ``c <= 0`` (or from the break) this gives ``c^2 <= a_out^2 + 2 J (v + eps T_up)``
+   (``v >= 0``, at most ``T_up`` since the break), and ``s'' <= c + eps`` is at most
+   ``ahat(v)`` (``(x + eps)^2 <= x^2 + 2 eps A + eps^2`` for ``x <= A``; where ``c <= 0``,
+   ``s'' <= eps``). With ``h(u) = u / ahat(u) >= 0`` and ``v`` going from ``v(0) <= vb``
+   to ``p`` over the distance ``y``: ``y = int v dt >= int h(v) max(s'', 0) dt >=
+   int h(v) s'' dt = int_v(0)^p h >= D(p)``, and ``D`` grows with ``p``. Run backwards
+   in time a motion is jerk-feasible with the arriving allowance ``a_in`` of the end
+   break, so the same holds from the end; the cap is the smaller of the two. On a line
+   from rest (``vb = a_out = eps = 0``) ``P`` is the speed of the jerk ramp ``+J`` from
+   rest at that distance: the cap is reached.
+
 Where it is loose: on arcs the path acceleration and jerk bounds of step 4 are norms
 over the axes (up to ``sqrt(n)`` above the pointwise values), and neighbouring segments
 are coupled only through the node bounds and the step allowances at their common break.
@@ -691,6 +712,129 @@ def speed_bounds(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarr
     np.maximum.at(b_seg, grid.segment, np.maximum(rel.b_bar, np.maximum(b_hat[:-1],
                                                                          b_hat[1:])))
     return acc_seg, b_hat[grid.break_node], b_seg
+
+
+#: Relative raise of the reach caps of :func:`reach_speed_caps` over the computed root
+#: (its closed form and bisection carry round-off of about 1e-15 relative; the cap must
+#: never fall below the true ``P(y)``).
+REACH_ROUNDOFF_REL = 1e-9
+#: Bisection steps of :func:`reach_speed_caps` on ``[vb, sqrt(vb^2 + 2 A y)]`` (the
+#: ``acc`` reach is the upper end): 2^-60 of that interval, far below the round-off raise.
+REACH_BISECTIONS = 60
+
+
+def reach_distance(p: np.ndarray, vb: np.ndarray, alpha: np.ndarray, A: np.ndarray,
+                   J: np.ndarray) -> np.ndarray:
+    """``D(p)`` of step 7: the least distance over which the speed can rise from ``vb``
+    to ``p`` with ``s'' <= min(A, sqrt(alpha + 2 J u))`` at speed ``u``, mm (0 where
+    ``p <= vb``), vectorised (every argument broadcast to one shape; ``alpha`` in
+    mm^2/s^4, ``A`` mm/s^2, ``J`` mm/s^3, speeds mm/s)."""
+    ustar = np.maximum((A * A - alpha) / (2.0 * J), 0.0)
+
+    def antiderivative(u):
+        x = np.minimum(u, ustar)
+        w = alpha + 2.0 * J * x
+        w0 = alpha
+        # int_0^x u / sqrt(alpha + 2 J u) du, then u / A above ustar
+        low = ((2.0 / 3.0) * (w ** 1.5 - w0 ** 1.5) - 2.0 * alpha * (np.sqrt(w) - np.sqrt(w0))) \
+            / (4.0 * J * J)
+        return low + np.where(u > ustar, (u * u - ustar * ustar) / (2.0 * A), 0.0)
+
+    return np.maximum(antiderivative(np.maximum(p, vb)) - antiderivative(vb), 0.0)
+
+
+def _reach_side(y: np.ndarray, vb: np.ndarray, a_s: np.ndarray, A: np.ndarray,
+                J: np.ndarray, eps: float, t_upper: float) -> np.ndarray:
+    """``P(y)`` of step 7 from one break (shape of ``y``), mm/s."""
+    A1 = A + eps
+    alpha = a_s * a_s + 2.0 * J * eps * t_upper + 2.0 * eps * A + eps * eps
+    lo = vb.copy()
+    hi = np.sqrt(vb * vb + 2.0 * A1 * np.maximum(y, 0.0))   # D(p) >= (p^2 - vb^2) / 2A'
+    for _ in range(REACH_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        short = reach_distance(mid, vb, alpha, A1, J) <= y
+        lo = np.where(short, mid, lo)
+        hi = np.where(short, hi, mid)
+    return hi * (1.0 + REACH_ROUNDOFF_REL)
+
+
+def reach_speed_caps(path: Path, env: SegmentEnvelope, s: np.ndarray, t_upper: float
+                     ) -> np.ndarray:
+    """Upper bounds of the speed at path positions ``s`` for every jerk-feasible motion
+    lasting at most ``t_upper`` (step 7), mm/s, shape of ``s``; ``inf`` on segments
+    without a finite jerk or acceleration bound (at rest, speeds at the breaks are
+    ``env.vb``).
+
+    Parameters
+    ----------
+    path : Path
+    env : SegmentEnvelope
+        :func:`segment_envelope` of ``path``.
+    s : numpy.ndarray, shape (N,)
+        Positions, mm (inside ``[0, path.total_length]``).
+    t_upper : float
+        s; a verified upper bound of the minimum time keeps the minimum among the motions
+        bounded.
+    """
+    s = np.asarray(s, dtype=np.float64)
+    out = np.full(s.shape, np.inf)
+    if path.n_segments == 0 or not math.isfinite(t_upper):
+        return out
+    sb = path.s_breaks
+    seg = np.clip(np.searchsorted(sb, s, side="right") - 1, 0, path.n_segments - 1)
+    A, J = env.A[seg], env.J[seg]
+    ok = np.isfinite(A) & np.isfinite(J) & (J > 0) & np.isin(seg, env.used)
+    if not np.any(ok):
+        return out
+    i = np.flatnonzero(ok)
+    g = seg[i]
+    y0 = np.maximum(s[i] - sb[g], 0.0)
+    y1 = np.maximum(sb[g + 1] - s[i], 0.0)
+    p0 = _reach_side(y0, env.vb[g], env.a_out[g], A[i], J[i], env.eps, t_upper)
+    p1 = _reach_side(y1, env.vb[g + 1], env.a_in[g + 1], A[i], J[i], env.eps, t_upper)
+    out[i] = np.minimum(p0, p1)
+    return out
+
+
+#: Nodes :func:`reach_nodes` adds on each side of every break at most, spaced
+#: geometrically from :data:`REACH_NODE_FIRST_REL` of the zone to the zone's end; the
+#: zone is :data:`REACH_ZONE_FACTOR` times the distance over which the fastest ramp from
+#: the break reaches the acceleration bound (beyond it the reach and the ``acc`` envelope
+#: differ by a shift that fades; measured on lcnc_sam_tolerance_issue, 40 nodes over 3 mm
+#: and 120 over 20 mm gave the turn programme's bound within 0.06 % of each other).
+REACH_NODES_PER_SIDE = 40
+REACH_NODE_FIRST_REL = 1e-3
+REACH_ZONE_FACTOR = 4.0
+#: Nodes :func:`reach_nodes` adds over the whole path at most (fewer per side on long
+#: programmes; below 4 per side none): the programme's cells grow with them.
+REACH_MAX_NODES = 40_000
+
+
+def reach_nodes(path: Path, env: SegmentEnvelope,
+                max_nodes: int = REACH_MAX_NODES) -> np.ndarray:
+    """Positions near every break where the reach envelope of step 7 bends, mm, sorted
+    (for a grid on which :func:`reach_speed_caps` is sampled; any nodes give a valid
+    bound, these a tighter one). Empty where the budget leaves fewer than 4 per side."""
+    used = env.used[np.isfinite(env.A[env.used]) & np.isfinite(env.J[env.used])]
+    if used.size == 0:
+        return np.zeros(0)
+    per_side = min(REACH_NODES_PER_SIDE, int(max_nodes) // (2 * used.size))
+    if per_side < 4:
+        return np.zeros(0)
+    A, J = env.A[used], env.J[used]
+    sb = path.s_breaks
+    half = 0.5 * (sb[used + 1] - sb[used])
+    out = []
+    for vb, a_s, start, sign in ((env.vb[used], env.a_out[used], sb[used], 1.0),
+                                 (env.vb[used + 1], env.a_in[used + 1], sb[used + 1], -1.0)):
+        t1 = np.maximum(A - np.minimum(a_s, A), 0.0) / J
+        zone = REACH_ZONE_FACTOR * (vb * t1 + a_s * t1 * t1 / 2 + J * t1 ** 3 / 6)
+        zone = np.minimum(zone, half)
+        frac = np.geomspace(REACH_NODE_FIRST_REL, 1.0, per_side)
+        d = zone[:, None] * frac[None, :]
+        out.append((start[:, None] + sign * d)[zone > 0].ravel())
+    pts = np.concatenate(out)
+    return np.unique(pts[(pts > 0) & (pts < path.total_length)])
 
 
 def jerk_lower_bound(path: Path, lim: AxisArrays, t_ipo: float, acc_grid_s: np.ndarray
