@@ -22,7 +22,11 @@ slower than ``T_up`` is not the minimum, so only motions with ``T <= T_up`` need
    on interval ``k``. On each *cell* (a piece of an interval, :func:`_envelope`)
    ``e_hi = sqrt(max phi)`` bounds ``v`` at every point of the cell and
    ``e_lo = sqrt(min phi)`` at *some* point of it (``phi`` is concave, so its least value is
-   at an end of the cell).
+   at an end of the cell). Any node bound valid for every motion the programme is for may
+   lower ``b_hat``: the slopes ``M_k`` hold for every motion of the ``acc`` problem, so
+   ``phi`` stays a bound. Under ``jerk+freq`` these are the jerk set's reach caps
+   (:func:`optimal.jerk.lower.reach_speed_caps`, step 7 there; ``node_caps`` of
+   :func:`humps_piece_bounds`).
 2. *Phase speed.* Let ``w(t) = v(0) + int_0^t s'' 1[in a phase] dt``: the speed with only
    the phases' accelerations. Outside phases ``|s''| <= eta abar``, so
    ``|v - w| <= delta = eta abar T_up``. ``w`` changes only inside phases, so it is

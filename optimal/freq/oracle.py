@@ -16,7 +16,8 @@ Pipeline (``base`` is ``acc`` or ``jerk``):
    (proof there), plus the holds; where the candidates of step 3 leave the bracket open,
    for ``jerk+freq`` the jerk relaxation again with rows of the rule on three segments
    at a time (:mod:`optimal.freq.windows`), and then the turn programme over the whole
-   path (:mod:`optimal.freq.humps`);
+   path (:mod:`optimal.freq.humps`; for ``jerk+freq`` its envelope lowered by the jerk
+   set's reach out of every break, :func:`optimal.jerk.lower.reach_speed_caps`);
 3. upper bound: the fastest of the verified candidates of :mod:`optimal.freq.upper`
    (the base optimum slowed down, the filtered acc optimum, for ``acc+freq`` the acc
    optimum with its rises and falls capped per hump (:mod:`optimal.freq.capped`), the
