@@ -730,17 +730,21 @@ def reach_distance(p: np.ndarray, vb: np.ndarray, alpha: np.ndarray, A: np.ndarr
     ``p <= vb``), vectorised (every argument broadcast to one shape; ``alpha`` in
     mm^2/s^4, ``A`` mm/s^2, ``J`` mm/s^3, speeds mm/s)."""
     ustar = np.maximum((A * A - alpha) / (2.0 * J), 0.0)
-
-    def antiderivative(u):
-        x = np.minimum(u, ustar)
-        w = alpha + 2.0 * J * x
-        w0 = alpha
-        # int_0^x u / sqrt(alpha + 2 J u) du, then u / A above ustar
-        low = ((2.0 / 3.0) * (w ** 1.5 - w0 ** 1.5) - 2.0 * alpha * (np.sqrt(w) - np.sqrt(w0))) \
-            / (4.0 * J * J)
-        return low + np.where(u > ustar, (u * u - ustar * ustar) / (2.0 * A), 0.0)
-
-    return np.maximum(antiderivative(np.maximum(p, vb)) - antiderivative(vb), 0.0)
+    p = np.maximum(p, vb)
+    # written as differences over [vb, p] (not of antiderivatives, whose values near
+    # p^2 / 2A would lose the short distances next to a break to cancellation):
+    # below ustar int u / sqrt(alpha + 2 J u) du with w = alpha + 2 J u,
+    # (w1 - w0) / (sqrt(w1) + sqrt(w0)) ((2/3) (w1 + sqrt(w1 w0) + w0) - 2 alpha) / (4 J^2);
+    # above it int u / A du = (x1 - x0) (x1 + x0) / 2A
+    x0, x1 = np.minimum(vb, ustar), np.minimum(p, ustar)
+    w0, w1 = alpha + 2.0 * J * x0, alpha + 2.0 * J * x1
+    r0, r1 = np.sqrt(w0), np.sqrt(w1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low = np.where(x1 > x0, 2.0 * J * (x1 - x0) / (r1 + r0)
+                       * ((2.0 / 3.0) * (w1 + r1 * r0 + w0) - 2.0 * alpha)
+                       / (4.0 * J * J), 0.0)
+    y0, y1 = np.maximum(vb, ustar), np.maximum(p, ustar)
+    return np.maximum(low, 0.0) + (y1 - y0) * (y1 + y0) / (2.0 * A)
 
 
 def _reach_side(y: np.ndarray, vb: np.ndarray, a_s: np.ndarray, A: np.ndarray,

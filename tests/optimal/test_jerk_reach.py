@@ -129,3 +129,15 @@ def test_ruckig_moves_stay_below_the_caps_of_a_line():
     early = (pos > 0.0) & (pos < 2.0)
     assert np.max(vel[early] / caps[early]) > 0.99
     assert ruckig_line_time(60.0, V, Ap, Jp, a_s) == pytest.approx(traj.duration)
+
+
+def test_fast_break_and_short_distance_keep_the_acc_reach():
+    """A break passed at speed with the whole acceleration available at once (``a_s = A``):
+    the cap is the ``acc`` reach ``sqrt(vb^2 + 2 A y)``, to round-off, even a micrometre
+    from the break at 1 m/s (the distance is not lost to cancellation)."""
+    vb = 1000.0
+    ys = np.array([1e-9, 1e-6, 1e-3, 1.0])
+    caps = _caps(ys, vb, A)
+    ref = np.sqrt(vb * vb + 2 * A * ys)
+    assert np.all(caps >= ref)
+    np.testing.assert_allclose(caps, ref, rtol=REACH_ROUNDOFF_REL + 1e-12)
