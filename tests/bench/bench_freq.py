@@ -29,7 +29,9 @@ starts from), and the jerk solve's time; left out where ``../shared`` is absent.
 it, the peak speed levels of the turn programme on ``lcnc_test_12mmflat.ngc``
 (``acc+freq``): the oracle and its bound with one level and with the default two. After
 it, the search over free phase ends (:mod:`optimal.freq.free_phases`) on the same program
-(``acc+freq``): the oracle's wall time and bracket without it and with it.
+(``acc+freq``): the oracle's wall time and bracket without it and with it; and the jerk
+set's reach caps in the turn programme's envelope (:func:`optimal.jerk.lower.
+reach_speed_caps`) on the same program (``jerk+freq``): without them and with them.
 """
 
 from __future__ import annotations
@@ -95,6 +97,7 @@ def main() -> int:
     peak_levels_row(machine)
     phase_nlp_row(machine)
     free_phases_row(machine)
+    reach_row(machine)
     return 0
 
 
@@ -228,6 +231,27 @@ def free_phases_row(machine) -> None:
     (w0, a), (w1, b) = _without_and_with(freq_oracle, "_free_phase_candidate",
                                          lambda *a, **k: None, path, machine, "acc+freq")
     print(f"{'free ends':>9} sam acc+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}); "
+          f"bracket [{a.lower_bound_s:.4f}, {a.upper_bound_s:.4f}] {a.gap:.2%} -> "
+          f"[{b.lower_bound_s:.4f}, {b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})",
+          flush=True)
+
+
+def reach_row(machine) -> None:
+    """The reach caps' cost and effect on lcnc_sam_tolerance_issue (``jerk+freq``, default
+    gap): the oracle with the turn programme on the ``acc`` grid alone, then as it is."""
+    from shared_inputs import CORPUS, CORPUS_PRESENT, NO_CORPUS
+    import optimal.freq.oracle as freq_oracle
+    from optimal.grid import grid_on
+    from reference.nc import parse_file
+
+    if not CORPUS_PRESENT:
+        print(f"{'reach':>9} skipped: {NO_CORPUS}")
+        return
+    path = build_path(parse_file(CORPUS / "lcnc_sam_tolerance_issue.ngc"), machine)
+    (w0, a), (w1, b) = _without_and_with(
+        freq_oracle, "_reach_grid", lambda work, lim, t_ipo, acc_grid, t: (
+            grid_on(work, acc_grid), None), path, machine, "jerk+freq")
+    print(f"{'reach':>9} sam jerk+freq: oracle {w0:.1f} -> {w1:.1f} s (x{w1 / w0:.2f}); "
           f"bracket [{a.lower_bound_s:.4f}, {a.upper_bound_s:.4f}] {a.gap:.2%} -> "
           f"[{b.lower_bound_s:.4f}, {b.upper_bound_s:.4f}] {b.gap:.2%} ({b.status})",
           flush=True)
