@@ -141,3 +141,33 @@ def test_fast_break_and_short_distance_keep_the_acc_reach():
     ref = np.sqrt(vb * vb + 2 * A * ys)
     assert np.all(caps >= ref)
     np.testing.assert_allclose(caps, ref, rtol=REACH_ROUNDOFF_REL + 1e-12)
+
+
+@pytest.mark.parametrize("L", [5.0, 30.0, 200.0])
+def test_turn_programme_with_the_caps_stays_below_ruckig_on_a_line(L):
+    """The ``jerk+freq`` turn programme with the reach caps (the oracle's grid and caps)
+    on a rest-to-rest line of the default machine's X: never above ruckig's time-optimal
+    move with the path ends' allowance (its two phases last far more than ``1/f``, so it
+    is a motion of the set: an upper reference), and well above the programme on the
+    ``acc`` envelope alone (the caps bind)."""
+    pytest.importorskip("ruckig")
+    import optimal
+    from optimal.freq.humps import humps_piece_bounds
+    from optimal.freq.oracle import _reach_grid
+    from optimal.grid import grid_on
+    from reference.machine import load_machine
+    m = load_machine()
+    path = line_path([[0.0, 0.0, 0.0], [L, 0.0, 0.0]], feed=1000.0)
+    work = path.restricted(path.moving_axes())
+    lim = m.limits.for_axes(work.axes)
+    t_ipo = m.limits.t_ipo_s
+    acc = optimal.solve(path, m.limits, bounds="acc")
+    _, b_break, b_seg = speed_bounds(work, lim, t_ipo, np.asarray(acc.grid))
+    env = segment_envelope(work, lim, t_ipo, b_break, b_seg)
+    t_ref = ruckig_line_time(L, float(env.V[0]), float(env.A[0]), float(env.J[0]),
+                             float(env.a_out[0]))
+    plain = humps_piece_bounds(work, lim, grid_on(work, acc.grid), t_ref).sum()
+    grid, caps = _reach_grid(work, lim, t_ipo, acc.grid, t_ref)
+    capped = humps_piece_bounds(work, lim, grid, t_ref, node_caps=caps).sum()
+    assert capped <= t_ref
+    assert capped >= plain + 0.02 * t_ref
