@@ -405,7 +405,7 @@ def solve_freq(path: Path, limits: MachineLimits, *, solve: Callable[..., object
         if base == "jerk":
             # the jerk set's reach out of every break (optimal.jerk.lower step 7) as
             # node caps of the programme's envelope, on nodes added where it bends;
-            # valid for the motions no slower than t_best, so for both runs below
+            # valid for every motion lasting at most t_best (>= t_up): both runs below
             env_grid, caps = _reach_grid(work, sub_lim, limits.t_ipo_s, acc.grid, t_best)
         per_piece = humps_piece_bounds(work, sub_lim, env_grid, t_up, lb - hold_t,
                                        base_sol.segment_lower_bounds_s, enough=enough,
