@@ -680,8 +680,7 @@ def humps_piece_bounds(path: Path, lim: AxisArrays, grid: Grid, t_upper: float,
     bounds = speed_envelope_bounds(path, lim, grid)
     if node_caps is not None:
         caps = np.asarray(node_caps, dtype=np.float64)
-        b_cap = np.where(np.isfinite(caps), caps * caps, np.inf)
-        bounds = (np.minimum(bounds[0], b_cap),) + tuple(bounds[1:])
+        bounds = (np.minimum(bounds[0], caps * caps),) + tuple(bounds[1:])
     t = _tents(path, lim, grid, bounds)
     drift = FREQ_ACCEL_TOL_REL * t.accel * t_upper
     if not np.any(t.period > 0) or not math.isfinite(drift):

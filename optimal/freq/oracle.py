@@ -86,12 +86,13 @@ ProgressFn = Callable[..., object]
 DEFAULT_FREQ_GAP_TOL = 2e-2
 
 
-def _reach_grid(work: Path, lim, t_ipo: float, acc_grid, t_upper: float):
-    """The ``acc`` grid with the nodes of :func:`optimal.jerk.lower.reach_nodes`, and the
-    reach caps (:func:`optimal.jerk.lower.reach_speed_caps`) at its nodes, mm/s: the
-    ``jerk+freq`` turn programme's envelope (:func:`optimal.freq.humps.humps_piece_bounds`,
+def _reach_grid(work: Path, lim, t_ipo: float, acc_grid: np.ndarray, t_upper: float):
+    """The ``acc`` grid (its nodes, mm) with the nodes of
+    :func:`optimal.jerk.lower.reach_nodes`, and the reach caps
+    (:func:`optimal.jerk.lower.reach_speed_caps`) at its nodes, mm/s: the ``jerk+freq``
+    turn programme's envelope (:func:`optimal.freq.humps.humps_piece_bounds`,
     ``node_caps``)."""
-    acc_s = np.asarray(getattr(acc_grid, "s", acc_grid), dtype=np.float64)
+    acc_s = np.asarray(acc_grid, dtype=np.float64)
     _, b_break, b_seg = speed_bounds(work, lim, t_ipo, acc_s)
     env = segment_envelope(work, lim, t_ipo, b_break, b_seg)
     extra = reach_nodes(work, env)
