@@ -370,28 +370,33 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     v_round = np.full(a.size, np.nan)
     if open_.any():
         o = np.flatnonzero(open_)
+        # the open corners' rows, gathered once (usually every corner: then the arrays
+        # themselves)
+        if o.size == a.size:
+            ao, bo, t1o, t2o, do_, mo = a, b, t1, t2, d, mode_id
+        else:
+            ao, bo, t1o, t2o, do_, mo = a[o], b[o], t1[o], t2[o], d[o], mode_id[o]
         # open corners are not tangential (decided above): the test is not repeated
-        v64[o] = junction_speed_cap(t1[o], t2[o], lim.jump, FEASIBLE, tangential[o])[0]
+        v64[o] = junction_speed_cap(t1o, t2o, lim.jump, FEASIBLE, tangential[o])[0]
         soft = accel_id[ka[o]] == soft_id
         # per line: programmed speed (feed, axis velocities), acceleration, jerk
-        a1, a2 = np.abs(t1[o]), np.abs(t2[o])
+        a1, a2 = np.abs(t1o), np.abs(t2o)
         # the rounding runs at most at the programmed speed; beside it each line at
         # most at its own one-IPO-cycle cap too (:func:`_line_speeds`)
-        v_prog = np.minimum(*_programmed_speeds(path, lim, a[o], b[o], t1[o], t2[o]))
-        v_in, v_out = _line_speeds(path, lim, a[o], b[o], t1[o], t2[o],
-                                   machine.limits.t_ipo_s)
+        p_in, p_out = _programmed_speeds(path, lim, ao, bo, t1o, t2o)
+        v_prog = np.minimum(p_in, p_out)
+        v_in, v_out = _line_speeds(path, ao, bo, p_in, p_out, machine.limits.t_ipo_s)
         with np.errstate(divide="ignore"):
             acc_in = row_min(lim.a_max[None, :] / a1)
             acc_out = row_min(lim.a_max[None, :] / a2)
             j_in = np.where(soft, row_min(lim.j_max[None, :] / a1), np.inf)
             j_out = np.where(soft, row_min(lim.j_max[None, :] / a2), np.inf)
-        v_round[o] = np.minimum(v_prog, _rounding_speed(t1[o], t2[o], theta[o], shape, o,
+        v_round[o] = np.minimum(v_prog, _rounding_speed(t1o, t2o, theta[o], shape, o,
                                                         lim, machine.limits.t_ipo_s, soft))
-        ovl = _is_in(mode_id[o], names, _OVERLOAD_CHECKED) & \
-            (not ch.ignore_ovl_factor_for_adis)
-        always = always_rounds(np.array(names, dtype=_MODE_DTYPE)[mode_id[o]],
+        ovl = _is_in(mo, names, _OVERLOAD_CHECKED) & (not ch.ignore_ovl_factor_for_adis)
+        always = always_rounds(np.array(names, dtype=_MODE_DTYPE)[mo],
                                ch.ignore_ovl_factor_for_adis)
-        radius_mode = _is_in(mode_id[o], names, _RADIUS_MODES)
+        radius_mode = _is_in(mo, names, _RADIUS_MODES)
         sub = np.zeros(a.size, bool)
         sub[o] = ovl & (v64[o] >= np.minimum(v_in, v_out))
         decide(sub, "G64 passes the corner without reduction (overload factor)")
@@ -399,9 +404,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         # holds: an inserted block between two blocks of one IPO cycle each (G643
         # inserts none, a window across short blocks replaces several by one)
         sub[:] = False
-        sub[o] = always & ~_is_in(mode_id[o], names, _INTERNAL) & (first[o] == a[o]) & (
-            last[o] == b[o]) & very_short_blocks(path.length[a[o]], path.length[b[o]],
-                                                  v_prog, machine.limits.t_ipo_s)
+        sub[o] = always & ~_is_in(mo, names, _INTERNAL) & (first[o] == ao) & (
+            last[o] == bo) & very_short_blocks(path.length[ao], path.length[bo], v_prog,
+                                               machine.limits.t_ipo_s)
         decide(sub, "rounding would slow the program down (between two very short blocks)")
         sub[:] = False
         # what the window leaves of the blocks it cuts (the corner's own two, or the
@@ -410,12 +415,12 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
         # is left between the two roundings (5.3), so each is judged with that cap
         # (errs toward a short leftover, as the tangential transitions' estimate)
         sb = path.s_breaks
-        s_c = sb[a[o] + 1]
-        w_lo, w_hi = break_windows(sb, a[o] + 1, d[o], d[o])
-        left_in = np.maximum((s_c - d[o]) - w_hi[first[o]], 0.0)
-        left_out = np.maximum(w_lo[last[o] + 1] - (s_c + d[o]), 0.0)
+        s_c = sb[ao + 1]
+        w_lo, w_hi = break_windows(sb, ao + 1, do_, do_)
+        left_in = np.maximum((s_c - do_) - w_hi[first[o]], 0.0)
+        left_out = np.maximum(w_lo[last[o] + 1] - (s_c + do_), 0.0)
         sub[o] = ~(corner_time_loss(v_in, v_out, v_round[o], acc_in, acc_out, j_in, j_out,
-                                    shape.length[o], d[o], None, left_in, left_out,
+                                    shape.length[o], do_, None, left_in, left_out,
                                     machine.limits.t_ipo_s)
                    < corner_time_loss(v_in, v_out, v64[o], acc_in, acc_out, j_in, j_out,
                                       0.0, 0.0)
@@ -588,14 +593,13 @@ def _programmed_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray
     return v_in, v_out
 
 
-def _line_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
-                 t1: np.ndarray, t2: np.ndarray, t_ipo: float
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def _line_speeds(path: Path, a: np.ndarray, b: np.ndarray, v_in: np.ndarray,
+                 v_out: np.ndarray, t_ipo: float) -> tuple[np.ndarray, np.ndarray]:
     """Speed the segments before and after corners can run at beside the corner, mm/s,
-    shape (k,) each: the programmed speed (:func:`_programmed_speeds`) and at most one
-    segment per IPO cycle, ``L / T_ipo`` (5.3: "every block ... needs at least one
-    interpolation point"; the heuristic caps every segment so,
-    :func:`reference.planner.limit_curves.segment_limits`).
+    shape (k,) each: the programmed speed (``v_in``, ``v_out``:
+    :func:`_programmed_speeds`) and at most one segment per IPO cycle, ``L / T_ipo``
+    (5.3: "every block ... needs at least one interpolation point"; the heuristic caps
+    every segment so, :func:`reference.planner.limit_curves.segment_limits`).
 
     The decision's estimate (:func:`corner_time_loss`) ramps each side between the
     corner speed and this speed and counts the length a rounding replaces at it. With
@@ -608,7 +612,6 @@ def _line_speeds(path: Path, lim: AxisArrays, a: np.ndarray, b: np.ndarray,
     "without a reduction" (4.3) where its corner speed is at least what the blocks run
     at.
     """
-    v_in, v_out = _programmed_speeds(path, lim, a, b, t1, t2)
     return (np.minimum(v_in, path.length[a] / t_ipo),
             np.minimum(v_out, path.length[b] / t_ipo))
 

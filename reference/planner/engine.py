@@ -107,12 +107,14 @@ def _plan_changed(units: Units, v_nodes: np.ndarray, old_units: Units,
                 & (old_v[j] == v_nodes[:-1]) & (old_v[j + 1] == v_nodes[1:]))
     new = np.flatnonzero(~same)
     part = _replan(units, new, v_nodes)
+    if new.size == first.size:
+        return part
+    # every row gathered from its old unit, then the planned ones overwritten: a cuts
+    # pass changes a few units, and a full gather costs less than a masked one
     out = {}
     for f in fields(UnitProfiles):
-        a_old, a_new = getattr(old_prof, f.name), getattr(part, f.name)
-        arr = np.empty((first.size,) + a_old.shape[1:], dtype=a_old.dtype)
-        arr[same] = a_old[j[same]]
-        arr[new] = a_new
+        arr = getattr(old_prof, f.name).take(j, axis=0)
+        arr[new] = getattr(part, f.name)
         out[f.name] = arr
     return UnitProfiles(**out)
 
