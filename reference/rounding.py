@@ -342,8 +342,12 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     # radius) the tangent arc
     theta = deflection_angle(t1, t2)
     g2 = (accel_id[ka] == soft_id) & _is_in(mode_id, names, ROUNDING_MODES)
+    # the clothoid pair's shape factors of the SOFT corners between lines, found once
+    # for the sizing and the shape
+    pair = g2 & is_line
+    d_1, e_1 = _pair_factors(theta, pair)
     d, multi, targets = _distances(path, attrs, machine, a, b, ka, mode_id, t1, t2, theta,
-                                   g2, is_line, decide)
+                                   g2, pair, d_1, e_1, decide)
     # corners next to arcs: decided and sized apart (reference.rounding_arcs), after the
     # mode's parameters were checked above
     arcc = np.flatnonzero(arc_corner & (reason < 0))
@@ -360,7 +364,7 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
     clamped = d > cap
     d = np.minimum(d, cap)
     decide(~(d > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
-    shape = _shape(theta, d, g2, reason < 0)
+    shape = _shape(theta, d, g2, reason < 0, d_1, e_1, pair)
     decide(~(shape.piece > MIN_SEGMENT_LENGTH_MM), "rounding distance too small")
 
     # --- speeds: G64 against rounding (4.3, 5.2 group 2, 5.8) -------------------------
@@ -489,8 +493,9 @@ def round_corners(path: Path, program: Program, machine: Machine) -> Path:
 
 def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np.ndarray,
                b: np.ndarray, ka: np.ndarray, mode: np.ndarray, t1: np.ndarray,
-               t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, lines: np.ndarray,
-               decide) -> tuple[np.ndarray, np.ndarray, dict]:
+               t2: np.ndarray, theta: np.ndarray, g2: np.ndarray, pair: np.ndarray,
+               d_1: np.ndarray, e_1: np.ndarray, decide
+               ) -> tuple[np.ndarray, np.ndarray, dict]:
     """Tangent distance per corner by mode, before the block-length clamp, mm, shape (k,);
     whether the corner's window may reach across short blocks (G642/G645 with a
     tolerance, :data:`_ACROSS_BLOCKS`), bool, shape (k,); and the limits themselves for
@@ -502,8 +507,9 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
     and ``dyn_length`` (G644 2xxx/3xxx, and 0xxx/1xxx as their cap,
     :func:`_dynamic_distance`), mm, ``dyn_cap`` (bool: G644 0xxx/1xxx). ``mode``:
     each corner's mode as an index into ``attrs["mode_names"]``, int, shape (k,);
-    ``lines`` (bool, shape (k,)): the corner lies between two lines (elsewhere the
-    distance is not used, and the clothoid pair's is not computed)."""
+    ``g2`` (bool, shape (k,)): the rounding is a clothoid pair; ``pair`` (bool, shape
+    (k,)): it is, between two lines (elsewhere the distance is not used), where
+    ``d_1``, ``e_1`` (shape (k,)) hold its shape factors (:func:`_pair_factors`)."""
     ch = machine.channel
     sm = ch.smoothing_mode
     k = a.size
@@ -559,9 +565,11 @@ def _distances(path: Path, attrs: dict[str, np.ndarray], machine: Machine, a: np
         decide(is_tol & ~(dev > 0), "rounding not parameterised (tolerance 0)")
         dev0 = np.maximum(dev, 0.0)
         d_dev = np.array(distance_for_deviation(theta, dev0), dtype=np.float64)
-        c = np.flatnonzero(g2 & lines)
+        c = np.flatnonzero(pair)
         if c.size:
-            d_dev[c] = _clothoid_distance(theta[c], dev0[c])
+            # both scale with the piece length: d = deviation d_1 / e_1
+            with np.errstate(divide="ignore", invalid="ignore"):
+                d_dev[c] = dev0[c] * d_1[c] / e_1[c]
         d = np.where(is_tol & (dev > 0), d_dev, d)
     # RND/RNDM: the programmed radius, d = R tan(theta/2)
     d = np.where(how == RADIUS, radius * np.tan(theta / 2.0), d)
@@ -946,8 +954,11 @@ class _Shape:
     sharp: np.ndarray
 
 
-def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) -> _Shape:
-    """Size of the rounding of tangent distance ``d`` at each open corner.
+def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray,
+           d_1: np.ndarray, e_1: np.ndarray, known: np.ndarray) -> _Shape:
+    """Size of the rounding of tangent distance ``d`` at each open corner; ``d_1``,
+    ``e_1`` the clothoid pair's shape factors where ``known`` (:func:`_pair_factors`),
+    found here for the other clothoid pairs.
 
     Tangent arc (``reference.core.rounding``): ``R = d / tan(theta/2)``, length
     ``R theta``, deviation ``d tan(theta/4)``. Clothoid pair
@@ -959,10 +970,11 @@ def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) 
     ok = open_ & (d > 0)
     if not ok.any():                      # no corner to size (e.g. all next to arcs)
         return _Shape(z, z.copy(), z.copy(), z.copy(), z.copy(), z.copy())
-    # the pair's shape where it is one (elementwise: the same numbers as on all rows)
-    d_1, e_1 = np.ones_like(d), np.ones_like(d)
-    c = np.flatnonzero(g2 & ok)           # the other rows read neither
+    # the pair's shape where it is one and not known yet (elementwise: the same numbers
+    # as on all rows; the open corners are not tangential, theta > 0)
+    c = np.flatnonzero(g2 & ok & ~known)  # the other rows read neither
     if c.size:
+        d_1, e_1 = d_1.copy(), e_1.copy()
         d_1[c], e_1[c] = clothoid_pair_shape(theta[c])
     with np.errstate(divide="ignore", invalid="ignore"):
         r_arc = d / np.tan(theta / 2.0)
@@ -976,12 +988,16 @@ def _shape(theta: np.ndarray, d: np.ndarray, g2: np.ndarray, open_: np.ndarray) 
     return _Shape(piece, length, deviation, radius, kappa, sharp)
 
 
-def _clothoid_distance(theta: np.ndarray, deviation: np.ndarray) -> np.ndarray:
-    """Tangent distance whose clothoid pair deviates from the corner by ``deviation``:
-    ``d = deviation d_1(theta) / e_1(theta)`` (both scale with the piece length), mm."""
-    d_1, e_1 = clothoid_pair_shape(np.clip(theta, 1e-300, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return deviation * d_1 / e_1
+def _pair_factors(theta: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The clothoid pair's tangent distance and deviation per unit piece length
+    (:func:`reference.core.geometry.clothoid_pair_shape`) at the corners ``rows`` (bool,
+    shape (k,)), 1 elsewhere, shape (k,) each; ``theta`` clipped above 0 (a tangential
+    corner is sized, then decided as such)."""
+    d_1, e_1 = np.ones_like(theta), np.ones_like(theta)
+    c = np.flatnonzero(rows)
+    if c.size:
+        d_1[c], e_1[c] = clothoid_pair_shape(np.clip(theta[c], 1e-300, None))
+    return d_1, e_1
 
 
 def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _Shape,
@@ -997,7 +1013,9 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _S
     curvature-jump rule at both ends (6.3; a clothoid pair starts and ends with zero
     curvature, as the lines do).
     """
-    kappa, sharp, piece = shape.kappa[o], shape.sharp[o], shape.piece[o]
+    kappa, sharp, piece = shape.kappa, shape.sharp, shape.piece
+    if o.size < kappa.size:                         # (every corner: the arrays themselves)
+        kappa, sharp, piece = kappa[o], sharp[o], piece[o]
     clo = sharp > 0
     normal, rho = _plane_weights(t1, t2)            # plane weight of each axis
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -1008,7 +1026,8 @@ def _rounding_speed(t1: np.ndarray, t2: np.ndarray, theta: np.ndarray, shape: _S
     sel = np.flatnonzero(soft)                      # the SOFT rules, on those corners only
     if sel.size == 0:
         return out
-    kappa, sharp, clo, rho, w = kappa[sel], sharp[sel], clo[sel], rho[sel], w[sel]
+    if sel.size < out.size:                         # (all SOFT: the arrays themselves)
+        kappa, sharp, clo, rho, w = kappa[sel], sharp[sel], clo[sel], rho[sel], w[sel]
     q3 = np.where(clo, np.hypot(kappa * kappa, sharp), kappa * kappa)
     with np.errstate(divide="ignore", invalid="ignore"):
         v_j = row_min(np.where(rho > 0, np.cbrt(JERK_VELOCITY_SHARE * lim.j_max[None, :]
