@@ -184,3 +184,20 @@ def test_infeasible_discrete_problem_is_a_status():
     res = solve_discrete(prob, "fast")
     assert res.status == optimal.SolveStatus.INFEASIBLE
     assert "interval 0" in res.message and res.time_s == float("inf")
+
+
+@pytest.mark.parametrize("problem", PROBLEMS)
+def test_auto_chooses_by_size_alone_not_by_the_process(problem):
+    """``method="auto"`` on a small problem gives the numpy sweep's result bit for bit
+    even once a large problem (or anything else) has loaded the compiled kernel: the two
+    agree to round-off only, and the oracle's NLP stages turned that round-off into a
+    1 % different upper bound depending on what ran before in the process."""
+    import optimal.backends.kernel  # noqa: F401 - loaded, as after a large solve
+    from optimal.backends.fast import sweep
+    from optimal.tolerances import COMPILED_MIN_ROWS
+
+    assert problem.c1.size < COMPILED_MIN_ROWS
+    b_auto, _, how = sweep(problem, method="auto")
+    b_vec, _, how_vec = sweep(problem, method="vectorised")
+    assert how == how_vec and "compiled" not in how
+    np.testing.assert_array_equal(b_auto, b_vec)
