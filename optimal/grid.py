@@ -244,3 +244,34 @@ def grid_on(path: Path, s: np.ndarray) -> Grid:
     s = np.asarray(s, dtype=np.float64)
     seg = path.segment_index(0.5 * (s[:-1] + s[1:]))
     return Grid(s=s, segment=seg, break_node=np.searchsorted(s, path.s_breaks))
+
+
+def with_nodes(s: np.ndarray, new: np.ndarray, min_gap: float) -> np.ndarray:
+    """Nodes ``s`` with the positions ``new`` added where each keeps at least ``min_gap``
+    from every other node: inside ``(s[0], s[-1])``, the first of new ones closer than
+    that to each other, none that close to a node of ``s`` (no vanishing intervals).
+
+    Parameters
+    ----------
+    s : numpy.ndarray, shape (N + 1,)
+        Strictly increasing nodes, mm.
+    new : numpy.ndarray, shape (M,)
+        Positions to add, mm (any order).
+    min_gap : float
+        mm (> 0).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N + 1 + K,)
+        Sorted, strictly increasing, mm.
+    """
+    s = np.asarray(s, dtype=np.float64)
+    new = np.asarray(new, dtype=np.float64)
+    new = np.unique(new[(new > s[0] + min_gap) & (new < s[-1] - min_gap)])
+    if new.size == 0:
+        return s
+    new = new[np.concatenate(([True], np.diff(new) > min_gap))]
+    i = np.searchsorted(s, new)
+    near = np.minimum(np.abs(new - s[np.maximum(i - 1, 0)]),
+                      np.abs(s[np.minimum(i, s.size - 1)] - new))
+    return np.union1d(s, new[near > min_gap])

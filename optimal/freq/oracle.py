@@ -64,7 +64,7 @@ from reference.core.rows import block_motion, block_rows
 
 from ..solution import IterationRecord, OptimalSolution
 from ..status import SolveStatus
-from ..grid import grid_on
+from ..grid import grid_on, with_nodes
 from ..jerk.oracle import jerk_grid
 from ..jerk.lower import reach_nodes, reach_speed_caps, segment_envelope, speed_bounds
 from ..jerk.relaxation import RunFloors
@@ -95,11 +95,8 @@ def _reach_grid(work: Path, lim, t_ipo: float, acc_grid: np.ndarray, t_upper: fl
     acc_s = np.asarray(acc_grid, dtype=np.float64)
     _, b_break, b_seg = speed_bounds(work, lim, t_ipo, acc_s)
     env = segment_envelope(work, lim, t_ipo, b_break, b_seg)
-    extra = reach_nodes(work, env)
-    # not within the segment-length floor of a node there (no vanishing intervals)
-    k = np.clip(np.searchsorted(acc_s, extra), 1, acc_s.size - 1)
-    gap = np.minimum(extra - acc_s[k - 1], acc_s[k] - extra)
-    grid = grid_on(work, np.union1d(acc_s, extra[gap > MIN_SEGMENT_LENGTH_MM]))
+    # none within the segment-length floor of another node (no vanishing intervals)
+    grid = grid_on(work, with_nodes(acc_s, reach_nodes(work, env), MIN_SEGMENT_LENGTH_MM))
     return grid, reach_speed_caps(work, env, grid.s, t_upper)
 
 

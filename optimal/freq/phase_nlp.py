@@ -98,7 +98,7 @@ from reference.core.phases import acceleration_phases, min_phase_duration, phase
 from reference.core.profile import Profile
 from reference.core.tolerances import VEL_TOL_MM_S
 
-from ..grid import Grid, grid_on
+from ..grid import Grid, grid_on, with_nodes
 from ..jerk.tolerances import DEFAULT_JERK_MAX_GRID
 from ..jerk.transcription import JerkProblem, PhaseRows, build_jerk_problem
 from ..jerk.upper import resolved
@@ -293,13 +293,7 @@ def _with_step_nodes(grid_s: np.ndarray, prof: Profile, t_ipo: float) -> np.ndar
     d = np.interp(s_b, prof.s, prof.v) * t_ipo
     new = np.concatenate((s_b, s_b - d, s_b + d))
     # none within the round-off of the positions (1e-9 of the path) of another node
-    tiny = 1e-9 * max(grid_s[-1] - grid_s[0], 1.0)
-    new = np.unique(new[(new > grid_s[0] + tiny) & (new < grid_s[-1] - tiny)])
-    new = new[np.concatenate(([True], np.diff(new) > tiny))]
-    i = np.searchsorted(grid_s, new)
-    near = np.minimum(np.abs(new - grid_s[np.maximum(i - 1, 0)]),
-                      np.abs(grid_s[np.minimum(i, grid_s.size - 1)] - new))
-    return np.union1d(grid_s, new[near > tiny])
+    return with_nodes(grid_s, new, 1e-9 * max(grid_s[-1] - grid_s[0], 1.0))
 
 
 def _same_phases(a: PhaseRows, b: PhaseRows) -> bool:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from optimal.grid import grid_from_counts, subdivide
+from optimal.grid import grid_from_counts, subdivide, with_nodes
 from oracle_cases import line_arc_line
 
 
@@ -82,3 +82,15 @@ def test_refinement_halves_a_spread_gap_and_cuts_a_concentrated_one_finer():
     # the budget bounds the new intervals
     pieces = _refine_marks(path, g, t_lb + 0.01, t_lb, 1.0, None, 5, 0.0)
     assert int((pieces - 1).sum()) <= 5
+
+
+def test_with_nodes_keeps_every_gap_above_the_floor():
+    """Hand case: nodes 0, 1, 2 mm, floor 0.01 mm. Kept: 0.5 and 1.5; dropped: -0.5 and
+    2.0005 (outside), 0.005 and 1.995 (within the floor of an end), 1.004 (of a node),
+    0.503 (of the new 0.5, the first of the two kept), an exact duplicate of 0.5."""
+    s = np.array([0.0, 1.0, 2.0])
+    new = np.array([1.5, 0.503, 0.5, 0.5, -0.5, 2.0005, 0.005, 1.995, 1.004])
+    out = with_nodes(s, new, 0.01)
+    np.testing.assert_array_equal(out, [0.0, 0.5, 1.0, 1.5, 2.0])
+    assert np.all(np.diff(with_nodes(s, np.linspace(0.0, 2.0, 4001), 0.01)) > 0.01)
+    np.testing.assert_array_equal(with_nodes(s, np.zeros(0), 0.01), s)
