@@ -66,7 +66,6 @@ import numpy as np
 from numba import njit, objmode, types
 from numba.extending import get_cython_function_address
 
-from .core.transition import ramp_offset
 from .core.transition_samedir import NEWTON_MAX_ITER as NEWTON_MAX_ITER_SAMEDIR
 from .core.transition_samedir import STEP_HALVINGS, _start
 from .core.transition_sbend import (DEV_SAMPLES, LANDING_TOL_MM, NEWTON_MAX_ITER,
@@ -457,8 +456,11 @@ def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMP
     f64 = np.float64
     total = lengths.sum(axis=1)
     # packed by one compiled loop: numpy's concatenation of the (k, p, 2) strided parts
-    # took about as long as a near search (1.1 ms of 8,000 transitions)
-    packed = _pack(*(np.asarray(v, f64) for v in pieces))
+    # took about as long as a near search (1.1 ms of 8,000 transitions); the same-way
+    # pieces come packed already (samedir_pieces)
+    packed = _packed_of(pieces)
+    if packed is None:
+        packed = _pack(*(np.asarray(v, f64) for v in pieces))
     r_in, r_out, centre_out = (np.ascontiguousarray(v, f64) for v in (r_in, r_out,
                                                                         centre_out))
     use_near = near is not None
@@ -633,61 +635,99 @@ def samedir_newton(r_in, r_out, ramp, rate, off, flat_out):
 
 # ----------------------------------------------------------------- same-way pieces
 @njit(cache=True, nogil=True, error_model="numpy")
-def _samedir_pieces(theta, phi, r_in, r_out, ramp_in, ramp_out, piece, rate, xq1, yq1,
-                    xq2, yq2):  # pragma: no cover - compiled
-    """``transition_samedir._canonical_pieces`` (with ``_ends``) of ``k`` transitions
-    whose ramps start at ``(xq1, yq1)``, ``(xq2, yq2)`` (shape (k,) each): its
-    operations, per transition, in its order (``2 sin^2(b/2)`` as two products, as
-    numpy's ``** 2``)."""
+def _ramp_start(radius: float, length: float, sc: np.ndarray):  # pragma: no cover
+    """:func:`reference.core.transition.ramp_offset`'s start ``(x_q, y_q)`` of one ramp:
+    its operations in its order (``2 R sin^2(psi/2)`` as ``(2 R) (s s)``, as numpy's
+    ``2.0 * radius * s ** 2``); ``sc`` (2,) scratch for the Fresnel integrals."""
+    c = 1.0 / (radius * length)
+    scale = math.sqrt(np.pi / c)
+    _FRESNEL(length / scale, sc[0:].ctypes, sc[1:].ctypes)
+    x_r, y_r = scale * sc[1], scale * sc[0]
+    psi = length / (2.0 * radius)
+    s = math.sin(psi / 2.0)
+    return radius * math.sin(psi) - x_r, 2.0 * radius * (s * s) - y_r
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _samedir_packed(theta, phi, r_in, r_out, ramp_in, ramp_out, piece,
+                    rate):  # pragma: no cover - compiled
+    """``transition_samedir._canonical_pieces`` (with ``_ends`` and the ramps' starts,
+    :func:`_ramp_start`) of ``k`` transitions, written as :func:`_pack` lays them out,
+    shape (k, 4, 9): its operations, per transition, in its order (``2 sin^2(b/2)`` as
+    two products, as numpy's ``** 2``; the pieces' starts as :func:`_pack` sums them)."""
     k = theta.size
-    origin = np.empty((k, 4, 2))
-    e1 = np.empty((k, 4, 2))
-    e2 = np.empty((k, 4, 2))
-    rates = np.empty((k, 4))
-    lengths = np.empty((k, 4))
+    out = np.empty((k, 4, 9))
+    sc = np.empty(2)
     for t in range(k):
         t1, p2 = theta[t], phi[t]
+        r1, r2 = r_in[t], r_out[t]
+        xq1, yq1 = _ramp_start(r1, ramp_in[t], sc)
+        xq2, yq2 = _ramp_start(r2, ramp_out[t], sc)
         b = -t1
         uax, uay = math.cos(b), math.sin(b)
         nax, nay = -uay, uax
         ubx, uby = math.cos(p2), math.sin(p2)
         nbx, nby = -uby, ubx
-        r1, r2 = r_in[t], r_out[t]
         s1 = math.sin(0.5 * t1)
         p1x, p1y = -r1 * math.sin(t1), 2.0 * r1 * (s1 * s1)
         s2 = math.sin(0.5 * p2)
         p2x, p2y = r2 * math.sin(p2), 2.0 * r2 * (s2 * s2)
-        q1x, q1y = p1x - xq1[t] * uax + yq1[t] * nax, p1y - xq1[t] * uay + yq1[t] * nay
-        q2x, q2y = p2x + xq2[t] * ubx + yq2[t] * nbx, p2y + xq2[t] * uby + yq2[t] * nby
-        for j, qx, qy, ux, uy, nx, ny in ((0, q1x, q1y, -uax, -uay, nax, nay),
-                                          (1, q1x, q1y, uax, uay, nax, nay),
-                                          (2, q2x, q2y, -ubx, -uby, nbx, nby),
-                                          (3, q2x, q2y, ubx, uby, nbx, nby)):
-            origin[t, j, 0], origin[t, j, 1] = qx, qy
-            e1[t, j, 0], e1[t, j, 1] = ux, uy
-            e2[t, j, 0], e2[t, j, 1] = nx, ny
+        q1x, q1y = p1x - xq1 * uax + yq1 * nax, p1y - xq1 * uay + yq1 * nay
+        q2x, q2y = p2x + xq2 * ubx + yq2 * nbx, p2y + xq2 * uby + yq2 * nby
         c = rate[t]
-        rates[t, 0] = -1.0 / (r1 * ramp_in[t])
-        rates[t, 1] = c
-        rates[t, 2] = -c
-        rates[t, 3] = 1.0 / (r2 * ramp_out[t])
-        lengths[t, 0] = ramp_in[t]
-        lengths[t, 1] = piece[t]
-        lengths[t, 2] = piece[t]
-        lengths[t, 3] = ramp_out[t]
-    return origin, e1, e2, rates, lengths
+        for j, qx, qy, ux, uy, nx, ny, rj, lj in (
+                (0, q1x, q1y, -uax, -uay, nax, nay, -1.0 / (r1 * ramp_in[t]), ramp_in[t]),
+                (1, q1x, q1y, uax, uay, nax, nay, c, piece[t]),
+                (2, q2x, q2y, -ubx, -uby, nbx, nby, -c, piece[t]),
+                (3, q2x, q2y, ubx, uby, nbx, nby, 1.0 / (r2 * ramp_out[t]), ramp_out[t])):
+            out[t, j, 0], out[t, j, 1] = qx, qy
+            out[t, j, 2], out[t, j, 3] = ux, uy
+            out[t, j, 4], out[t, j, 5] = nx, ny
+            out[t, j, 6], out[t, j, 7] = rj, lj
+        run = 0.0
+        for j in range(4):
+            run = out[t, j, 7] if j == 0 else run + out[t, j, 7]
+            out[t, j, 8] = run - out[t, j, 7]
+    return out
+
+
+def _views(packed: np.ndarray) -> tuple:
+    """The pieces tuple (:func:`reference.core.transition_sbend.pieces_deviation`) as
+    views of a packed array (k, p, 9): origins, ``e1``, ``e2`` (k, p, 2), rates and
+    lengths (k, p)."""
+    return (packed[:, :, 0:2], packed[:, :, 2:4], packed[:, :, 4:6], packed[:, :, 6],
+            packed[:, :, 7])
+
+
+def _packed_of(pieces) -> np.ndarray | None:
+    """The array ``pieces`` are views of (:func:`_views`) where it is packed as
+    :func:`_pack` packs them (its starts column the running sum of the lengths, as
+    there: :func:`samedir_pieces` returns such views), else None (then packed anew)."""
+    base = pieces[0].base
+    if not (isinstance(base, np.ndarray) and base.ndim == 3 and base.shape[2] == 9
+            and base.dtype == np.float64 and base.flags.c_contiguous):
+        return None
+    for v, w in zip(pieces, _views(base)):
+        if not (v.base is base and v.shape == w.shape and v.strides == w.strides
+                and v.ctypes.data == w.ctypes.data):
+            return None
+    lengths = base[:, :, 7]
+    if not np.array_equal(base[:, :, 8], np.cumsum(lengths, axis=1) - lengths):
+        return None
+    return base
 
 
 def samedir_pieces(sh):
     """:func:`reference.core.transition_samedir._canonical_pieces` by the compiled
-    :func:`_samedir_pieces` (the same argument and results, bit for bit; the ramps'
-    starts by :func:`reference.core.transition.ramp_offset`, as there). Why: it builds
-    the pieces of every shape the sizing measures, some thirty numpy operations on
-    (k, 2) rows and five stacks each time (measured on 8,000 same-way transitions:
-    2.4 ms a call, 0.7 ms compiled, most of it the two ``ramp_offset``)."""
-    xq1, yq1, _, _ = ramp_offset(sh.r_in, sh.ramp_in)
-    xq2, yq2, _, _ = ramp_offset(sh.r_out, sh.ramp_out)
+    :func:`_samedir_packed` (the same argument and results, bit for bit), as views of
+    the packed array the compiled search measures (:func:`deviation_where` takes it as
+    it is). Why: it builds the pieces of every shape the sizing measures, some thirty
+    numpy operations on (k, 2) rows, five stacks and the two ramps' starts
+    (``ramp_offset``) each time (measured on 8,000 same-way transitions: 2.4 ms a call,
+    0.7 ms compiled, most of it the two ``ramp_offset``); built packed, the search's
+    packing of the five arrays (:func:`_pack`, 0.35 ms a call of 8,000 transitions) and
+    numpy's two ``ramp_offset`` (0.3 ms) are not needed either."""
     f64 = np.float64
-    return _samedir_pieces(*(np.ascontiguousarray(v, f64) for v in (
-        sh.theta, sh.phi, sh.r_in, sh.r_out, sh.ramp_in, sh.ramp_out, sh.piece, sh.rate,
-        xq1, yq1, xq2, yq2)))
+    return _views(_samedir_packed(*(np.ascontiguousarray(v, f64) for v in (
+        sh.theta, sh.phi, sh.r_in, sh.r_out, sh.ramp_in, sh.ramp_out, sh.piece,
+        sh.rate))))

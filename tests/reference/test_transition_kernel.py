@@ -118,6 +118,42 @@ def test_compiled_pieces_equal_the_vectorised_pieces(seed):
     _same(samedir._canonical_pieces(sh), samedir_pieces(sh))
 
 
+@pytest.mark.parametrize("seed", range(2))
+def test_search_of_packed_pieces_equals_the_vectorised_search(seed):
+    """The compiled pieces come packed, as views the compiled search measures as they
+    are: its results on them equal the vectorised search's on the vectorised pieces
+    (full, coarse and ``near``), and a tuple of other arrays (here copies of those
+    views, and views of a packed array whose starts were not filled by the pieces) is
+    packed anew, not taken for the one it looks like."""
+    from reference.transition_kernel import _packed_of, _views
+    rng = np.random.default_rng(10 + seed)
+    n = 300
+    r1 = rng.uniform(2.0, 200.0, n)
+    r2 = r1 * np.exp(rng.uniform(-3.0, 3.0, n))
+    rate = np.exp(rng.uniform(np.log(3.0), np.log(3000.0), n)) / np.minimum(r1, r2) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sh = samedir.samedir_shape(r1, r2, rate, deviation=False)
+    sh = sbend.take(sh, np.flatnonzero(np.isfinite(sh.theta)))
+    views = samedir_pieces(sh)
+    assert _packed_of(views) is views[0].base
+    copies = tuple(np.array(v) for v in views)
+    assert _packed_of(copies) is None
+    assert _packed_of(views[:4] + (copies[4],)) is None
+    numpy_pieces = samedir._canonical_pieces(sh)
+    total = numpy_pieces[4].sum(axis=1)
+    for kw in ({}, {"samples": sbend.LOCATE_SAMPLES, "scan": 0},
+               {"near": 0.4 * total}):
+        want = sbend._deviation_where(numpy_pieces, sh.r_in, sh.r_out, sh.r_out, **kw)
+        _same(want, deviation_where(views, sh.r_in, sh.r_out, sh.r_out, **kw))
+        _same(want, deviation_where(copies, sh.r_in, sh.r_out, sh.r_out, **kw))
+    # views of an array of the same layout whose starts are not the running sum of
+    # its lengths are not taken as packed (the search would measure wrong pieces)
+    other = rng.uniform(1.0, 2.0, views[0].base.shape)
+    assert _packed_of(_views(other)) is None
+    other[:, :, 8] = np.cumsum(other[:, :, 7], axis=1) - other[:, :, 7]
+    assert _packed_of(_views(other)) is other
+
+
 def _machine():
     """The default machine with PATH_TRANS_POS_TOL = 0.05 mm (most transitions rounded,
     as in the benchmark)."""
