@@ -253,21 +253,33 @@ def _solve(r_in, r_out, ramp, rate, off, first=None, newton=None):
     t1, p2 = newton(r_in, r_out, ramp, rate, off, first)
     lost = np.flatnonzero(np.isnan(t1))
     if lost.size:
-        sel = (r_in[lost], r_out[lost], ramp[lost], rate[lost], tuple(o[lost] for o in off))
+        sel = (r_in[lost], r_out[lost], ramp[lost], rate[lost],
+               None if off is None else tuple(o[lost] for o in off))
         t1[lost], p2[lost] = newton(*sel, ~first[lost])
     return t1, p2
+
+
+def _ramp_starts(r_in, r_out, ramp) -> tuple:
+    """The two ramps' zero-curvature ends in their arcs' frames, ``(x_q1, y_q1, x_q2,
+    y_q2)`` (:func:`reference.core.transition.ramp_offset`, shape (k,) each, mm): the
+    ``off`` of :func:`_newton` and :func:`_landing`."""
+    xq1, yq1, _, _ = ramp_offset(r_in, ramp)
+    xq2, yq2, _, _ = ramp_offset(r_out, ramp)
+    return xq1, yq1, xq2, yq2
 
 
 def _newton(r_in, r_out, ramp, rate, off, flat_out):
     """Newton's method on the landing from the small-angle start with the pair on the
     second arc where ``flat_out`` (on the first elsewhere): ``theta1, phi2`` (nan where
-    it does not converge).
+    it does not converge). ``off``: the ramps' starts (:func:`_ramp_starts`), or None
+    (then found here from ``ramp``: another implementation finds them its own way).
 
     Each transition's iterates are those it would have alone: the arrays of the ones
     still iterating are compacted whenever some stop (the per-iteration cost is then
     that of the few that wander, up to :data:`NEWTON_MAX_ITER` steps, where the pair on
     the flatter arc has no landing), and a transition's verdict is the test of the
     miss at its last iterate (the one it stopped at, or after the last step)."""
+    off = _ramp_starts(r_in, r_out, ramp) if off is None else off
     t1, p2 = _start(r_in, r_out, ramp, rate, flat_out)
     lands = np.zeros(t1.shape, bool)
     act = np.arange(t1.size)
@@ -363,11 +375,10 @@ def samedir_shape(r_in: np.ndarray, r_out: np.ndarray, rate: np.ndarray,
     """
     r_in, r_out, rate = (np.asarray(v, dtype=np.float64) for v in (r_in, r_out, rate))
     ramp = 1.0 / (np.minimum(r_in, r_out) * rate)
-    xq1, yq1, _, _ = ramp_offset(r_in, ramp)
-    xq2, yq2, _, _ = ramp_offset(r_out, ramp)
     first = None if like is None else np.where(np.isfinite(like.theta), _on_second(like),
                                                 r_out > r_in)
-    t1, p2 = _solve(r_in, r_out, ramp, rate, (xq1, yq1, xq2, yq2), first, newton)
+    # the ramps' starts found by the Newton implementation (the compiled one's own)
+    t1, p2 = _solve(r_in, r_out, ramp, rate, None, first, newton)
     sh = _shaped(r_in, r_out, rate, ramp, t1, p2)
     return samedir_measured(sh) if deviation else sh
 
@@ -406,9 +417,7 @@ def samedir_canonical(sh: SameDirShape, newton=None) -> SameDirShape:
     if not sharp.size:
         return sh
     r1, r2, c, ramp = sh.r_in[sharp], sh.r_out[sharp], sh.rate[sharp], sh.ramp_in[sharp]
-    xq1, yq1, _, _ = ramp_offset(r1, ramp)
-    xq2, yq2, _, _ = ramp_offset(r2, ramp)
-    t1, p2 = (newton or _newton)(r1, r2, ramp, c, (xq1, yq1, xq2, yq2), r2 > r1)
+    t1, p2 = (newton or _newton)(r1, r2, ramp, c, None, r2 > r1)
     lands = np.flatnonzero(np.isfinite(t1))
     if not lands.size:
         return sh

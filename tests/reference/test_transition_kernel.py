@@ -101,6 +101,25 @@ def test_compiled_landing_equals_the_vectorised_landing(seed):
         got = samedir_newton(r1, r2, ramp, rate, off, side)
         _same(want, got)
         assert np.isnan(want[0]).any() and np.isfinite(want[0]).any()
+        # without the ramps' starts each finds them its own way (the compiled one by
+        # its own loop): the same landings
+        with np.errstate(invalid="ignore", divide="ignore"):
+            _same(want, samedir._newton(r1, r2, ramp, rate, None, side))
+        _same(want, samedir_newton(r1, r2, ramp, rate, None, side))
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_compiled_ramp_starts_equal_ramp_offset(seed):
+    """The compiled ramps' starts are ``ramp_offset``'s, bit for bit, from gentle ramps
+    (``L/R`` 1e-4) to ramps turning more than a radian."""
+    from reference.transition_kernel import _ramp_starts
+    rng = np.random.default_rng(20 + seed)
+    n = 2000
+    r1 = rng.uniform(0.5, 500.0, n)
+    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, n))
+    ramp = np.minimum(r1, r2) * np.exp(rng.uniform(np.log(1e-4), np.log(3.0), n))
+    want = (*ramp_offset(r1, ramp)[:2], *ramp_offset(r2, ramp)[:2])
+    _same(want, _ramp_starts(r1, r2, ramp))
 
 
 @pytest.mark.parametrize("seed", range(3))
