@@ -122,17 +122,21 @@ def test_compiled_ramp_starts_equal_ramp_offset(seed):
     _same(want, _ramp_starts(r1, r2, ramp))
 
 
+def _samedir_shapes(rng, n: int, log_ratio: float, rate_lo: float):
+    """Same-way shapes of ``n`` random transitions: radii 2..200 mm, ratios up to
+    ``e^log_ratio`` either way, rates ``rate_lo..3000 / min(R)^2``."""
+    r1 = rng.uniform(2.0, 200.0, n)
+    r2 = r1 * np.exp(rng.uniform(-log_ratio, log_ratio, n))
+    rate = np.exp(rng.uniform(np.log(rate_lo), np.log(3000.0), n)) / np.minimum(r1, r2) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return samedir.samedir_shape(r1, r2, rate, deviation=False)
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_compiled_pieces_equal_the_vectorised_pieces(seed):
     """The same-way pieces of random transitions, those that land and those that do
     not (``theta`` nan: every number nan where the vectorised ones are)."""
-    rng = np.random.default_rng(seed)
-    n = 400
-    r1 = rng.uniform(2.0, 200.0, n)
-    r2 = r1 * np.exp(rng.uniform(-3.5, 3.5, n))
-    rate = np.exp(rng.uniform(np.log(2.0), np.log(3000.0), n)) / np.minimum(r1, r2) ** 2
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sh = samedir.samedir_shape(r1, r2, rate, deviation=False)
+    sh = _samedir_shapes(np.random.default_rng(seed), 400, 3.5, 2.0)
     assert np.isnan(sh.theta).any() and np.isfinite(sh.theta).any()
     _same(samedir._canonical_pieces(sh), samedir_pieces(sh))
 
@@ -146,12 +150,7 @@ def test_search_of_packed_pieces_equals_the_vectorised_search(seed):
     packed anew, not taken for the one it looks like."""
     from reference.transition_kernel import _packed_of, _views
     rng = np.random.default_rng(10 + seed)
-    n = 300
-    r1 = rng.uniform(2.0, 200.0, n)
-    r2 = r1 * np.exp(rng.uniform(-3.0, 3.0, n))
-    rate = np.exp(rng.uniform(np.log(3.0), np.log(3000.0), n)) / np.minimum(r1, r2) ** 2
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sh = samedir.samedir_shape(r1, r2, rate, deviation=False)
+    sh = _samedir_shapes(rng, 300, 3.0, 3.0)
     sh = sbend.take(sh, np.flatnonzero(np.isfinite(sh.theta)))
     views = samedir_pieces(sh)
     assert _packed_of(views) is views[0].base
