@@ -428,22 +428,31 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _fill_starts(out: np.ndarray, t: int) -> None:  # pragma: no cover - compiled
+    """Column 8 of transition ``t`` of a packed array: each piece's start, the running
+    sum of the lengths (column 7), piece by piece as ``numpy.cumsum``, less the piece's
+    own length (as ``transition_sbend._packed``)."""
+    run = 0.0
+    for j in range(out.shape[1]):
+        length = out[t, j, 7]
+        run = length if j == 0 else run + length
+        out[t, j, 8] = run - length
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def _pack(origin, e1, e2, rates, lengths):  # pragma: no cover - compiled
     """``transition_sbend._packed`` of the pieces (the starts as there: the running sum
     of the lengths, piece by piece as ``numpy.cumsum``, less the piece's own length)."""
     k, p = lengths.shape
     out = np.empty((k, p, 9))
     for t in range(k):
-        run = 0.0
         for j in range(p):
             out[t, j, 0], out[t, j, 1] = origin[t, j, 0], origin[t, j, 1]
             out[t, j, 2], out[t, j, 3] = e1[t, j, 0], e1[t, j, 1]
             out[t, j, 4], out[t, j, 5] = e2[t, j, 0], e2[t, j, 1]
             out[t, j, 6] = rates[t, j]
-            length = lengths[t, j]
-            out[t, j, 7] = length
-            run = length if j == 0 else run + length
-            out[t, j, 8] = run - length
+            out[t, j, 7] = lengths[t, j]
+        _fill_starts(out, t)
     return out
 
 
@@ -672,7 +681,8 @@ def _samedir_packed(theta, phi, r_in, r_out, ramp_in, ramp_out, piece,
     """``transition_samedir._canonical_pieces`` (with ``_ends`` and the ramps' starts,
     :func:`_ramp_start`) of ``k`` transitions, written as :func:`_pack` lays them out,
     shape (k, 4, 9): its operations, per transition, in its order (``2 sin^2(b/2)`` as
-    two products, as numpy's ``** 2``; the pieces' starts as :func:`_pack` sums them)."""
+    two products, as numpy's ``** 2``; the pieces' starts by :func:`_fill_starts`, as
+    :func:`_pack`)."""
     k = theta.size
     out = np.empty((k, 4, 9))
     sc = np.empty(2)
@@ -702,10 +712,7 @@ def _samedir_packed(theta, phi, r_in, r_out, ramp_in, ramp_out, piece,
             out[t, j, 2], out[t, j, 3] = ux, uy
             out[t, j, 4], out[t, j, 5] = nx, ny
             out[t, j, 6], out[t, j, 7] = rj, lj
-        run = 0.0
-        for j in range(4):
-            run = out[t, j, 7] if j == 0 else run + out[t, j, 7]
-            out[t, j, 8] = run - out[t, j, 7]
+        _fill_starts(out, t)
     return out
 
 
