@@ -259,12 +259,13 @@ def _solve(r_in, r_out, ramp, rate, off, first=None, newton=None):
     return t1, p2
 
 
-def _ramp_starts(r_in, r_out, ramp) -> tuple:
+def _ramp_starts(r_in, r_out, ramp, ramp_out=None) -> tuple:
     """The two ramps' zero-curvature ends in their arcs' frames, ``(x_q1, y_q1, x_q2,
     y_q2)`` (:func:`reference.core.transition.ramp_offset`, shape (k,) each, mm): the
-    ``off`` of :func:`_newton` and :func:`_landing`."""
+    ``off`` of :func:`_newton` and :func:`_landing`, and the pieces' ends. ``ramp`` the
+    ramps' length (``ramp_out`` the second's, where given), mm."""
     xq1, yq1, _, _ = ramp_offset(r_in, ramp)
-    xq2, yq2, _, _ = ramp_offset(r_out, ramp)
+    xq2, yq2, _, _ = ramp_offset(r_out, ramp if ramp_out is None else ramp_out)
     return xq1, yq1, xq2, yq2
 
 
@@ -445,10 +446,9 @@ def samedir_measured(sh: SameDirShape, search=None, pieces=None) -> SameDirShape
 def _canonical_pieces(sh: SameDirShape):
     """Zero-curvature ends, ``e1``, ``e2`` (shape (k, 4, 2) each), signed rates and
     lengths (shape (k, 4)) of the four pieces in the canonical frame."""
-    xq1, yq1, _, _ = ramp_offset(sh.r_in, sh.ramp_in)
-    xq2, yq2, _, _ = ramp_offset(sh.r_out, sh.ramp_out)
     q1, q2, ua, na, ub, nb, _, _ = _ends(sh.theta, sh.phi, sh.r_in, sh.r_out,
-                                         (xq1, yq1, xq2, yq2))
+                                         _ramp_starts(sh.r_in, sh.r_out, sh.ramp_in,
+                                                      sh.ramp_out))
     # e1 points to growing sigma from each piece's zero-curvature end, e2 to the side it
     # bends towards (every piece bends towards the arcs' centres)
     pts = [q1, q1, q2, q2]
