@@ -134,6 +134,46 @@ def test_the_deviation_is_path_trans_pos_tol(r1, r2, tol):
     assert dev >= tol * (1 - 1e-5)
 
 
+@pytest.mark.parametrize("compiled", [False, True])
+def test_the_full_search_without_a_scan_finds_the_largest_distance(compiled):
+    """The full deviation search of these transitions has no scan rounds
+    (``transition_samedir.SCAN_ROUNDS``): its samples' best lies within a sample spacing
+    of the largest distance. Checked against dense points (4001 a piece, the pieces'
+    own point model, the distance by hand geometry) on random transitions at the sized
+    rate and at three times it (where the block-length clamp measures): the search is
+    never below the largest dense point (1e-12 relative: round-off of the distance) and
+    above it by no more than the dense spacing allows."""
+    from reference.core.transition_samedir import SCAN_ROUNDS, _canonical_pieces
+    from reference.core.transition_sbend import _on_pieces, _packed, take
+    from reference.transition_kernel import deviation_where
+    assert SCAN_ROUNDS == 0
+    rng = np.random.default_rng(29)
+    n = 300
+    r1 = np.exp(rng.uniform(-1.0, 7.5, n))
+    r2 = np.exp(rng.uniform(-1.0, 7.5, n))
+    tol = np.exp(rng.uniform(np.log(1e-4), np.log(0.1), n))
+    sized = samedir_for_deviation(r1, r2, tol)
+    search = deviation_where if compiled else None
+    for factor in (1.0, 3.0):
+        sh = samedir_measured(samedir_shape(sized.r_in, sized.r_out, factor * sized.rate,
+                                            deviation=False), search)
+        ok = np.flatnonzero(np.isfinite(sh.theta))
+        assert ok.size >= 0.95 * n
+        sh = take(sh, ok)
+        packed = _packed(_canonical_pieces(sh))
+        frac = np.linspace(0.0, 1.0, 4001)
+        starts, lengths = packed[:, :, 8], packed[:, :, 7]
+        s = (starts[:, :, None] + lengths[:, :, None] * frac).reshape(ok.size, -1)
+        xy = _on_pieces(packed, s, derivatives=False)
+        x, y = xy[..., 0], xy[..., 1]
+        # from the first arc before the normal at J, the second after (the centres
+        # (0, R1), (0, R2)); |q|^2 - R^2 over |q| + R, free of hypot - R's R eps
+        r = np.where(x <= 0, sh.r_in[:, None], sh.r_out[:, None])
+        dense = (np.abs(x * x + y * (y - 2.0 * r)) / (np.hypot(x, y - r) + r)).max(axis=1)
+        assert (sh.deviation >= dense * (1.0 - 1e-12)).all()
+        assert (sh.deviation <= dense * (1.0 + 1e-6)).all()
+
+
 @pytest.mark.parametrize("r1, r2, tol", CASES[:4])
 def test_the_curvature_leaves_the_interval_and_the_pair_sits_on_the_flatter_arc(r1, r2,
                                                                               tol):
