@@ -318,8 +318,8 @@ def tangential_transitions(path: Path, machine: Machine, a: np.ndarray, ka: np.n
                                   pieces=pieces),
                  partial(samedir_shape, newton=newton),
                  partial(samedir_measured, search=search, pieces=pieces),
-                 partial(samedir_canonical, newton=newton), samedir_rows,
-                 SAMEDIR_PIECES)):
+                 partial(samedir_canonical, newton=newton),
+                 partial(samedir_rows, pieces=pieces), SAMEDIR_PIECES)):
             sel = kind[o]
             at = o[sel]
             if not at.size:

@@ -532,12 +532,13 @@ def _samedir_table() -> tuple[np.ndarray, np.ndarray]:
 
 
 def samedir_rows(junction: np.ndarray, along: np.ndarray, inward: np.ndarray,
-                 sh: SameDirShape, block: np.ndarray, kind_code: int
+                 sh: SameDirShape, block: np.ndarray, kind_code: int, pieces=None
                  ) -> dict[str, np.ndarray]:
     """Packed rows of the transitions, :data:`SAMEDIR_PIECES` per transition in path
     order (:func:`reference.core.transition_sbend.pieces_rows`; ``inward`` towards the
-    arcs' centres)."""
-    return pieces_rows(_canonical_pieces(sh), junction, along, inward, block, kind_code)
+    arcs' centres); ``pieces`` as for :func:`samedir_for_deviation`."""
+    return pieces_rows((pieces or _canonical_pieces)(sh), junction, along, inward, block,
+                       kind_code)
 
 
 __all__ = ["SAMEDIR_PIECES", "SameDirShape", "samedir_canonical", "samedir_for_deviation",
