@@ -116,9 +116,10 @@ STEP_HALVINGS = 8
 #: (300 samples a piece, 3 scan rounds) on 20,000 random transitions (radii e^-1 ..
 #: e^7.5 mm, tolerances 1e-4 .. 0.1 mm) at the sized rate and at 1.5 to 100 times it:
 #: the search without the scan and with two rounds find the same deviation to 2.6e-15
-#: relative, both below the dense one in the same single transition at 10 and 100
-#: times the rate (by 1.2e-4 and 1.6e-4), in none at the rates the sizing measures
-#: (``tests/reference/test_rounding_samedir.py`` keeps the comparison). Without it the
+#: relative; both are below the dense one in the same single transition at 10 and 100
+#: times the rate (by 1.2e-4 and 1.6e-4), in none at 1, 1.5 and 3 times it
+#: (``tests/reference/test_rounding_samedir.py`` keeps the comparison against dense
+#: points at 1 and 3 times). Without it the
 #: full search of the same-way row of ``tests/bench/bench_rounding.py`` takes 1.7
 #: instead of 2.4 us a transition (8,000 searches a build).
 SCAN_ROUNDS = 0

@@ -1032,10 +1032,10 @@ def size_for_deviation(shape_of, pieces_of, centre_out: np.ndarray, r_in: np.nda
     done = np.zeros(k, bool)                 # accepted by the full search at its rate
 
     def check(i):
-        """The full search at the shapes of transitions ``i`` (made the model's): those
-        within half the margin are done; the trim of the others' exceeds its cap (left to
-        the caller, ``early``), or the measure is the next point of their steps (where
-        the full search found the maximum, which the steps then follow)."""
+        """The full search at the shapes of transitions ``i`` (made the model's), except
+        where a trim exceeds its cap (those are left to the caller, ``early``): those
+        within half the margin are done; for the others the measure is the next point
+        of their steps, which then follow the maximum the full search found."""
         nonlocal sh
         part = take(sh, i)
         if canonical is not None:
