@@ -70,7 +70,7 @@ from .core.transition_samedir import NEWTON_MAX_ITER as NEWTON_MAX_ITER_SAMEDIR
 from .core.transition_samedir import STEP_HALVINGS, _start
 from .core.transition_sbend import (DEV_SAMPLES, LANDING_TOL_MM, NEWTON_MAX_ITER,
                                     NEWTON_STEP_TOL, REFINE_POINTS, REFINE_SHRINK,
-                                    SCAN_ROUNDS, THETA_MAX, _refine_sampled)
+                                    SCAN_ROUNDS, THETA_MAX, _refine_sampled, larger_side)
 
 # scipy's Fresnel integrals for one double (S, C by pointer), the C function behind
 # scipy.special.fresnel, called by its symbol name (a ctypes pointer would be a constant
@@ -145,6 +145,15 @@ def _distance(x: float, y: float, first: bool, r_in: float, r_out: float,
     r = r_in if first else r_out
     qy = y - yc
     return abs(x * x + y * (y - 2.0 * yc)) / (math.sqrt(x * x + qy * qy) + r)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _on_side(d: float, x: float, side: int) -> float:  # pragma: no cover - compiled
+    """``transition_sbend._on_side`` of one point."""
+    if side == 0:
+        return d
+    keep = (x <= 0) if side == 1 else (x > 0)
+    return d if keep else -np.inf
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -280,7 +289,8 @@ def _crossing(packed, rows, a, b, xa, xb):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, error_model="numpy")
 def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
            centre_out: np.ndarray, near: np.ndarray, use_near: bool, samples: int,
-           scan: int, lin: np.ndarray, off: np.ndarray):  # pragma: no cover - compiled
+           scan: int, lin: np.ndarray, off: np.ndarray,
+           side: int):  # pragma: no cover - compiled
     """The search of ``_deviation_where`` up to its fallback refinement.
 
     Parameters
@@ -299,6 +309,9 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
         ``numpy.linspace(0, 1, samples + 1)``.
     off : numpy.ndarray, shape (REFINE_POINTS,)
         The scan's offsets, in units of its half width.
+    side : int
+        The samples and scan points taken: 1 those with ``x <= 0``, 2 ``x > 0``, 0 all
+        (``transition_sbend._on_side``).
 
     Returns
     -------
@@ -342,8 +355,8 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
                     fc, fs = scale * sc[1], scale * sc[0]
                     x = packed[t, j, 0] + fc * packed[t, j, 2] + fs * packed[t, j, 4]
                     y = packed[t, j, 1] + fc * packed[t, j, 3] + fs * packed[t, j, 5]
-                    dev[j * n1 + i] = _distance(x, y, x <= 0, r_in[t], r_out[t],
-                                                centre_out[t])
+                    dev[j * n1 + i] = _on_side(_distance(x, y, x <= 0, r_in[t],
+                                                         r_out[t], centre_out[t]), x, side)
                     sv[j * n1 + i] = st + s_local
             i = _argmax(dev)
             best[t], at[t] = dev[i], sv[i]
@@ -354,8 +367,8 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
                     xq = _clip(at[t] + h[t] * off[q], 0.0, total[t])
                     _point(packed, t, xq, sc, buf, False)
                     xs[q] = xq
-                    d[q] = _distance(buf[0], buf[1], buf[0] <= 0, r_in[t], r_out[t],
-                                     centre_out[t])
+                    d[q] = _on_side(_distance(buf[0], buf[1], buf[0] <= 0, r_in[t],
+                                              r_out[t], centre_out[t]), buf[0], side)
                 j = _argmax(d)
                 if d[j] > best[t]:
                     best[t], at[t] = d[j], xs[j]
@@ -457,9 +470,15 @@ def _pack(origin, e1, e2, rates, lengths):  # pragma: no cover - compiled
 
 
 def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
-                    scan=SCAN_ROUNDS):
+                    scan=SCAN_ROUNDS, side=0):
     """:func:`reference.core.transition_sbend._deviation_where` by the compiled
-    :func:`search` (the same arguments and results, bit for bit)."""
+    :func:`search` (the same arguments and results, bit for bit; the full search with
+    scan rounds once on each side, combined by the same :func:`~reference.core.
+    transition_sbend.larger_side`)."""
+    if near is None and scan > 0 and side == 0:
+        return larger_side(*(deviation_where(pieces, r_in, r_out, centre_out,
+                                             samples=samples, scan=scan, side=sd)
+                             for sd in (1, 2)))
     lengths = pieces[4]
     k = lengths.shape[0]
     f64 = np.float64
@@ -477,7 +496,8 @@ def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMP
     off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
     best, where, at, h0, win_lo, win_hi, ok = search(
         packed, np.ascontiguousarray(total, f64), r_in, r_out, centre_out, near_arr,
-        use_near, int(samples), int(scan), np.linspace(0.0, 1.0, int(samples) + 1), off)
+        use_near, int(samples), int(scan), np.linspace(0.0, 1.0, int(samples) + 1), off,
+        int(side))
     if not ok.all():
         rest = np.flatnonzero(~ok)
         best[rest] = np.maximum(best[rest], _refine_sampled(

@@ -630,7 +630,7 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
 
 
 def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
-                     scan=SCAN_ROUNDS):
+                     scan=SCAN_ROUNDS, side=0):
     """:func:`pieces_deviation` and where the largest distance was found (distance from
     the rounding's start, mm), shape (k,) each.
 
@@ -647,8 +647,23 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
     cost. It is the largest distance only where no other local maximum is higher, which
     the sizing checks by a full search at its answer.
 
+    The full search with scan rounds is run once on each side of the normal at ``J``
+    (``side`` 1: the samples and scan points with ``x <= 0``, measured from the first
+    circle; 2: ``x > 0``; 0: both, :func:`larger_side` of the two) and the larger taken:
+    where the circle the distance is measured from changes, the distance has a sharp
+    peak, and a smooth maximum just beyond it on the other side can be higher by less
+    than the scan points miss it by, which the scan then never refines (measured: an
+    S-bend of 20,000 random ones, R1 13.856 mm, R2 8.986 mm, tolerance 3.1795e-4 mm, its
+    largest distance 0.0023 mm past the crossing, 8.6e-11 mm above the peak at the
+    crossing the search took: the sizing's answer was 2.7e-7 relative above the
+    tolerance).
+
     Returns the deviation, where it was found and whether that lies inside the last
     window (a maximum at its end lies beyond it, which a search ``near`` misses)."""
+    if near is None and scan > 0 and side == 0:
+        return larger_side(*(_deviation_where(pieces, r_in, r_out, centre_out,
+                                              samples=samples, scan=scan, side=sd)
+                             for sd in (1, 2)))
     lengths = pieces[4]
     k, n_pieces = lengths.shape
     rows = np.arange(k)
@@ -656,7 +671,7 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
     packed = _packed(pieces)
     if near is None:
         s, sx, sy = _samples(pieces, samples)
-        dev = _distance(sx, sy, r_in, r_out, centre_out)
+        dev = _on_side(_distance(sx, sy, r_in, r_out, centre_out), sx, side)
         i = dev.argmax(axis=1)
         best, at = dev[rows, i], s[rows, i]
         h0 = lengths[rows, np.minimum(i // (samples + 1), n_pieces - 1)] / samples
@@ -665,7 +680,8 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
         for _ in range(scan):
             x = np.clip(at[:, None] + h[:, None] * off[None, :], 0.0, total[:, None])
             p = _on_pieces(packed, x, derivatives=False)
-            d = _distance(p[..., 0], p[..., 1], r_in, r_out, centre_out)
+            d = _on_side(_distance(p[..., 0], p[..., 1], r_in, r_out, centre_out),
+                         p[..., 0], side)
             j = d.argmax(axis=1)
             better = d[rows, j] > best
             best = np.where(better, d[rows, j], best)
@@ -707,6 +723,24 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
             packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
             centre_out[rest]))
     return best, where, (where > win_lo) & (where < win_hi)
+
+
+def _on_side(d: np.ndarray, x: np.ndarray, side: int) -> np.ndarray:
+    """The distances ``d`` of points with canonical ``x`` on ``side`` of the normal at
+    ``J`` (:func:`_deviation_where`: 1 ``x <= 0``, 2 ``x > 0``, 0 all), ``-inf``
+    elsewhere (so the search's ``argmax`` and comparisons take none of them)."""
+    if side == 0:
+        return d
+    return np.where((x <= 0) if side == 1 else (x > 0), d, -np.inf)
+
+
+def larger_side(first, second):
+    """Of two searches' results (deviation, where, inside; shape (k,) each), per
+    transition the one with the larger deviation (the first where they tie or the
+    second is nan): how the full search combines its two sides (:func:`_deviation_where`
+    and the compiled one alike)."""
+    take_second = second[0] > first[0]
+    return tuple(np.where(take_second, b, a) for a, b in zip(first, second))
 
 
 def _refine_sampled(packed: np.ndarray, at: np.ndarray, h: np.ndarray, best: np.ndarray,
