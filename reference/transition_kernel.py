@@ -5,7 +5,8 @@ the search measures (:func:`reference.core.transition_samedir._canonical_pieces`
 written as the plain loops they are.
 
 The search is that of :func:`reference.core.transition_sbend.pieces_deviation` (its
-docstring has the argument): samples along the rounding, scan rounds around the largest,
+docstring has the argument): samples along the rounding, scan rounds around the largest
+(with scan rounds, once on each side of the normal at ``J``, the larger taken),
 the last window cut where the rounding crosses the normal at ``J`` and the largest
 distance on each part by safeguarded Newton steps on its slope; or, with ``near``, the
 refinement alone around a place found before. Each transition's numbers are the

@@ -736,8 +736,8 @@ def _on_side(d: np.ndarray, x: np.ndarray, side: int) -> np.ndarray:
 
 def larger_side(first, second):
     """Of two searches' results (deviation, where, inside; shape (k,) each), per
-    transition the one with the larger deviation (the first where they tie or the
-    second is nan): how the full search combines its two sides (:func:`_deviation_where`
+    transition the second where its deviation is larger, else the first (where they
+    tie or either is nan): how the full search combines its two sides (:func:`_deviation_where`
     and the compiled one alike)."""
     take_second = second[0] > first[0]
     return tuple(np.where(take_second, b, a) for a, b in zip(first, second))
