@@ -288,10 +288,50 @@ def _crossing(packed, rows, a, b, xa, xb):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _sampled(packed: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
+             centre_out: np.ndarray, lin: np.ndarray):  # pragma: no cover - compiled
+    """The samples of the full search (``transition_sbend._samples`` and their
+    ``_distance``), once for both sides: distances, places (from the rounding's start)
+    and canonical ``x``, shape (k, p (n + 1)) each, ``lin`` =
+    ``numpy.linspace(0, 1, n + 1)``."""
+    k, p, n1 = packed.shape[0], packed.shape[1], lin.size
+    dev = np.empty((k, p * n1))
+    at = np.empty((k, p * n1))
+    xv = np.empty((k, p * n1))
+    sc = np.empty(2)
+    # every piece has a sample at its zero-curvature end (sigma 0): the integrals
+    # there, of +0 and of -0, evaluated once (the same numbers as at each sample)
+    zero = np.empty(4)
+    _FRESNEL(0.0, zero[0:].ctypes, zero[1:].ctypes)
+    _FRESNEL(-0.0, zero[2:].ctypes, zero[3:].ctypes)
+    for t in range(k):
+        for j in range(p):
+            rate, length, st = packed[t, j, 6], packed[t, j, 7], packed[t, j, 8]
+            scale = math.sqrt(np.pi / abs(rate))
+            for i in range(n1):
+                s_local = length * lin[i]
+                sigma = length - s_local if rate < 0 else s_local
+                z = sigma / scale
+                if z == 0.0:
+                    zi = 0 if math.copysign(1.0, z) > 0 else 2
+                    sc[0], sc[1] = zero[zi], zero[zi + 1]
+                else:
+                    _FRESNEL(z, sc[0:].ctypes, sc[1:].ctypes)
+                fc, fs = scale * sc[1], scale * sc[0]
+                x = packed[t, j, 0] + fc * packed[t, j, 2] + fs * packed[t, j, 4]
+                y = packed[t, j, 1] + fc * packed[t, j, 3] + fs * packed[t, j, 5]
+                dev[t, j * n1 + i] = _distance(x, y, x <= 0, r_in[t], r_out[t],
+                                               centre_out[t])
+                at[t, j * n1 + i] = st + s_local
+                xv[t, j * n1 + i] = x
+    return dev, at, xv
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.ndarray,
            centre_out: np.ndarray, near: np.ndarray, use_near: bool, samples: int,
-           scan: int, lin: np.ndarray, off: np.ndarray,
-           side: int):  # pragma: no cover - compiled
+           scan: int, off: np.ndarray, side: int, s_dev: np.ndarray, s_at: np.ndarray,
+           s_x: np.ndarray):  # pragma: no cover - compiled
     """The search of ``_deviation_where`` up to its fallback refinement.
 
     Parameters
@@ -306,13 +346,14 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
         Where to refine (with ``use_near``), mm.
     samples, scan : int
         Samples per piece and scan rounds (without ``use_near``).
-    lin : numpy.ndarray, shape (samples + 1,)
-        ``numpy.linspace(0, 1, samples + 1)``.
     off : numpy.ndarray, shape (REFINE_POINTS,)
         The scan's offsets, in units of its half width.
     side : int
         The samples and scan points taken: 1 those with ``x <= 0``, 2 ``x > 0``, 0 all
         (``transition_sbend._on_side``).
+    s_dev, s_at, s_x : numpy.ndarray, shape (k, p (samples + 1))
+        The samples' distances, places and ``x`` (:func:`_sampled`; unused with
+        ``use_near``).
 
     Returns
     -------
@@ -332,35 +373,13 @@ def search(packed: np.ndarray, total: np.ndarray, r_in: np.ndarray, r_out: np.nd
     if not use_near:
         n1 = samples + 1
         dev = np.empty(p * n1)
-        sv = np.empty(p * n1)
         d = np.empty(off.size)
         xs = np.empty(off.size)
-        # every piece has a sample at its zero-curvature end (sigma 0): the integrals
-        # there, of +0 and of -0, evaluated once (the same numbers as at each sample)
-        zero = np.empty(4)
-        _FRESNEL(0.0, zero[0:].ctypes, zero[1:].ctypes)
-        _FRESNEL(-0.0, zero[2:].ctypes, zero[3:].ctypes)
         for t in range(k):
-            for j in range(p):
-                rate, length, st = packed[t, j, 6], packed[t, j, 7], packed[t, j, 8]
-                scale = math.sqrt(np.pi / abs(rate))
-                for i in range(n1):
-                    s_local = length * lin[i]
-                    sigma = length - s_local if rate < 0 else s_local
-                    z = sigma / scale
-                    if z == 0.0:
-                        zi = 0 if math.copysign(1.0, z) > 0 else 2
-                        sc[0], sc[1] = zero[zi], zero[zi + 1]
-                    else:
-                        _FRESNEL(z, sc[0:].ctypes, sc[1:].ctypes)
-                    fc, fs = scale * sc[1], scale * sc[0]
-                    x = packed[t, j, 0] + fc * packed[t, j, 2] + fs * packed[t, j, 4]
-                    y = packed[t, j, 1] + fc * packed[t, j, 3] + fs * packed[t, j, 5]
-                    dev[j * n1 + i] = _on_side(_distance(x, y, x <= 0, r_in[t],
-                                                         r_out[t], centre_out[t]), x, side)
-                    sv[j * n1 + i] = st + s_local
+            for m in range(p * n1):
+                dev[m] = _on_side(s_dev[t, m], s_x[t, m], side)
             i = _argmax(dev)
-            best[t], at[t] = dev[i], sv[i]
+            best[t], at[t] = dev[i], s_at[t, i]
             h0[t] = packed[t, min(i // n1, p - 1), 7] / samples
             h[t] = h0[t]
             for _ in range(scan):
@@ -471,19 +490,15 @@ def _pack(origin, e1, e2, rates, lengths):  # pragma: no cover - compiled
 
 
 def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
-                    scan=SCAN_ROUNDS, side=0):
+                    scan=SCAN_ROUNDS):
     """:func:`reference.core.transition_sbend._deviation_where` by the compiled
     :func:`search` (the same arguments and results, bit for bit; the full search with
-    scan rounds once on each side, combined by the same :func:`~reference.core.
-    transition_sbend.larger_side`)."""
-    if near is None and scan > 0 and side == 0:
-        return larger_side(*(deviation_where(pieces, r_in, r_out, centre_out,
-                                             samples=samples, scan=scan, side=sd)
-                             for sd in (1, 2)))
+    scan rounds once on each side from the same samples, combined by the same
+    :func:`~reference.core.transition_sbend.larger_side`)."""
     lengths = pieces[4]
     k = lengths.shape[0]
     f64 = np.float64
-    total = lengths.sum(axis=1)
+    total = np.ascontiguousarray(lengths.sum(axis=1), f64)
     # packed by one compiled loop: numpy's concatenation of the (k, p, 2) strided parts
     # took about as long as a near search (1.1 ms of 8,000 transitions); the same-way
     # pieces come packed already (samedir_pieces)
@@ -495,16 +510,24 @@ def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMP
     use_near = near is not None
     near_arr = np.ascontiguousarray(near, f64) if use_near else np.zeros(k)
     off = (np.arange(REFINE_POINTS) - REFINE_POINTS // 2) / (REFINE_POINTS // 2)
-    best, where, at, h0, win_lo, win_hi, ok = search(
-        packed, np.ascontiguousarray(total, f64), r_in, r_out, centre_out, near_arr,
-        use_near, int(samples), int(scan), np.linspace(0.0, 1.0, int(samples) + 1), off,
-        int(side))
-    if not ok.all():
-        rest = np.flatnonzero(~ok)
-        best[rest] = np.maximum(best[rest], _refine_sampled(
-            packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
-            centre_out[rest]))
-    return best, where, (where > win_lo) & (where < win_hi)
+    sampled = ((np.zeros((k, 0)),) * 3 if use_near else
+               _sampled(packed, r_in, r_out, centre_out,
+                        np.linspace(0.0, 1.0, int(samples) + 1)))
+
+    def on_side(side):
+        best, where, at, h0, win_lo, win_hi, ok = search(
+            packed, total, r_in, r_out, centre_out, near_arr, use_near, int(samples),
+            int(scan), off, side, *sampled)
+        if not ok.all():
+            rest = np.flatnonzero(~ok)
+            best[rest] = np.maximum(best[rest], _refine_sampled(
+                packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
+                centre_out[rest]))
+        return best, where, (where > win_lo) & (where < win_hi)
+
+    if not use_near and scan > 0:
+        return larger_side(on_side(1), on_side(2))
+    return on_side(0)
 
 
 # ----------------------------------------------------------------- same-way landing

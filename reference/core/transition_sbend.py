@@ -630,7 +630,7 @@ def pieces_deviation(pieces, r_in: np.ndarray, r_out: np.ndarray,
 
 
 def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMPLES,
-                     scan=SCAN_ROUNDS, side=0):
+                     scan=SCAN_ROUNDS):
     """:func:`pieces_deviation` and where the largest distance was found (distance from
     the rounding's start, mm), shape (k,) each.
 
@@ -648,8 +648,7 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
     the sizing checks by a full search at its answer.
 
     The full search with scan rounds is run once on each side of the normal at ``J``
-    (``side`` 1: the samples and scan points with ``x <= 0``, measured from the first
-    circle; 2: ``x > 0``; 0: both, :func:`larger_side` of the two) and the larger taken:
+    from the same samples (:func:`_side_search`) and the larger taken (:func:`larger_side`):
     where the circle the distance is measured from changes, the distance has a sharp
     peak, and a smooth maximum just beyond it on the other side can be higher by less
     than the scan points miss it by, which the scan then never refines (measured: an
@@ -660,18 +659,32 @@ def _deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAM
 
     Returns the deviation, where it was found and whether that lies inside the last
     window (a maximum at its end lies beyond it, which a search ``near`` misses)."""
-    if near is None and scan > 0 and side == 0:
-        return larger_side(*(_deviation_where(pieces, r_in, r_out, centre_out,
-                                              samples=samples, scan=scan, side=sd)
-                             for sd in (1, 2)))
+    packed = _packed(pieces)
+    sampled = None
+    if near is None:
+        s, sx, sy = _samples(pieces, samples)
+        sampled = (s, sx, _distance(sx, sy, r_in, r_out, centre_out))
+    if near is None and scan > 0:
+        return larger_side(*(_side_search(pieces, packed, r_in, r_out, centre_out, None,
+                                          samples, scan, side, sampled)
+                             for side in (1, 2)))
+    return _side_search(pieces, packed, r_in, r_out, centre_out, near, samples, scan, 0,
+                        sampled)
+
+
+def _side_search(pieces, packed, r_in, r_out, centre_out, near, samples, scan, side,
+                 sampled):
+    """The search of :func:`_deviation_where` (``packed`` its pieces, :func:`_packed`)
+    with the samples and scan points on ``side`` of the normal at ``J`` (1: ``x <= 0``,
+    2: ``x > 0``, 0: all; :func:`_on_side`); ``sampled`` the samples' distances from the
+    start, ``x`` and distances, shape (k, p (samples + 1)) each (None with ``near``)."""
     lengths = pieces[4]
     k, n_pieces = lengths.shape
     rows = np.arange(k)
     total = lengths.sum(axis=1)
-    packed = _packed(pieces)
     if near is None:
-        s, sx, sy = _samples(pieces, samples)
-        dev = _on_side(_distance(sx, sy, r_in, r_out, centre_out), sx, side)
+        s, sx, dev = sampled
+        dev = _on_side(dev, sx, side)
         i = dev.argmax(axis=1)
         best, at = dev[rows, i], s[rows, i]
         h0 = lengths[rows, np.minimum(i // (samples + 1), n_pieces - 1)] / samples
