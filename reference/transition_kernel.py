@@ -71,7 +71,7 @@ from .core.transition_samedir import NEWTON_MAX_ITER as NEWTON_MAX_ITER_SAMEDIR
 from .core.transition_samedir import STEP_HALVINGS, _start
 from .core.transition_sbend import (DEV_SAMPLES, LANDING_TOL_MM, NEWTON_MAX_ITER,
                                     NEWTON_STEP_TOL, REFINE_POINTS, REFINE_SHRINK,
-                                    SCAN_ROUNDS, THETA_MAX, _refine_sampled, larger_side)
+                                    SCAN_ROUNDS, THETA_MAX, finished, larger_side)
 
 # scipy's Fresnel integrals for one double (S, C by pointer), the C function behind
 # scipy.special.fresnel, called by its symbol name (a ctypes pointer would be a constant
@@ -515,15 +515,9 @@ def deviation_where(pieces, r_in, r_out, centre_out, near=None, samples=DEV_SAMP
                         np.linspace(0.0, 1.0, int(samples) + 1)))
 
     def on_side(side):
-        best, where, at, h0, win_lo, win_hi, ok = search(
-            packed, total, r_in, r_out, centre_out, near_arr, use_near, int(samples),
-            int(scan), off, side, *sampled)
-        if not ok.all():
-            rest = np.flatnonzero(~ok)
-            best[rest] = np.maximum(best[rest], _refine_sampled(
-                packed[rest], at[rest], h0[rest], best[rest], r_in[rest], r_out[rest],
-                centre_out[rest]))
-        return best, where, (where > win_lo) & (where < win_hi)
+        return finished(packed, *search(packed, total, r_in, r_out, centre_out, near_arr,
+                                        use_near, int(samples), int(scan), off, side,
+                                        *sampled), r_in, r_out, centre_out)
 
     if not use_near and scan > 0:
         return larger_side(on_side(1), on_side(2))

@@ -730,6 +730,16 @@ def _side_search(pieces, packed, r_in, r_out, centre_out, near, samples, scan, s
         best[rw[up]] = value[part][up]
     ok = np.ones(k, dtype=bool)
     np.logical_and.at(ok, which, done)
+    return finished(packed, best, where, at, h0, win_lo, win_hi, ok, r_in, r_out,
+                    centre_out)
+
+
+def finished(packed, best, where, at, h0, win_lo, win_hi, ok, r_in, r_out, centre_out):
+    """A search's result (:func:`_side_search`, and the compiled one alike) from its
+    refinement (shape (k,) each): where the Newton steps did not converge (``ok``
+    false), the deviation raised to what :func:`_refine_sampled` finds around ``at``;
+    the deviation, where and whether that is inside the last window ``[win_lo,
+    win_hi]``."""
     if not ok.all():
         rest = np.flatnonzero(~ok)
         best[rest] = np.maximum(best[rest], _refine_sampled(
